@@ -1,0 +1,16 @@
+# Compile options for vsd's own targets. Everything here is PRIVATE so that
+# consumers never inherit our warnings, -Werror or sanitizer flags.
+function(vsd_target_options target)
+  target_compile_features(${target} PUBLIC cxx_std_20)
+  if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
+    target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic)
+    if(VSD_WERROR)
+      target_compile_options(${target} PRIVATE -Werror)
+    endif()
+    if(VSD_SANITIZE)
+      target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
+                                               -fno-sanitize-recover=all)
+      target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+    endif()
+  endif()
+endfunction()

@@ -1,0 +1,84 @@
+/** @file
+ *  @brief Environment: the whole simulation — its SimStates, id allocation, modules and step loop.
+ *
+ *  Schema apart from state: the Registry (what types are) is shared; each SimState holds values.
+ *  Ids come from one atomic counter per Environment, so SimStates filled in different threads can be
+ *  merged without clashes; the 16-bit site number keeps ids of different machines apart.
+ */
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <typeindex>
+#include <utility>
+#include <vector>
+
+#include "vsd/core/module.hpp"
+#include "vsd/core/registry.hpp"
+#include "vsd/core/scheduler.hpp"
+#include "vsd/core/sim_state.hpp"
+
+namespace vsd {
+
+class Environment : public Instance {
+  VSD_ABSTRACT_INSTANCE(Environment, Instance)
+
+ public:
+  /// @param site distinguishes environments that exchange transactions (machines, processes).
+  explicit Environment(std::uint16_t site = 0, Registry& registry = Registry::global());
+  ~Environment() override;
+
+  [[nodiscard]] Registry& registry() const noexcept { return *registry_; }
+  [[nodiscard]] std::uint16_t site() const noexcept { return site_; }
+  /// @brief The first SimState, made with the environment.
+  [[nodiscard]] SimState& main_state() const noexcept { return *states_.front(); }
+  /// @brief Makes another SimState (for a loader thread, a replica, a what-if copy, ...).
+  SimState& create_state(std::string name);
+  /// @brief Deletes a SimState other than the main one.
+  void remove_state(SimState& state);
+  [[nodiscard]] std::vector<SimState*> states() const;
+  /// @brief A fresh id, unique in this environment. Thread-safe.
+  [[nodiscard]] Id next_id() noexcept;
+
+  /// @brief Uses module M: on first use registers its types and attaches it. Returns the module.
+  template <class M, class... A>
+  M& use(A&&... args) {
+    if (Module* m = find_module(typeid(M))) return static_cast<M&>(*m);
+    auto mod = std::make_unique<M>(std::forward<A>(args)...);
+    M& ref = *mod;
+    add_module(typeid(M), std::move(mod));
+    return ref;
+  }
+  /// @brief The module of type M if it is used, else nullptr.
+  template <class M>
+  [[nodiscard]] M* module() const noexcept {
+    return static_cast<M*>(find_module(typeid(M)));
+  }
+  [[nodiscard]] std::vector<const Module*> modules() const;
+
+  [[nodiscard]] Scheduler& scheduler() noexcept { return scheduler_; }
+  /// @brief Simulated time in seconds.
+  [[nodiscard]] double time() const noexcept { return scheduler_.time(); }
+  /// @brief One step of the scheduler.
+  void step() { scheduler_.step(); }
+  VSD_METHOD(step)
+  /// @brief Steps for @p seconds of simulated time.
+  void run_for(double seconds) { scheduler_.run_for(seconds); }
+  VSD_METHOD(run_for)
+
+ private:
+  Module* find_module(std::type_index t) const noexcept;
+  void add_module(std::type_index t, std::unique_ptr<Module> m);
+
+  Registry* registry_;
+  std::uint16_t site_;
+  std::atomic<std::uint64_t> next_id_{2};  // 1 is every SimState's Database
+  std::vector<std::unique_ptr<SimState>> states_;
+  std::vector<std::pair<std::type_index, std::unique_ptr<Module>>> modules_;
+  Scheduler scheduler_;
+};
+
+}  // namespace vsd

@@ -1,0 +1,104 @@
+/** @file
+ *  @brief MetaTypes of the Eigen vocabulary: Vector2d/3d/4d, Quaterniond and Isometry3d frames.
+ *
+ *  They are structs to the meta-information system: vectors have fields x, y, (z, w); a quaternion
+ *  has w, x, y, z; a frame has a translation (Vector3d) and a rotation (Quaterniond). A struct whose
+ *  fields are all numbers is written as a list, so a Vector3d reads `[1, 2, 3]` and a frame
+ *  `{translation: [1, 2, 3], rotation: [1, 0, 0, 0]}`.
+ */
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "vsd/core/meta_type.hpp"
+
+namespace vsd {
+
+namespace detail {
+// Eigen default-constructs its types uninitialised; a value must start from a defined state.
+template <>
+struct DefaultValue<Eigen::Vector2d> {
+  static Eigen::Vector2d make() { return Eigen::Vector2d::Zero(); }
+};
+template <>
+struct DefaultValue<Eigen::Vector3d> {
+  static Eigen::Vector3d make() { return Eigen::Vector3d::Zero(); }
+};
+template <>
+struct DefaultValue<Eigen::Vector4d> {
+  static Eigen::Vector4d make() { return Eigen::Vector4d::Zero(); }
+};
+template <>
+struct DefaultValue<Eigen::Quaterniond> {
+  static Eigen::Quaterniond make() { return Eigen::Quaterniond::Identity(); }
+};
+template <>
+struct DefaultValue<Eigen::Isometry3d> {
+  static Eigen::Isometry3d make() { return Eigen::Isometry3d::Identity(); }
+};
+}  // namespace detail
+
+namespace detail {
+template <class V, int I>
+MetaType::Field eigen_coeff(const char* name) {
+  return {name, &meta_type<double>(), MetaType::npos,
+          [](const void* o, void* out) { *static_cast<double*>(out) = (*static_cast<const V*>(o))[I]; },
+          [](void* o, const void* in) { (*static_cast<V*>(o))[I] = *static_cast<const double*>(in); }};
+}
+}  // namespace detail
+
+template <>
+struct TypeTraits<Eigen::Vector2d> {
+  static MetaType make() {
+    auto t = detail::make_type<Eigen::Vector2d>("Vector2d", TypeKind::Struct);
+    t.add_field(detail::eigen_coeff<Eigen::Vector2d, 0>("x")).add_field(detail::eigen_coeff<Eigen::Vector2d, 1>("y"));
+    return t;
+  }
+};
+template <>
+struct TypeTraits<Eigen::Vector3d> {
+  static MetaType make() {
+    auto t = detail::make_type<Eigen::Vector3d>("Vector3d", TypeKind::Struct);
+    t.add_field(detail::eigen_coeff<Eigen::Vector3d, 0>("x"))
+        .add_field(detail::eigen_coeff<Eigen::Vector3d, 1>("y"))
+        .add_field(detail::eigen_coeff<Eigen::Vector3d, 2>("z"));
+    return t;
+  }
+};
+template <>
+struct TypeTraits<Eigen::Vector4d> {
+  static MetaType make() {
+    auto t = detail::make_type<Eigen::Vector4d>("Vector4d", TypeKind::Struct);
+    t.add_field(detail::eigen_coeff<Eigen::Vector4d, 0>("x"))
+        .add_field(detail::eigen_coeff<Eigen::Vector4d, 1>("y"))
+        .add_field(detail::eigen_coeff<Eigen::Vector4d, 2>("z"))
+        .add_field(detail::eigen_coeff<Eigen::Vector4d, 3>("w"));
+    return t;
+  }
+};
+
+namespace detail {
+void make_quaternion_fields(MetaType& t);
+void make_isometry_fields(MetaType& t);
+}  // namespace detail
+
+template <>
+struct TypeTraits<Eigen::Quaterniond> {
+  static MetaType make() {
+    auto t = detail::make_type<Eigen::Quaterniond>("Quaterniond", TypeKind::Struct);
+    detail::make_quaternion_fields(t);
+    return t;
+  }
+};
+template <>
+struct TypeTraits<Eigen::Isometry3d> {
+  static MetaType make() {
+    auto t = detail::make_type<Eigen::Isometry3d>("Isometry3d", TypeKind::Struct);
+    detail::make_isometry_fields(t);
+    return t;
+  }
+};
+
+
+}  // namespace vsd

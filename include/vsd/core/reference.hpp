@@ -1,0 +1,241 @@
+/** @file
+ *  @brief References between instances: Ref (composite), SharedRef (shared) and their lists.
+ *
+ *  - Composite aggregation, `Ref<T>` / `RefList<T>`: counted. All parent-child relations are composite.
+ *    When the last composite reference to an instance goes away, the instance is deleted with its own
+ *    composite subtree. A newly created instance has no composite reference; it lives (floating, still
+ *    in the element index) until it is attached and later released, or deleted explicitly.
+ *  - Shared aggregation, `SharedRef<T>` / `SharedRefList<T>`: not counted. When the target is deleted,
+ *    the reference becomes null (a list loses the element) and the holding instance emits a property
+ *    change, so holders are notified without polling.
+ *
+ *  A reference held in a property knows its holder, so every change to it goes through the holder
+ *  (signals, transactions). A reference held anywhere else ("free", e.g. a local variable or a Value) is
+ *  a plain handle: a free SharedRef is a safe weak handle, a free Ref owns like a shared pointer.
+ *  Properties hand out references only as const: there is no writable path around the change signal.
+ */
+#pragma once
+
+#include <cstddef>
+#include <string_view>
+#include <vector>
+
+#include "vsd/core/config.hpp"
+#include "vsd/core/meta_type.hpp"
+
+namespace vsd {
+
+namespace detail {
+
+struct RefAccess;  // the SimState's access to link internals (reference.cpp, sim_state.cpp)
+
+/// One reference: an entry in the intrusive list of its target's holders.
+struct RefLink {
+  SimStateInstance* target = nullptr;
+  SimStateInstance* holder = nullptr;  // instance whose property holds the link; null when free
+  const MetaProperty* prop = nullptr;
+  RefLink* prev = nullptr;
+  RefLink* next = nullptr;
+  bool composite = false;
+
+  explicit RefLink(bool is_composite) noexcept : composite(is_composite) {}
+  RefLink(const RefLink&) = delete;
+  RefLink& operator=(const RefLink&) = delete;
+  ~RefLink() { reset(nullptr); }
+
+  /// Points the link at @p t (nullptr clears). Releasing the last composite link of an instance deletes
+  /// it; linking to an instance that is being deleted throws vsd::Error.
+  void reset(SimStateInstance* t);
+  /// Detaches from the target without releasing it (the target is going away).
+  void drop() noexcept;
+};
+
+}  // namespace detail
+
+/// @brief Untyped storage shared by Ref<T> and SharedRef<T>.
+class RefBase {
+ public:
+  RefBase(const RefBase& o) : link_(o.link_.composite) { link_.reset(o.link_.target); }
+  RefBase& operator=(const RefBase& o) {
+    link_.reset(o.link_.target);
+    return *this;
+  }
+  ~RefBase() = default;
+
+  /// @brief The target, or nullptr.
+  [[nodiscard]] SimStateInstance* get() const noexcept { return link_.target; }
+  explicit operator bool() const noexcept { return link_.target != nullptr; }
+  /// @brief The target's id, or null_id.
+  [[nodiscard]] Id id() const noexcept;
+  [[nodiscard]] bool is_composite() const noexcept { return link_.composite; }
+  /// @brief The instance holding this reference in a property, or nullptr for a free reference.
+  [[nodiscard]] SimStateInstance* holder() const noexcept { return link_.holder; }
+
+  friend bool operator==(const RefBase& a, const RefBase& b) noexcept { return a.get() == b.get(); }
+
+ protected:
+  explicit RefBase(bool composite, SimStateInstance* t = nullptr) : link_(composite) { link_.reset(t); }
+  void reset_target(SimStateInstance* t) { link_.reset(t); }
+
+ private:
+  friend struct detail::RefAccess;
+  detail::RefLink link_;
+};
+
+/// @brief Composite (counted) reference to a T.
+template <class T>
+class Ref : public RefBase {
+ public:
+  Ref() : RefBase(true) {}
+  Ref(std::nullptr_t) : RefBase(true) {}  // NOLINT(google-explicit-constructor)
+  Ref(T* p) : RefBase(true, p) {}         // NOLINT(google-explicit-constructor)
+  Ref(T& p) : RefBase(true, &p) {}        // NOLINT(google-explicit-constructor)
+  Ref(const Ref&) = default;
+  Ref& operator=(const Ref&) = default;
+  Ref& operator=(T* p) {
+    reset_target(p);
+    return *this;
+  }
+  [[nodiscard]] T* get() const noexcept { return static_cast<T*>(RefBase::get()); }
+  T* operator->() const noexcept { return get(); }
+  T& operator*() const noexcept { return *get(); }
+};
+
+/// @brief Shared (uncounted) reference to a T: becomes null when the target is deleted.
+template <class T>
+class SharedRef : public RefBase {
+ public:
+  SharedRef() : RefBase(false) {}
+  SharedRef(std::nullptr_t) : RefBase(false) {}  // NOLINT(google-explicit-constructor)
+  SharedRef(T* p) : RefBase(false, p) {}         // NOLINT(google-explicit-constructor)
+  SharedRef(T& p) : RefBase(false, &p) {}        // NOLINT(google-explicit-constructor)
+  SharedRef(const SharedRef&) = default;
+  SharedRef& operator=(const SharedRef&) = default;
+  SharedRef& operator=(T* p) {
+    reset_target(p);
+    return *this;
+  }
+  [[nodiscard]] T* get() const noexcept { return static_cast<T*>(RefBase::get()); }
+  T* operator->() const noexcept { return get(); }
+  T& operator*() const noexcept { return *get(); }
+};
+
+/// @brief Untyped storage shared by RefList<T> and SharedRefList<T>: an ordered list of references.
+class RefListBase {
+ public:
+  RefListBase(const RefListBase& o);
+  RefListBase& operator=(const RefListBase& o);
+  RefListBase(RefListBase&& o) noexcept;
+  RefListBase& operator=(RefListBase&& o);
+  ~RefListBase();
+
+  [[nodiscard]] std::size_t size() const noexcept { return links_.size(); }
+  [[nodiscard]] bool empty() const noexcept { return links_.empty(); }
+  [[nodiscard]] SimStateInstance* at(std::size_t i) const noexcept { return links_[i]->target; }
+  [[nodiscard]] bool is_composite() const noexcept { return composite_; }
+  /// @brief Position of @p p, or npos.
+  [[nodiscard]] std::size_t index_of(const SimStateInstance* p) const noexcept;
+  [[nodiscard]] bool contains(const SimStateInstance* p) const noexcept { return index_of(p) != npos; }
+  static constexpr std::size_t npos = static_cast<std::size_t>(-1);
+
+  friend bool operator==(const RefListBase& a, const RefListBase& b) noexcept;
+
+ protected:
+  explicit RefListBase(bool composite) noexcept : composite_(composite) {}
+  void insert_at(std::size_t i, SimStateInstance* p);
+  void erase_at(std::size_t i);
+  void clear_all();
+
+ private:
+  friend struct detail::RefAccess;
+  std::vector<detail::RefLink*> links_;
+  SimStateInstance* holder_ = nullptr;
+  const MetaProperty* prop_ = nullptr;
+  bool composite_;
+};
+
+namespace detail {
+template <class T, class Base>
+class TypedRefList : public Base {
+ public:
+  class iterator {
+   public:
+    using value_type = T*;
+    using difference_type = std::ptrdiff_t;
+    iterator() = default;
+    iterator(const TypedRefList* l, std::size_t i) : l_(l), i_(i) {}
+    T* operator*() const noexcept { return static_cast<T*>(l_->at(i_)); }
+    iterator& operator++() noexcept {
+      ++i_;
+      return *this;
+    }
+    iterator operator++(int) noexcept {
+      auto c = *this;
+      ++i_;
+      return c;
+    }
+    bool operator==(const iterator& o) const noexcept { return i_ == o.i_; }
+
+   private:
+    const TypedRefList* l_ = nullptr;
+    std::size_t i_ = 0;
+  };
+  using Base::Base;
+  [[nodiscard]] T* operator[](std::size_t i) const noexcept { return static_cast<T*>(this->at(i)); }
+  [[nodiscard]] iterator begin() const noexcept { return {this, 0}; }
+  [[nodiscard]] iterator end() const noexcept { return {this, this->size()}; }
+  /// @brief Appends to a free list (lists held in properties change through their holder).
+  void push_back(T* p) { this->insert_at(this->size(), p); }
+  void insert(std::size_t i, T* p) { this->insert_at(i, p); }
+  void erase(std::size_t i) { this->erase_at(i); }
+  void clear() { this->clear_all(); }
+};
+}  // namespace detail
+
+/// @brief Ordered list of composite references to T.
+template <class T>
+class RefList : public detail::TypedRefList<T, RefListBase> {
+ public:
+  RefList() : detail::TypedRefList<T, RefListBase>(true) {}
+};
+
+/// @brief Ordered list of shared references to T.
+template <class T>
+class SharedRefList : public detail::TypedRefList<T, RefListBase> {
+ public:
+  SharedRefList() : detail::TypedRefList<T, RefListBase>(false) {}
+};
+
+namespace detail {
+extern const TypeOps ref_ops;
+extern const TypeOps ref_list_ops;
+
+template <class R, class T>
+MetaType make_ref_type(std::string_view prefix, TypeKind kind) {
+  MetaType t(std::string(prefix) + "<" + std::string(T::vsd_class_name) + ">", kind, sizeof(R), alignof(R),
+             kind == TypeKind::Ref || kind == TypeKind::SharedRef ? ref_ops : ref_list_ops);
+  t.set_target(+[]() -> const MetaInstance& { return T::static_meta(); });
+  return t;
+}
+}  // namespace detail
+
+template <class T>
+struct TypeTraits<Ref<T>> {
+  static MetaType make() { return detail::make_ref_type<Ref<T>, T>("ref", TypeKind::Ref); }
+};
+template <class T>
+struct TypeTraits<SharedRef<T>> {
+  static MetaType make() { return detail::make_ref_type<SharedRef<T>, T>("shared", TypeKind::SharedRef); }
+};
+template <class T>
+struct TypeTraits<RefList<T>> {
+  static MetaType make() { return detail::make_ref_type<RefList<T>, T>("list", TypeKind::RefList); }
+};
+template <class T>
+struct TypeTraits<SharedRefList<T>> {
+  static MetaType make() {
+    return detail::make_ref_type<SharedRefList<T>, T>("shared_list", TypeKind::SharedRefList);
+  }
+};
+
+}  // namespace vsd

@@ -1,0 +1,152 @@
+/** @file
+ *  @brief SimState: one state of the simulation — it owns its instances, the Database (spanning
+ *  tree), the ElementIndex and the signals, and it records and applies transactions.
+ *
+ *  Threading rule: a SimState belongs to one thread at a time. Other threads never touch it; they
+ *  build their own SimState and hand over a Transaction (bytes), which the owner applies.
+ *
+ *  Lifetime: instances live until deleted explicitly, until their last composite reference is
+ *  released, or until the SimState is destroyed. Deleting an instance deletes the composite subtree that
+ *  nothing else holds, nulls every shared reference to it (signalling the holders), and is recorded as
+ *  the sequence of those steps, so that a replica applying the bundle ends equal to the source.
+ */
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "vsd/core/database.hpp"
+#include "vsd/core/declare.hpp"
+#include "vsd/core/element_index.hpp"
+#include "vsd/core/transaction.hpp"
+
+namespace vsd {
+
+class Environment;
+namespace detail {
+class Applier;
+}  // namespace detail
+
+class SimState : public Instance {
+  VSD_ABSTRACT_INSTANCE(SimState, Instance)
+
+ public:
+  using InstanceSignal = Signal<void(SimStateInstance&)>;
+  using ChildSignal = Signal<void(Node& parent, Node& child)>;
+
+  SimState(Environment& env, std::string name);
+  ~SimState() override;
+
+  [[nodiscard]] Environment& environment() const noexcept { return *env_; }
+  [[nodiscard]] const std::string& name() const noexcept { return name_; }
+  /// @brief The root of the spanning tree (id 1).
+  [[nodiscard]] Database& database() const noexcept { return *root_; }
+  [[nodiscard]] ElementIndex& index() noexcept { return index_; }
+  [[nodiscard]] const ElementIndex& index() const noexcept { return index_; }
+
+  // ---- instances ----
+  /// @brief Creates an instance of class T (built-in or a C++ class declared with VSD_INSTANCE).
+  template <class T>
+  T& create() {
+    return static_cast<T&>(create(T::static_meta()));
+  }
+  /// @brief Creates an instance of @p cls (built-in or run-time). @throws vsd::Error for abstract classes.
+  SimStateInstance& create(const MetaInstance& cls);
+  /// @brief Creates an instance of the class named @p cls. @throws vsd::Error for unknown names.
+  SimStateInstance& create(std::string_view cls);
+  /// @brief Deletes @p inst now (see the file comment). @throws vsd::Error for the Database root or an
+  /// instance of another SimState.
+  void destroy(SimStateInstance& inst);
+  /// @brief The instance with id @p id, or nullptr.
+  [[nodiscard]] SimStateInstance* find(Id id) const noexcept;
+  template <class T>
+  [[nodiscard]] T* find(Id id) const noexcept {
+    SimStateInstance* i = find(id);
+    return i != nullptr ? i->template as<T>() : nullptr;
+  }
+  /// @brief Number of live instances, the Database included.
+  [[nodiscard]] std::size_t size() const noexcept { return by_id_.size(); }
+  /// @brief All live instances, ordered by id.
+  [[nodiscard]] std::vector<SimStateInstance*> instances() const;
+
+  // ---- signals ----
+  /// @brief Emitted after an instance is created and has its initial values.
+  InstanceSignal& on_created() noexcept { return created_; }
+  /// @brief Emitted when an instance starts being deleted, while it is still whole.
+  InstanceSignal& on_deleted() noexcept { return deleted_; }
+  /// @brief Emitted for every property change of every instance (reference lists included).
+  PropertySignal& on_property_changed();
+  /// @brief Emitted for property changes of instances of @p type (and subclasses, when asked).
+  PropertySignal& on_property_changed(const MetaInstance& type, bool include_subtypes = true);
+  ChildSignal& on_child_added() noexcept { return child_added_; }
+  ChildSignal& on_child_removed() noexcept { return child_removed_; }
+
+  // ---- transactions ----
+  /// @brief Starts recording every change into a bundle (continues an ongoing recording).
+  void start_recording();
+  /// @brief True while recording.
+  [[nodiscard]] bool recording() const noexcept { return recording_; }
+  /// @brief The changes recorded so far; recording goes on with an empty bundle.
+  Transaction take_recording();
+  /// @brief Stops recording and returns what was recorded.
+  Transaction stop_recording();
+  /// @brief Applies a bundle. Everything is checked first (ids, classes, properties, values, list
+  /// positions): a bundle that does not fit this state throws vsd::Error and changes nothing.
+  void apply(const Transaction& t);
+  /// @brief The whole state as a bundle that rebuilds it in an empty SimState.
+  [[nodiscard]] Transaction snapshot() const;
+  /// @brief Makes this (empty) state a copy of @p other. @throws vsd::Error when this state is not empty.
+  void copy_from(const SimState& other);
+  /// @brief Deep comparison: same ids, classes and property values (references by id).
+  /// @param difference receives a description of the first difference found.
+  [[nodiscard]] bool equals(const SimState& other, std::string* difference = nullptr) const;
+
+ private:
+  friend class SimStateInstance;
+  friend class Node;
+  friend class Database;
+  friend struct detail::RefAccess;
+  friend class detail::Applier;
+
+  SimStateInstance& make(const MetaInstance& cls, Id id);
+  void finish_create(SimStateInstance& inst);
+  void released(SimStateInstance& inst);  // last composite reference went away
+  void detach_link(detail::RefLink& link);
+  void clear_reference(SimStateInstance& inst, const MetaProperty& p);
+  void enable_state_watch();
+  bool state_watch_wanted() const noexcept;
+  void property_changed(SimStateInstance& inst, const MetaProperty& p, const void* old_value);
+  void list_changed(SimStateInstance& holder, const MetaProperty& p, std::size_t index, SimStateInstance& target,
+                    bool inserted);
+  PropertySignal* type_signal(const MetaInstance& m, bool tree) const noexcept;
+  void emit_property(SimStateInstance& inst, const MetaProperty& p);
+  void free_graveyard() noexcept;
+  struct Dispatch;
+
+  Environment* env_;
+  std::string name_;
+  Database* root_ = nullptr;
+  std::unordered_map<Id, SimStateInstance*> by_id_;
+  ElementIndex index_;
+  InstanceSignal created_;
+  InstanceSignal deleted_;
+  PropertySignal property_changed_;
+  ChildSignal child_added_;
+  ChildSignal child_removed_;
+  std::unordered_map<const SimStateInstance*, std::unique_ptr<PropertySignal>> instance_signals_;
+  std::vector<std::unique_ptr<PropertySignal>> type_exact_, type_tree_;
+  std::vector<SimStateInstance*> graveyard_;  // deleted during a dispatch, freed when it ends
+  int dispatching_ = 0;
+  std::size_t type_signals_ = 0;
+  std::vector<std::uint8_t> recorded_;
+  std::size_t recorded_ops_ = 0;
+  int applying_ = 0;
+  bool recording_ = false;
+  bool state_watch_ = false;
+};
+
+}  // namespace vsd

@@ -1,0 +1,74 @@
+/** @file
+ *  @brief TextReader: the small scanner behind MetaType::from_text, with line:col in every error.
+ *
+ *  The text form of values (used by persistence, scripting and the demo's printing):
+ *  `true`, `-12`, `0.5`, `"quoted \"string\""`, enum names `Red`, flags `Read|Write`,
+ *  structs `{x: 1, y: 2}`, vectors `[1, 2, 3]`, references `@42` or `null`.
+ */
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace vsd {
+
+/// @brief Reads the text form of values; throws vsd::Error("where:line:col: what") on bad input.
+class TextReader {
+ public:
+  /// @param text the text to read; @param origin names the source in error messages (file name, ...).
+  explicit TextReader(std::string_view text, std::string_view origin = {}) noexcept
+      : text_(text), origin_(origin) {}
+
+  void skip_ws() noexcept;
+  /// @brief Next non-blank character, or '\0' at the end.
+  [[nodiscard]] char peek() noexcept;
+  [[nodiscard]] bool at_end() noexcept;
+  /// @brief Consumes @p c if it is next (after blanks) and says so.
+  bool accept(char c) noexcept;
+  /// @brief Consumes @p c or throws.
+  void expect(char c);
+  /// @brief Reads an identifier: [A-Za-z_][A-Za-z0-9_]*, parts joined by '::'.
+  std::string_view identifier();
+  /// @brief Reads a quoted string with escapes.
+  std::string string();
+  /// @brief Reads a number token (sign, digits, '.', exponent, nan, inf) without converting it.
+  std::string_view number_token();
+  std::int64_t integer();
+  std::uint64_t unsigned_integer();
+  double real();
+  /// @brief Throws vsd::Error that names origin:line:col and @p what.
+  [[noreturn]] void fail(std::string_view what) const;
+  /// @brief Throws unless only blanks remain.
+  void expect_end();
+
+  [[nodiscard]] std::size_t position() const noexcept { return pos_; }
+  [[nodiscard]] std::size_t line() const noexcept;
+  [[nodiscard]] std::size_t column() const noexcept;
+
+  /// @brief Nesting guard for recursive values: throws beyond a fixed depth instead of overflowing.
+  class Nest {
+   public:
+    explicit Nest(TextReader& r);
+    ~Nest() { --r_.depth_; }
+    Nest(const Nest&) = delete;
+    Nest& operator=(const Nest&) = delete;
+
+   private:
+    TextReader& r_;
+  };
+
+ private:
+  std::string_view text_;
+  std::string_view origin_;
+  std::size_t pos_ = 0;
+  int depth_ = 0;
+};
+
+/// @brief Appends @p s to @p out as a quoted, escaped string.
+void write_quoted(std::string& out, std::string_view s);
+/// @brief Appends the shortest text that reads back as exactly @p v.
+void write_real(std::string& out, double v);
+
+}  // namespace vsd

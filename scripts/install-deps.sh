@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Installs the Debian packages vsd needs to build, test and benchmark. Idempotent: when every package
+# is already installed, apt is not touched at all. Uses sudo only when not running as root.
+#
+# Set VSD_SKIP_DEPS=1 to skip this step (e.g. on a machine whose dependencies are managed otherwise).
+set -euo pipefail
+
+# The one list of packages.
+PACKAGES=(
+  # toolchain and core dependencies
+  build-essential
+  cmake
+  g++
+  libeigen3-dev
+  # tests and benchmarks
+  libgtest-dev
+  libgmock-dev
+  libbenchmark-dev
+  # peers the benchmarks compare against
+  librttr-dev
+  qtbase5-dev
+  libboost-dev
+  libsigc++-3.0-dev
+)
+
+if [[ "${VSD_SKIP_DEPS:-0}" == "1" ]]; then
+  echo "install-deps: VSD_SKIP_DEPS=1, skipping"
+  exit 0
+fi
+
+missing=()
+for pkg in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q '^install ok installed$'; then
+    missing+=("$pkg")
+  fi
+done
+
+if [[ ${#missing[@]} -eq 0 ]]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages already installed"
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+if [[ "$(id -u)" -eq 0 ]]; then
+  SUDO=()
+elif command -v sudo >/dev/null 2>&1; then
+  SUDO=(sudo)
+else
+  echo "install-deps: not root and sudo is not available; please install: ${missing[*]}" >&2
+  exit 1
+fi
+
+"${SUDO[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update
+"${SUDO[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "${missing[@]}"

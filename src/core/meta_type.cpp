@@ -1,0 +1,314 @@
+#include "vsd/core/meta_type.hpp"
+
+#include <cstring>
+#include <string>
+
+#include "vsd/core/bytes.hpp"
+#include "vsd/core/error.hpp"
+#include "vsd/core/text.hpp"
+
+namespace vsd {
+
+std::string_view MetaType::enum_name(std::int64_t v) const noexcept {
+  for (const auto& e : enum_values_)
+    if (e.value == v) return e.name;
+  return {};
+}
+
+bool MetaType::enum_value(std::string_view n, std::int64_t& out) const noexcept {
+  for (const auto& e : enum_values_) {
+    if (e.name == n) {
+      out = e.value;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::int64_t MetaType::load_integer(const void* obj) const noexcept {
+  const bool is_unsigned = kind_ == TypeKind::UInt || kind_ == TypeKind::Flags || kind_ == TypeKind::Bool;
+  switch (size_) {
+    case 1: {
+      std::uint8_t v;
+      std::memcpy(&v, obj, 1);
+      return is_unsigned ? static_cast<std::int64_t>(v) : static_cast<std::int64_t>(static_cast<std::int8_t>(v));
+    }
+    case 2: {
+      std::uint16_t v;
+      std::memcpy(&v, obj, 2);
+      return is_unsigned ? static_cast<std::int64_t>(v) : static_cast<std::int64_t>(static_cast<std::int16_t>(v));
+    }
+    case 4: {
+      std::uint32_t v;
+      std::memcpy(&v, obj, 4);
+      return is_unsigned ? static_cast<std::int64_t>(v) : static_cast<std::int64_t>(static_cast<std::int32_t>(v));
+    }
+    default: {
+      std::int64_t v;
+      std::memcpy(&v, obj, 8);
+      return v;
+    }
+  }
+}
+
+void MetaType::store_integer(void* obj, std::int64_t v) const noexcept {
+  switch (size_) {
+    case 1: {
+      auto x = static_cast<std::uint8_t>(v);
+      std::memcpy(obj, &x, 1);
+      break;
+    }
+    case 2: {
+      auto x = static_cast<std::uint16_t>(v);
+      std::memcpy(obj, &x, 2);
+      break;
+    }
+    case 4: {
+      auto x = static_cast<std::uint32_t>(v);
+      std::memcpy(obj, &x, 4);
+      break;
+    }
+    default: std::memcpy(obj, &v, 8);
+  }
+}
+
+std::string MetaType::to_text(const void* obj) const {
+  std::string out;
+  write_text(obj, out);
+  return out;
+}
+
+void MetaType::from_text(void* obj, std::string_view text, const RefResolver* refs) const {
+  TextReader in(text);
+  read_text(obj, in, refs);
+  in.expect_end();
+}
+
+namespace detail {
+
+std::size_t hash_combine(std::size_t seed, std::size_t v) noexcept {
+  return seed ^ (v + 0x9e3779b97f4a7c15ULL + (seed << 6) + (seed >> 2));
+}
+
+namespace {
+
+// A field's value is reached in place when it has an offset, else copied through get/set into a
+// temporary of the field's type.
+class FieldValue {
+ public:
+  FieldValue(const MetaType::Field& f, const void* obj) : f_(f) {
+    if (f.offset != MetaType::npos) {
+      ptr_ = static_cast<const char*>(obj) + f.offset;
+    } else {
+      VSD_ASSERT(f.type->size() <= sizeof(buf_) && f.type->alignment() <= alignof(std::max_align_t),
+                 "get/set field too large for the scratch buffer");
+      f.type->construct(buf_);
+      owned_ = true;
+      f.get(obj, buf_);
+      ptr_ = buf_;
+    }
+  }
+  ~FieldValue() {
+    if (owned_) f_.type->destroy(buf_);
+  }
+  FieldValue(const FieldValue&) = delete;
+  FieldValue& operator=(const FieldValue&) = delete;
+  [[nodiscard]] const void* get() const noexcept { return ptr_; }
+  [[nodiscard]] void* mut() noexcept { return const_cast<void*>(ptr_); }
+  void store(void* obj) const {
+    if (owned_) f_.set(obj, buf_);
+  }
+
+ private:
+  const MetaType::Field& f_;
+  const void* ptr_ = nullptr;
+  alignas(std::max_align_t) unsigned char buf_[128];
+  bool owned_ = false;
+};
+
+bool all_numeric(const MetaType& t) {
+  for (const auto& f : t.fields())
+    if (!f.type->is_arithmetic()) return false;
+  return !t.fields().empty();
+}
+
+}  // namespace
+
+bool struct_equal(const MetaType& t, const void* a, const void* b) {
+  for (const auto& f : t.fields()) {
+    FieldValue fa(f, a), fb(f, b);
+    if (!f.type->equal(fa.get(), fb.get())) return false;
+  }
+  return true;
+}
+
+std::size_t struct_hash(const MetaType& t, const void* obj) {
+  std::size_t h = t.fields().size();
+  for (const auto& f : t.fields()) {
+    FieldValue fv(f, obj);
+    h = hash_combine(h, f.type->hash(fv.get()));
+  }
+  return h;
+}
+
+void struct_write_text(const MetaType& t, const void* obj, std::string& out) {
+  const bool positional = all_numeric(t);
+  out.push_back(positional ? '[' : '{');
+  bool first = true;
+  for (const auto& f : t.fields()) {
+    if (!first) out += ", ";
+    first = false;
+    if (!positional) {
+      out += f.name;
+      out += ": ";
+    }
+    FieldValue fv(f, obj);
+    f.type->write_text(fv.get(), out);
+  }
+  out.push_back(positional ? ']' : '}');
+}
+
+void struct_read_text(const MetaType& t, void* obj, TextReader& in, const RefResolver* refs) {
+  TextReader::Nest nest(in);
+  const auto& fields = t.fields();
+  if (in.accept('[')) {  // positional form: every field, in declaration order
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+      if (i != 0) in.expect(',');
+      FieldValue fv(fields[i], obj);
+      fields[i].type->read_text(fv.mut(), in, refs);
+      fv.store(obj);
+    }
+    if (in.peek() != ']') in.fail(t.name() + " has " + std::to_string(fields.size()) + " fields");
+    in.expect(']');
+    return;
+  }
+  if (in.peek() != '{') in.fail("expected '{' or '[' to start a " + t.name());
+  in.expect('{');
+  if (in.accept('}')) return;
+  do {
+    const auto name = in.identifier();
+    const MetaType::Field* field = nullptr;
+    for (const auto& f : fields)
+      if (f.name == name) field = &f;
+    if (field == nullptr) in.fail(t.name() + " has no field '" + std::string(name) + "'");
+    in.expect(':');
+    FieldValue fv(*field, obj);
+    field->type->read_text(fv.mut(), in, refs);
+    fv.store(obj);
+  } while (in.accept(','));
+  in.expect('}');
+}
+
+void struct_write_bytes(const MetaType& t, const void* obj, ByteWriter& out) {
+  for (const auto& f : t.fields()) {
+    FieldValue fv(f, obj);
+    f.type->write_bytes(fv.get(), out);
+  }
+}
+
+void struct_read_bytes(const MetaType& t, void* obj, ByteReader& in, const RefResolver* refs) {
+  for (const auto& f : t.fields()) {
+    FieldValue fv(f, obj);
+    f.type->read_bytes(fv.mut(), in, refs);
+    fv.store(obj);
+  }
+}
+
+void enum_write_text(const MetaType& t, const void* obj, std::string& out) {
+  const std::int64_t v = t.load_integer(obj);
+  if (t.kind() == TypeKind::Enum) {
+    const auto name = t.enum_name(v);
+    if (!name.empty()) {
+      out += name;
+    } else {
+      out += std::to_string(v);  // a value without a name still round-trips
+    }
+    return;
+  }
+  // Flags: names of the set bits joined by '|', unnamed bits as a number, nothing set as 0.
+  auto rest = static_cast<std::uint64_t>(v);
+  bool first = true;
+  for (const auto& e : t.enum_values()) {
+    const auto bit = static_cast<std::uint64_t>(e.value);
+    if (bit != 0 && (rest & bit) == bit) {
+      if (!first) out.push_back('|');
+      out += e.name;
+      rest &= ~bit;
+      first = false;
+    }
+  }
+  if (rest != 0 || first) {
+    if (!first) out.push_back('|');
+    out += std::to_string(rest);
+  }
+}
+
+void enum_read_text(const MetaType& t, void* obj, TextReader& in) {
+  std::int64_t total = 0;
+  do {
+    std::int64_t v = 0;
+    const char c = in.peek();
+    if (c == '-' || (c >= '0' && c <= '9')) {
+      v = in.integer();
+    } else {
+      const auto name = in.identifier();
+      if (!t.enum_value(name, v)) in.fail("'" + std::string(name) + "' is not a value of " + t.name());
+    }
+    total = t.kind() == TypeKind::Flags ? (total | v) : v;
+  } while (t.kind() == TypeKind::Flags && in.accept('|'));
+  t.store_integer(obj, total);
+}
+
+bool vector_read_text_next(TextReader& in, bool first) {
+  if (first) {
+    in.expect('[');
+    return !in.accept(']');
+  }
+  if (in.accept(']')) return false;
+  in.expect(',');
+  return true;
+}
+
+std::size_t vector_read_bytes_size(ByteReader& in, std::size_t min_element_bytes) {
+  return in.size_prefix(min_element_bytes);
+}
+
+void vector_write_bytes_size(ByteWriter& out, std::size_t n) { out.varint(n); }
+
+void make_quaternion_fields(MetaType& t) {
+  using Q = Eigen::Quaterniond;
+  t.add_field({"w", &meta_type<double>(), MetaType::npos,
+               [](const void* o, void* out) { *static_cast<double*>(out) = static_cast<const Q*>(o)->w(); },
+               [](void* o, const void* in) { static_cast<Q*>(o)->w() = *static_cast<const double*>(in); }});
+  t.add_field({"x", &meta_type<double>(), MetaType::npos,
+               [](const void* o, void* out) { *static_cast<double*>(out) = static_cast<const Q*>(o)->x(); },
+               [](void* o, const void* in) { static_cast<Q*>(o)->x() = *static_cast<const double*>(in); }});
+  t.add_field({"y", &meta_type<double>(), MetaType::npos,
+               [](const void* o, void* out) { *static_cast<double*>(out) = static_cast<const Q*>(o)->y(); },
+               [](void* o, const void* in) { static_cast<Q*>(o)->y() = *static_cast<const double*>(in); }});
+  t.add_field({"z", &meta_type<double>(), MetaType::npos,
+               [](const void* o, void* out) { *static_cast<double*>(out) = static_cast<const Q*>(o)->z(); },
+               [](void* o, const void* in) { static_cast<Q*>(o)->z() = *static_cast<const double*>(in); }});
+}
+
+void make_isometry_fields(MetaType& t) {
+  using I = Eigen::Isometry3d;
+  t.add_field({"translation", &meta_type<Eigen::Vector3d>(), MetaType::npos,
+               [](const void* o, void* out) {
+                 *static_cast<Eigen::Vector3d*>(out) = static_cast<const I*>(o)->translation();
+               },
+               [](void* o, const void* in) {
+                 static_cast<I*>(o)->translation() = *static_cast<const Eigen::Vector3d*>(in);
+               }});
+  t.add_field({"rotation", &meta_type<Eigen::Quaterniond>(), MetaType::npos,
+               [](const void* o, void* out) {
+                 *static_cast<Eigen::Quaterniond*>(out) = Eigen::Quaterniond(static_cast<const I*>(o)->linear());
+               },
+               [](void* o, const void* in) {
+                 static_cast<I*>(o)->linear() = static_cast<const Eigen::Quaterniond*>(in)->normalized().toRotationMatrix();
+               }});
+}
+
+}  // namespace detail
+
+}  // namespace vsd

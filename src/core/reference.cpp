@@ -1,0 +1,349 @@
+// References: the intrusive holder lists, counting, cycle checks, and the ops of reference MetaTypes.
+#include "vsd/core/reference.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "vsd/core/bytes.hpp"
+#include "vsd/core/error.hpp"
+#include "vsd/core/instance.hpp"
+#include "vsd/core/sim_state.hpp"
+#include "vsd/core/text.hpp"
+
+namespace vsd {
+
+namespace detail {
+
+struct RefAccess {
+  static RefLink*& head(SimStateInstance& t, bool composite) noexcept {
+    return composite ? t.composite_head_ : t.shared_head_;
+  }
+
+  static void unlink(RefLink& l) noexcept {
+    if (l.prev != nullptr) {
+      l.prev->next = l.next;
+    } else {
+      head(*l.target, l.composite) = l.next;
+    }
+    if (l.next != nullptr) l.next->prev = l.prev;
+    l.prev = l.next = nullptr;
+  }
+
+  static void link(RefLink& l, SimStateInstance& t) noexcept {
+    RefLink*& h = head(t, l.composite);
+    l.prev = nullptr;
+    l.next = h;
+    if (h != nullptr) h->prev = &l;
+    h = &l;
+    l.target = &t;
+  }
+
+  // True when @p t holds @p h through a chain of composite references (so h -> t would close a cycle).
+  static bool composite_ancestor(const SimStateInstance& t, const SimStateInstance& h) {
+    std::vector<const SimStateInstance*> todo{&h}, seen;
+    while (!todo.empty()) {
+      const SimStateInstance* x = todo.back();
+      todo.pop_back();
+      if (x == &t) return true;
+      if (std::find(seen.begin(), seen.end(), x) != seen.end()) continue;
+      seen.push_back(x);
+      for (const RefLink* l = x->composite_head_; l != nullptr; l = l->next)
+        if (l->holder != nullptr) todo.push_back(l->holder);
+    }
+    return false;
+  }
+
+  static void check(const RefLink& l, SimStateInstance& t) {
+    // A free reference may still point at a dying instance (old values being recorded, a listener's
+    // copy): the SimState drops such links before it frees the instance. A property may not.
+    if (t.is_being_deleted() && l.holder != nullptr)
+      throw_error("cannot reference instance #" + std::to_string(t.id()) + " of class '" + t.meta().name() +
+                  "': it is being deleted");
+    if (l.holder == nullptr) return;
+    if (t.state_ != l.holder->state_)
+      throw_error("instance #" + std::to_string(l.holder->id()) + " cannot reference instance #" +
+                  std::to_string(t.id()) + ": they live in different SimStates");
+    if (l.composite && composite_ancestor(t, *l.holder))
+      throw_error("a composite reference from #" + std::to_string(l.holder->id()) + " to #" + std::to_string(t.id()) +
+                  " would make an instance its own ancestor");
+  }
+
+  static void reset(RefLink& l, SimStateInstance* t) {
+    SimStateInstance* old = l.target;
+    if (t == old) return;
+    if (t != nullptr) check(l, *t);
+    if (old != nullptr) unlink(l);
+    if (t != nullptr) {
+      link(l, *t);
+      if (l.composite) ++t->refs_;
+    } else {
+      l.target = nullptr;
+    }
+    if (old != nullptr && l.composite && --old->refs_ == 0) old->state_->released(*old);
+  }
+
+  static void drop(RefLink& l) noexcept {
+    if (l.target == nullptr) return;
+    unlink(l);
+    if (l.composite) --l.target->refs_;
+    l.target = nullptr;
+  }
+
+  static std::vector<RefLink*>& links(RefListBase& r) noexcept { return r.links_; }
+  static void bind(RefListBase& r, SimStateInstance* holder, const MetaProperty* prop) noexcept {
+    r.holder_ = holder;
+    r.prop_ = prop;
+    for (RefLink* l : r.links_) {
+      l->holder = holder;
+      l->prop = prop;
+    }
+  }
+  static void bind(RefBase& r, SimStateInstance* holder, const MetaProperty* prop) noexcept {
+    r.link_.holder = holder;
+    r.link_.prop = prop;
+  }
+};
+
+void RefLink::reset(SimStateInstance* t) { RefAccess::reset(*this, t); }
+void RefLink::drop() noexcept { RefAccess::drop(*this); }
+
+}  // namespace detail
+
+Id RefBase::id() const noexcept { return link_.target != nullptr ? link_.target->id() : null_id; }
+
+// ---- RefListBase ------------------------------------------------------------------------------------------
+
+RefListBase::RefListBase(const RefListBase& o) : composite_(o.composite_) {
+  links_.reserve(o.links_.size());
+  for (const detail::RefLink* l : o.links_) insert_at(links_.size(), l->target);
+}
+
+RefListBase& RefListBase::operator=(const RefListBase& o) {
+  if (this == &o) return *this;
+  // Link the new targets before releasing the old ones, so an element in both never hits zero.
+  std::vector<detail::RefLink*> old;
+  old.swap(links_);
+  try {
+    for (const detail::RefLink* l : o.links_) insert_at(links_.size(), l->target);
+  } catch (...) {
+    for (auto* l : links_) delete l;
+    links_ = std::move(old);
+    throw;
+  }
+  for (auto* l : old) delete l;
+  return *this;
+}
+
+RefListBase::RefListBase(RefListBase&& o) noexcept : links_(std::move(o.links_)), composite_(o.composite_) {
+  o.links_.clear();
+  for (auto* l : links_) {  // a moved-to list is free
+    l->holder = nullptr;
+    l->prop = nullptr;
+  }
+}
+
+RefListBase& RefListBase::operator=(RefListBase&& o) {
+  if (this != &o) {
+    *this = static_cast<const RefListBase&>(o);
+    o.clear_all();
+  }
+  return *this;
+}
+
+RefListBase::~RefListBase() { clear_all(); }
+
+std::size_t RefListBase::index_of(const SimStateInstance* p) const noexcept {
+  for (std::size_t i = 0; i < links_.size(); ++i)
+    if (links_[i]->target == p) return i;
+  return npos;
+}
+
+bool operator==(const RefListBase& a, const RefListBase& b) noexcept {
+  if (a.links_.size() != b.links_.size()) return false;
+  for (std::size_t i = 0; i < a.links_.size(); ++i)
+    if (a.links_[i]->target != b.links_[i]->target) return false;
+  return true;
+}
+
+void RefListBase::insert_at(std::size_t i, SimStateInstance* p) {
+  if (p == nullptr) detail::throw_error("a reference list cannot hold null");
+  if (i > links_.size()) detail::throw_error("index " + std::to_string(i) + " is past the end of a list of " +
+                                             std::to_string(links_.size()));
+  auto* l = new detail::RefLink(composite_);
+  l->holder = holder_;
+  l->prop = prop_;
+  try {
+    links_.insert(links_.begin() + static_cast<std::ptrdiff_t>(i), l);
+  } catch (...) {
+    delete l;
+    throw;
+  }
+  try {
+    l->reset(p);
+  } catch (...) {
+    links_.erase(links_.begin() + static_cast<std::ptrdiff_t>(i));
+    delete l;
+    throw;
+  }
+}
+
+void RefListBase::erase_at(std::size_t i) {
+  if (i >= links_.size()) detail::throw_error("index " + std::to_string(i) + " is out of a list of " +
+                                              std::to_string(links_.size()));
+  detail::RefLink* l = links_[i];
+  links_.erase(links_.begin() + static_cast<std::ptrdiff_t>(i));
+  delete l;  // releases last: a cascade sees the list already updated
+}
+
+void RefListBase::clear_all() {
+  while (!links_.empty()) erase_at(links_.size() - 1);
+}
+
+// ---- ops of reference MetaTypes ---------------------------------------------------------------------------
+
+namespace detail {
+namespace {
+
+bool is_composite_kind(const MetaType& t) { return t.kind() == TypeKind::Ref || t.kind() == TypeKind::RefList; }
+
+SimStateInstance* resolve(const MetaType& t, Id id, const RefResolver* refs, const auto& fail) {
+  if (id == null_id) return nullptr;
+  if (refs == nullptr) fail("cannot resolve reference @" + std::to_string(id) + " here");
+  SimStateInstance* p = refs->resolve(id);
+  if (p == nullptr) fail("dangling reference: no instance @" + std::to_string(id));
+  if (t.target() != nullptr && !p->is_a(*t.target()))
+    fail("@" + std::to_string(id) + " is a '" + p->meta().name() + "', not a '" + t.target()->name() + "'");
+  return p;
+}
+
+struct RefCore : RefBase {  // gives the ops access to RefBase's protected constructor and reset
+  RefCore(bool composite, SimStateInstance* t) : RefBase(composite, t) {}
+  using RefBase::reset_target;
+};
+struct ListCore : RefListBase {
+  explicit ListCore(bool composite) : RefListBase(composite) {}
+  using RefListBase::clear_all;
+  using RefListBase::insert_at;
+};
+
+void ref_construct(const MetaType& t, void* dst) { ::new (dst) RefCore(is_composite_kind(t), nullptr); }
+void ref_copy(const MetaType&, void* dst, const void* src) { ::new (dst) RefBase(*static_cast<const RefBase*>(src)); }
+void ref_move(const MetaType&, void* dst, void* src) noexcept {
+  // Copying a link cannot fail for a valid source (same target), so this is safe as noexcept.
+  ::new (dst) RefBase(*static_cast<const RefBase*>(src));
+}
+void ref_destroy(const MetaType&, void* p) noexcept { static_cast<RefBase*>(p)->~RefBase(); }
+void ref_assign(const MetaType&, void* dst, const void* src) {
+  static_cast<RefCore*>(dst)->reset_target(static_cast<const RefBase*>(src)->get());
+}
+bool ref_equal(const MetaType&, const void* a, const void* b) {
+  return static_cast<const RefBase*>(a)->id() == static_cast<const RefBase*>(b)->id();
+}
+std::size_t ref_hash(const MetaType&, const void* p) { return std::hash<Id>{}(static_cast<const RefBase*>(p)->id()); }
+void write_id(std::string& out, Id id) {
+  if (id == null_id) {
+    out += "null";
+  } else {
+    out += "@" + std::to_string(id);
+  }
+}
+Id read_id(TextReader& in) {
+  if (in.accept('@')) return in.unsigned_integer();
+  const auto word = in.identifier();
+  if (word != "null") in.fail("expected a reference (@id or null), found '" + std::string(word) + "'");
+  return null_id;
+}
+void ref_write_text(const MetaType&, const void* p, std::string& out) {
+  write_id(out, static_cast<const RefBase*>(p)->id());
+}
+void ref_read_text(const MetaType& t, void* p, TextReader& in, const RefResolver* refs) {
+  const Id id = read_id(in);
+  SimStateInstance* target = resolve(t, id, refs, [&](const std::string& m) { in.fail(m); });
+  static_cast<RefCore*>(p)->reset_target(target);
+}
+void ref_write_bytes(const MetaType&, const void* p, ByteWriter& out) {
+  out.varint(static_cast<const RefBase*>(p)->id());
+}
+void ref_read_bytes(const MetaType& t, void* p, ByteReader& in, const RefResolver* refs) {
+  const Id id = in.varint();
+  SimStateInstance* target = resolve(t, id, refs, [&](const std::string& m) { in.fail(m); });
+  static_cast<RefCore*>(p)->reset_target(target);
+}
+void ref_bind(const MetaType&, void* p, SimStateInstance* holder, const MetaProperty* prop) {
+  RefAccess::bind(*static_cast<RefBase*>(p), holder, prop);
+}
+
+void list_construct(const MetaType& t, void* dst) { ::new (dst) ListCore(is_composite_kind(t)); }
+void list_copy(const MetaType&, void* dst, const void* src) {
+  ::new (dst) RefListBase(*static_cast<const RefListBase*>(src));
+}
+void list_move(const MetaType&, void* dst, void* src) noexcept {
+  ::new (dst) RefListBase(std::move(*static_cast<RefListBase*>(src)));
+}
+void list_destroy(const MetaType&, void* p) noexcept { static_cast<RefListBase*>(p)->~RefListBase(); }
+void list_assign(const MetaType&, void* dst, const void* src) {
+  *static_cast<RefListBase*>(dst) = *static_cast<const RefListBase*>(src);
+}
+bool list_equal(const MetaType&, const void* a, const void* b) {
+  const auto& x = *static_cast<const RefListBase*>(a);
+  const auto& y = *static_cast<const RefListBase*>(b);
+  if (x.size() != y.size()) return false;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (x.at(i)->id() != y.at(i)->id()) return false;  // by id: equal across replicas
+  return true;
+}
+std::size_t list_hash(const MetaType&, const void* p) {
+  const auto& x = *static_cast<const RefListBase*>(p);
+  std::size_t h = x.size();
+  for (std::size_t i = 0; i < x.size(); ++i) h = hash_combine(h, std::hash<Id>{}(x.at(i)->id()));
+  return h;
+}
+void list_write_text(const MetaType&, const void* p, std::string& out) {
+  const auto& x = *static_cast<const RefListBase*>(p);
+  out.push_back('[');
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (i != 0) out += ", ";
+    write_id(out, x.at(i)->id());
+  }
+  out.push_back(']');
+}
+void list_read_text(const MetaType& t, void* p, TextReader& in, const RefResolver* refs) {
+  ListCore fresh(is_composite_kind(t));
+  for (bool first = true; vector_read_text_next(in, first); first = false) {
+    const Id id = read_id(in);
+    if (id == null_id) in.fail("a reference list cannot hold null");
+    fresh.insert_at(fresh.size(), resolve(t, id, refs, [&](const std::string& m) { in.fail(m); }));
+  }
+  *static_cast<RefListBase*>(p) = fresh;
+}
+void list_write_bytes(const MetaType&, const void* p, ByteWriter& out) {
+  const auto& x = *static_cast<const RefListBase*>(p);
+  out.varint(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) out.varint(x.at(i)->id());
+}
+void list_read_bytes(const MetaType& t, void* p, ByteReader& in, const RefResolver* refs) {
+  ListCore fresh(is_composite_kind(t));
+  const std::size_t n = in.size_prefix(1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Id id = in.varint();
+    if (id == null_id) in.fail("a reference list cannot hold null");
+    fresh.insert_at(fresh.size(), resolve(t, id, refs, [&](const std::string& m) { in.fail(m); }));
+  }
+  *static_cast<RefListBase*>(p) = fresh;
+}
+void list_bind(const MetaType&, void* p, SimStateInstance* holder, const MetaProperty* prop) {
+  RefAccess::bind(*static_cast<RefListBase*>(p), holder, prop);
+}
+
+}  // namespace
+
+const TypeOps ref_ops{&ref_construct, &ref_copy,       &ref_move,      &ref_destroy,
+                      &ref_assign,    &ref_equal,      &ref_hash,      &ref_write_text,
+                      &ref_read_text, &ref_write_bytes, &ref_read_bytes, &ref_bind};
+const TypeOps ref_list_ops{&list_construct, &list_copy,       &list_move,      &list_destroy,
+                           &list_assign,    &list_equal,      &list_hash,      &list_write_text,
+                           &list_read_text, &list_write_bytes, &list_read_bytes, &list_bind};
+
+}  // namespace detail
+
+}  // namespace vsd

@@ -1,0 +1,175 @@
+#include "vsd/core/registry.hpp"
+
+#include <algorithm>
+
+#include "vsd/core/database.hpp"
+#include "vsd/core/environment.hpp"
+#include "vsd/core/error.hpp"
+#include "vsd/core/extension.hpp"
+#include "vsd/core/node.hpp"
+#include "vsd/core/reference.hpp"
+#include "vsd/core/sim_state.hpp"
+
+namespace vsd {
+
+namespace detail {
+bool auto_register(const MetaInstance& meta) noexcept {
+  try {
+    Registry::global().add(meta);
+    return true;
+  } catch (...) {
+    return false;  // a name clash is reported again, as an Error, by an explicit add()
+  }
+}
+}  // namespace detail
+
+Registry& Registry::global() {
+  // Never destroyed: static objects of any translation unit may still look classes up at exit.
+  static Registry& registry = *new Registry;
+  return registry;
+}
+
+Registry::Registry() {
+  // Built-in value types and core classes are always known by name.
+  for (const MetaType* t :
+       {&meta_type<bool>(), &meta_type<std::int8_t>(), &meta_type<std::int16_t>(), &meta_type<std::int32_t>(),
+        &meta_type<std::int64_t>(), &meta_type<std::uint8_t>(), &meta_type<std::uint16_t>(),
+        &meta_type<std::uint32_t>(), &meta_type<std::uint64_t>(), &meta_type<float>(), &meta_type<double>(),
+        &meta_type<std::string>(), &meta_type<Eigen::Vector2d>(), &meta_type<Eigen::Vector3d>(),
+        &meta_type<Eigen::Vector4d>(), &meta_type<Eigen::Quaterniond>(), &meta_type<Eigen::Isometry3d>(),
+        &meta_type<std::vector<bool>>(), &meta_type<std::vector<std::int32_t>>(),
+        &meta_type<std::vector<std::int64_t>>(), &meta_type<std::vector<double>>(),
+        &meta_type<std::vector<std::string>>(), &meta_type<std::vector<Eigen::Vector3d>>()})
+    add_type_locked(*t);
+  for (const MetaInstance* c :
+       {&Instance::static_meta(), &SimStateInstance::static_meta(), &NamedModelInstance::static_meta(),
+        &Node::static_meta(), &Extension::static_meta(), &Database::static_meta(), &SimState::static_meta(),
+        &Environment::static_meta()})
+    add_locked(*c);
+}
+
+Registry::~Registry() = default;
+
+void Registry::add(const MetaInstance& cls) {
+  std::unique_lock lock(mutex_);
+  add_locked(cls);
+}
+
+void Registry::add_locked(const MetaInstance& cls) {
+  auto [it, inserted] = classes_.emplace(cls.name(), &cls);
+  if (!inserted && it->second != &cls)
+    detail::throw_error("class name '" + cls.name() + "' is already registered for another class");
+  if (!inserted) return;
+  for (const MetaProperty* p : cls.own_properties())
+    if (!p->type().is_reference()) add_type_locked(p->type());
+}
+
+void Registry::add(const MetaType& type) {
+  std::unique_lock lock(mutex_);
+  add_type_locked(type);
+}
+
+void Registry::add_type_locked(const MetaType& type) {
+  auto [it, inserted] = types_.emplace(type.name(), &type);
+  if (!inserted && it->second != &type)
+    detail::throw_error("type name '" + type.name() + "' is already registered for another type");
+  if (type.element() != nullptr && !type.element()->is_reference()) add_type_locked(*type.element());
+  for (const auto& f : type.fields()) add_type_locked(*f.type);
+}
+
+const MetaInstance* Registry::find_class(std::string_view name) const {
+  std::shared_lock lock(mutex_);
+  auto it = classes_.find(std::string(name));
+  return it == classes_.end() ? nullptr : it->second;
+}
+
+const MetaInstance& Registry::get_class(std::string_view name) const {
+  if (const MetaInstance* c = find_class(name)) return *c;
+  detail::throw_error("unknown class '" + std::string(name) + "'");
+}
+
+const MetaType* Registry::find_type(std::string_view name) const {
+  std::shared_lock lock(mutex_);
+  auto it = types_.find(std::string(name));
+  return it == types_.end() ? nullptr : it->second;
+}
+
+const MetaType& Registry::get_type(std::string_view name) {
+  if (const MetaType* t = find_type(name)) return *t;
+  static constexpr std::pair<std::string_view, TypeKind> kinds[] = {{"ref<", TypeKind::Ref},
+                                                                     {"shared<", TypeKind::SharedRef},
+                                                                     {"list<", TypeKind::RefList},
+                                                                     {"shared_list<", TypeKind::SharedRefList}};
+  for (const auto& [prefix, kind] : kinds) {
+    if (name.size() > prefix.size() + 1 && name.substr(0, prefix.size()) == prefix && name.back() == '>') {
+      const auto cls = name.substr(prefix.size(), name.size() - prefix.size() - 1);
+      return reference_type(kind, get_class(cls));
+    }
+  }
+  detail::throw_error("unknown type '" + std::string(name) + "'");
+}
+
+const MetaType& Registry::reference_type(TypeKind kind, const MetaInstance& target) {
+  std::string prefix;
+  switch (kind) {
+    case TypeKind::Ref: prefix = "ref"; break;
+    case TypeKind::SharedRef: prefix = "shared"; break;
+    case TypeKind::RefList: prefix = "list"; break;
+    case TypeKind::SharedRefList: prefix = "shared_list"; break;
+    default: detail::throw_error("reference_type: not a reference kind");
+  }
+  const std::string name = prefix + "<" + target.name() + ">";
+  std::unique_lock lock(mutex_);
+  if (auto it = types_.find(name); it != types_.end()) return *it->second;
+  const bool single = kind == TypeKind::Ref || kind == TypeKind::SharedRef;
+  auto t = std::make_unique<MetaType>(name, kind, single ? sizeof(RefBase) : sizeof(RefListBase),
+                                      single ? alignof(RefBase) : alignof(RefListBase),
+                                      single ? detail::ref_ops : detail::ref_list_ops);
+  t->set_target(&target);
+  const MetaType& ref = *t;
+  runtime_types_.push_back(std::move(t));
+  types_.emplace(name, &ref);
+  return ref;
+}
+
+std::vector<const MetaInstance*> Registry::classes() const {
+  std::shared_lock lock(mutex_);
+  std::vector<const MetaInstance*> out;
+  for (const auto& [n, c] : classes_) out.push_back(c);
+  std::sort(out.begin(), out.end(), [](auto* a, auto* b) { return a->name() < b->name(); });
+  return out;
+}
+
+std::vector<const MetaType*> Registry::types() const {
+  std::shared_lock lock(mutex_);
+  std::vector<const MetaType*> out;
+  for (const auto& [n, t] : types_) out.push_back(t);
+  std::sort(out.begin(), out.end(), [](auto* a, auto* b) { return a->name() < b->name(); });
+  return out;
+}
+
+const MetaInstance& Registry::define(std::unique_ptr<MetaInstance> cls) {
+  std::unique_lock lock(mutex_);
+  if (classes_.count(cls->name()) != 0) detail::throw_error("class name '" + cls->name() + "' is already registered");
+  cls->link_to_base();
+  const MetaInstance& ref = *cls;
+  classes_.emplace(ref.name(), &ref);
+  for (const MetaProperty* p : ref.own_properties())
+    if (!p->type().is_reference()) add_type_locked(p->type());
+  runtime_classes_.push_back(std::move(cls));
+  return ref;
+}
+
+void Registry::undefine(const MetaInstance& cls) {
+  std::unique_lock lock(mutex_);
+  if (!cls.is_runtime()) detail::throw_error("built-in class '" + cls.name() + "' cannot be undefined");
+  if (cls.live_instances() != 0)
+    detail::throw_error("class '" + cls.name() + "' still has " + std::to_string(cls.live_instances()) + " instance(s)");
+  if (!cls.derived().empty()) detail::throw_error("class '" + cls.name() + "' still has subclasses");
+  auto it = std::find_if(runtime_classes_.begin(), runtime_classes_.end(), [&](auto& p) { return p.get() == &cls; });
+  if (it == runtime_classes_.end()) detail::throw_error("class '" + cls.name() + "' is not defined in this registry");
+  classes_.erase(cls.name());
+  runtime_classes_.erase(it);  // ~MetaInstance unlinks it from its base
+}
+
+}  // namespace vsd

@@ -1,0 +1,345 @@
+// SimState: instance lifetime, signals and transaction recording.
+#include "vsd/core/sim_state.hpp"
+
+#include <algorithm>
+
+#include "vsd/core/detail/tx_codec.hpp"
+#include "vsd/core/environment.hpp"
+#include "vsd/core/error.hpp"
+
+namespace vsd {
+
+/// Marks a dispatch in progress: instances deleted meanwhile stay allocated until the outermost one
+/// ends, so a listener that deletes an instance never pulls it from under the code that notifies.
+struct SimState::Dispatch {
+  explicit Dispatch(SimState& s) noexcept : s_(s) { ++s_.dispatching_; }
+  ~Dispatch() {
+    if (--s_.dispatching_ == 0) s_.free_graveyard();
+  }
+  Dispatch(const Dispatch&) = delete;
+  Dispatch& operator=(const Dispatch&) = delete;
+  SimState& s_;
+};
+
+SimState::SimState(Environment& env, std::string name) : env_(&env), name_(std::move(name)) {
+  set_meta(static_meta());
+  root_ = static_cast<Database*>(&make(Database::static_meta(), 1));
+}
+
+SimState::~SimState() {
+  ++applying_;  // no cascades while tearing down
+  // First cut every reference to every instance (free references outside become null), so that the
+  // instances can then be freed in any order.
+  for (auto& [id, x] : by_id_) {
+    while (x->composite_head_ != nullptr) x->composite_head_->drop();
+    while (x->shared_head_ != nullptr) x->shared_head_->drop();
+  }
+  for (auto& [id, x] : by_id_) x->meta().destroy(x);
+  by_id_.clear();
+  free_graveyard();
+}
+
+void SimState::free_graveyard() noexcept {
+  while (!graveyard_.empty()) {
+    SimStateInstance* x = graveyard_.back();
+    graveyard_.pop_back();
+    while (x->composite_head_ != nullptr) x->composite_head_->drop();  // free references still held
+    while (x->shared_head_ != nullptr) x->shared_head_->drop();
+    x->meta().destroy(x);
+  }
+}
+
+SimStateInstance& SimState::make(const MetaInstance& cls, Id id) {
+  if (!cls.is_a(SimStateInstance::static_meta()))
+    detail::throw_error("class '" + cls.name() + "' is not a SimStateInstance and cannot live in a SimState");
+  if (cls.is_abstract()) detail::throw_error("class '" + cls.name() + "' is abstract and cannot be instantiated");
+  if (root_ != nullptr && cls.is_a(Database::static_meta()))
+    detail::throw_error("SimState '" + name_ + "' already has its Database");
+  if (by_id_.count(id) != 0)
+    detail::throw_error("SimState '" + name_ + "' already has an instance #" + std::to_string(id));
+  void* memory = ::operator new(cls.size(), std::align_val_t(cls.alignment()));
+  SimStateInstance* obj = nullptr;
+  try {
+    obj = cls.construct(memory);
+  } catch (...) {
+    ::operator delete(memory, std::align_val_t(cls.alignment()));
+    throw;
+  }
+  obj->state_ = this;
+  obj->id_ = id;
+  obj->watch_ = state_watch_ ? SimStateInstance::state_watch : 0;
+  by_id_.emplace(id, obj);
+  index_.add(*obj);
+  return *obj;
+}
+
+void SimState::finish_create(SimStateInstance& inst) {
+  Dispatch d(*this);
+  if (recording_) {
+    detail::write_lifecycle(recorded_, Transaction::Op::Create, inst);
+    ++recorded_ops_;
+  }
+  created_.emit(inst);
+  index_.emit_created(inst);
+}
+
+SimStateInstance& SimState::create(const MetaInstance& cls) {
+  SimStateInstance& inst = make(cls, env_->next_id());
+  finish_create(inst);
+  return inst;
+}
+
+SimStateInstance& SimState::create(std::string_view cls) { return create(env_->registry().get_class(cls)); }
+
+SimStateInstance* SimState::find(Id id) const noexcept {
+  auto it = by_id_.find(id);
+  return it == by_id_.end() || it->second->is_being_deleted() ? nullptr : it->second;
+}
+
+std::vector<SimStateInstance*> SimState::instances() const {
+  std::vector<SimStateInstance*> out;
+  out.reserve(by_id_.size());
+  for (const auto& [id, x] : by_id_) out.push_back(x);
+  std::sort(out.begin(), out.end(), [](auto* a, auto* b) { return a->id() < b->id(); });
+  return out;
+}
+
+void SimState::released(SimStateInstance& inst) {
+  if (applying_ == 0 && !inst.is_being_deleted()) destroy(inst);
+}
+
+void SimState::destroy(SimStateInstance& x) {
+  if (x.state_ != this)
+    detail::throw_error("instance #" + std::to_string(x.id()) + " belongs to SimState '" + x.state_->name_ +
+                        "', not '" + name_ + "'");
+  if (&x == root_) detail::throw_error("the Database of SimState '" + name_ + "' cannot be deleted");
+  if (x.is_being_deleted()) return;
+  Dispatch d(*this);
+  x.life_ |= SimStateInstance::dying_bit;
+  deleted_.emit(x);
+  index_.emit_deleted(x);
+  // 1. Leave every composite holder (a parent's children list, ...): each step is a recorded change.
+  while (x.composite_head_ != nullptr) detach_link(*x.composite_head_);
+  // 2. Release what x holds; composite targets that nothing else holds go with it.
+  const auto refs = x.meta().reference_properties();
+  for (auto it = refs.rbegin(); it != refs.rend(); ++it) clear_reference(x, **it);
+  // 3. Null shared references to x; their holders are told through their change signals.
+  while (x.shared_head_ != nullptr) detach_link(*x.shared_head_);
+  if (recording_) {
+    detail::write_lifecycle(recorded_, Transaction::Op::Delete, x);
+    ++recorded_ops_;
+  }
+  by_id_.erase(x.id_);
+  index_.remove(x);
+  instance_signals_.erase(&x);
+  graveyard_.push_back(&x);
+}
+
+void SimState::detach_link(detail::RefLink& link) {
+  SimStateInstance* holder = link.holder;
+  if (holder == nullptr) {  // a free reference: it just becomes null
+    link.drop();
+    return;
+  }
+  const MetaProperty& p = *link.prop;
+  if (p.type().is_ref_list()) {
+    const auto& list = *static_cast<const RefListBase*>(p.address(*holder));
+    holder->list_erase(p, list.index_of(link.target));
+  } else {
+    const Value null(p.type());
+    p.assign_raw(*holder, null.data());
+  }
+}
+
+void SimState::clear_reference(SimStateInstance& inst, const MetaProperty& p) {
+  if (p.type().is_ref_list()) {
+    const auto& list = *static_cast<const RefListBase*>(p.address(inst));
+    while (!list.empty()) inst.list_erase(p, list.size() - 1);
+  } else if (static_cast<const RefBase*>(p.address(inst))->get() != nullptr) {
+    const Value null(p.type());
+    p.assign_raw(inst, null.data());
+  }
+}
+
+// ---- signals ----------------------------------------------------------------------------------------------
+
+void SimState::enable_state_watch() {
+  if (state_watch_) return;
+  state_watch_ = true;
+  for (auto& [id, x] : by_id_) x->watch_ |= SimStateInstance::state_watch;
+}
+
+bool SimState::state_watch_wanted() const noexcept {
+  return recording_ || property_changed_.has_listeners() || type_signals_ != 0;
+}
+
+PropertySignal& SimState::on_property_changed() {
+  enable_state_watch();
+  return property_changed_;
+}
+
+PropertySignal& SimState::on_property_changed(const MetaInstance& type, bool include_subtypes) {
+  auto& table = include_subtypes ? type_tree_ : type_exact_;
+  if (table.size() <= type.index()) table.resize(type.index() + 1);
+  auto& slot = table[type.index()];
+  if (!slot) {
+    slot = std::make_unique<PropertySignal>();
+    ++type_signals_;
+  }
+  enable_state_watch();
+  return *slot;
+}
+
+PropertySignal* SimState::type_signal(const MetaInstance& m, bool tree) const noexcept {
+  const auto& table = tree ? type_tree_ : type_exact_;
+  if (m.index() >= table.size()) return nullptr;
+  PropertySignal* s = table[m.index()].get();
+  return s != nullptr && s->has_listeners() ? s : nullptr;
+}
+
+void SimState::emit_property(SimStateInstance& inst, const MetaProperty& p) {
+  PropertySignal* own = nullptr;
+  if ((inst.watch_ & SimStateInstance::own_watch) != 0) {
+    auto it = instance_signals_.find(&inst);
+    if (it != instance_signals_.end() && it->second->has_listeners()) {
+      own = it->second.get();
+    } else {
+      inst.watch_ &= static_cast<std::uint8_t>(~SimStateInstance::own_watch);
+    }
+  }
+  if (!state_watch_wanted()) state_watch_ = false;
+  if (!state_watch_) inst.watch_ &= static_cast<std::uint8_t>(~SimStateInstance::state_watch);
+  if (own != nullptr) own->emit(inst, p);
+  if (!state_watch_) return;
+  if (type_signals_ != 0) {
+    if (PropertySignal* s = type_signal(inst.meta(), false)) s->emit(inst, p);
+    for (const MetaInstance* m = &inst.meta(); m != nullptr; m = m->base())
+      if (PropertySignal* s = type_signal(*m, true)) s->emit(inst, p);
+  }
+  property_changed_.emit(inst, p);
+}
+
+void SimState::property_changed(SimStateInstance& inst, const MetaProperty& p, const void* old_value) {
+  Dispatch d(*this);
+  if (recording_ && !p.has(Transient)) {
+    detail::write_set(recorded_, inst, p, old_value, p.address(inst));
+    ++recorded_ops_;
+  }
+  emit_property(inst, p);
+}
+
+void SimState::list_changed(SimStateInstance& holder, const MetaProperty& p, std::size_t index,
+                            SimStateInstance& target, bool inserted) {
+  Dispatch d(*this);
+  if (recording_ && !p.has(Transient)) {
+    detail::write_list(recorded_, inserted ? Transaction::Op::Insert : Transaction::Op::Erase, holder.id(), p, index,
+                       target.id());
+    ++recorded_ops_;
+  }
+  if (&p == &Node::vsd_prop_children()) {
+    auto& parent = static_cast<Node&>(holder);
+    auto& child = static_cast<Node&>(target);
+    if (inserted) {
+      child_added_.emit(parent, child);
+      root_->notify_attached(parent, child);
+    } else {
+      child_removed_.emit(parent, child);
+      root_->notify_detached(parent, child);
+    }
+  }
+  if (holder.watch_ != 0) emit_property(holder, p);
+}
+
+// ---- transactions -----------------------------------------------------------------------------------------
+
+void SimState::start_recording() {
+  if (recorded_.empty()) detail::write_tx_header(recorded_);
+  recording_ = true;
+  enable_state_watch();
+}
+
+Transaction SimState::take_recording() {
+  Transaction t;
+  if (!recorded_.empty()) {
+    t.bytes_ = std::move(recorded_);
+    t.ops_ = recorded_ops_;
+  }
+  recorded_.clear();
+  recorded_ops_ = 0;
+  if (recording_) detail::write_tx_header(recorded_);
+  return t;
+}
+
+Transaction SimState::stop_recording() {
+  recording_ = false;
+  Transaction t = take_recording();
+  return t;
+}
+
+Transaction SimState::snapshot() const {
+  Transaction t;
+  std::vector<std::uint8_t>& out = t.bytes_;
+  detail::write_tx_header(out);
+  const auto all = instances();
+  for (SimStateInstance* x : all) {
+    if (x == root_) {
+      for (const MetaProperty* p : x->meta().properties()) {
+        if (!detail::carried_in_payload(*p) || p->type().equal(p->address(*x), p->default_value().data())) continue;
+        detail::write_set(out, *x, *p, p->default_value().data(), p->address(*x));
+        ++t.ops_;
+      }
+      continue;
+    }
+    detail::write_lifecycle(out, Transaction::Op::Create, *x);
+    ++t.ops_;
+  }
+  for (SimStateInstance* x : all) {
+    for (const MetaProperty* p : x->meta().reference_properties()) {
+      if (p->has(Transient)) continue;
+      if (p->type().is_ref_list()) {
+        const auto& list = *static_cast<const RefListBase*>(p->address(*x));
+        for (std::size_t i = 0; i < list.size(); ++i) {
+          detail::write_list(out, Transaction::Op::Insert, x->id(), *p, i, list.at(i)->id());
+          ++t.ops_;
+        }
+      } else if (static_cast<const RefBase*>(p->address(*x))->get() != nullptr) {
+        const Value null(p->type());
+        detail::write_set(out, *x, *p, null.data(), p->address(*x));
+        ++t.ops_;
+      }
+    }
+  }
+  if (t.ops_ == 0) t.bytes_.clear();
+  return t;
+}
+
+void SimState::copy_from(const SimState& other) {
+  if (size() != 1 || !root_->children().empty())
+    detail::throw_error("copy_from needs an empty SimState, but '" + name_ + "' holds " + std::to_string(size()) +
+                        " instances");
+  apply(other.snapshot());
+}
+
+bool SimState::equals(const SimState& other, std::string* difference) const {
+  auto differ = [&](std::string what) {
+    if (difference != nullptr) *difference = std::move(what);
+    return false;
+  };
+  if (size() != other.size())
+    return differ("instance count " + std::to_string(size()) + " vs " + std::to_string(other.size()));
+  for (SimStateInstance* x : instances()) {
+    const SimStateInstance* y = other.find(x->id());
+    if (y == nullptr) return differ("#" + std::to_string(x->id()) + " missing");
+    if (&x->meta() != &y->meta())
+      return differ("#" + std::to_string(x->id()) + " is a " + x->meta().name() + " vs a " + y->meta().name());
+    for (const MetaProperty* p : x->meta().properties()) {
+      if (p->has(Transient)) continue;
+      if (!p->type().equal(p->address(*x), p->address(*y)))
+        return differ("#" + std::to_string(x->id()) + "." + p->name() + ": " + p->type().to_text(p->address(*x)) +
+                      " vs " + p->type().to_text(p->address(*y)));
+    }
+  }
+  return true;
+}
+
+}  // namespace vsd

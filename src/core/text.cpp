@@ -1,0 +1,237 @@
+#include "vsd/core/text.hpp"
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+
+#include "vsd/core/error.hpp"
+
+namespace vsd {
+
+namespace {
+constexpr int max_text_depth = 256;
+bool ident_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) != 0 || c == '_'; }
+bool ident_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_'; }
+}  // namespace
+
+TextReader::Nest::Nest(TextReader& r) : r_(r) {
+  if (++r_.depth_ > max_text_depth) {
+    --r_.depth_;
+    r_.fail("values nested deeper than " + std::to_string(max_text_depth));
+  }
+}
+
+void TextReader::skip_ws() noexcept {
+  while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_])) != 0) ++pos_;
+}
+
+char TextReader::peek() noexcept {
+  skip_ws();
+  return pos_ < text_.size() ? text_[pos_] : '\0';
+}
+
+bool TextReader::at_end() noexcept {
+  skip_ws();
+  return pos_ >= text_.size();
+}
+
+bool TextReader::accept(char c) noexcept {
+  if (peek() != c || at_end()) return false;
+  ++pos_;
+  return true;
+}
+
+void TextReader::expect(char c) {
+  if (!accept(c)) {
+    if (at_end()) fail(std::string("expected '") + c + "' but the text ended");
+    fail(std::string("expected '") + c + "' but found '" + text_[pos_] + "'");
+  }
+}
+
+std::string_view TextReader::identifier() {
+  skip_ws();
+  if (pos_ >= text_.size() || !ident_start(text_[pos_])) fail("expected a name");
+  const std::size_t start = pos_;
+  while (pos_ < text_.size()) {
+    if (ident_char(text_[pos_])) {
+      ++pos_;
+    } else if (text_.substr(pos_, 2) == "::" && pos_ + 2 < text_.size() && ident_start(text_[pos_ + 2])) {
+      pos_ += 2;  // qualified names such as vsd::Node
+    } else {
+      break;
+    }
+  }
+  return text_.substr(start, pos_ - start);
+}
+
+std::string TextReader::string() {
+  skip_ws();
+  if (pos_ >= text_.size() || text_[pos_] != '"') fail("expected a quoted string");
+  ++pos_;
+  std::string out;
+  while (true) {
+    if (pos_ >= text_.size()) fail("unterminated string");
+    const char c = text_[pos_++];
+    if (c == '"') return out;
+    if (c != '\\') {
+      out.push_back(c);
+      continue;
+    }
+    if (pos_ >= text_.size()) fail("unterminated escape in string");
+    const char e = text_[pos_++];
+    switch (e) {
+      case '"': out.push_back('"'); break;
+      case '\\': out.push_back('\\'); break;
+      case '/': out.push_back('/'); break;
+      case 'n': out.push_back('\n'); break;
+      case 't': out.push_back('\t'); break;
+      case 'r': out.push_back('\r'); break;
+      case 'b': out.push_back('\b'); break;
+      case 'f': out.push_back('\f'); break;
+      case 'u': {
+        if (text_.size() - pos_ < 4) fail("truncated \\u escape");
+        unsigned code = 0;
+        auto [p, ec] = std::from_chars(text_.data() + pos_, text_.data() + pos_ + 4, code, 16);
+        if (ec != std::errc() || p != text_.data() + pos_ + 4) fail("bad \\u escape");
+        pos_ += 4;
+        // Encode as UTF-8 (surrogate pairs are passed through as-is: values are bytes to vsd).
+        if (code < 0x80) {
+          out.push_back(static_cast<char>(code));
+        } else if (code < 0x800) {
+          out.push_back(static_cast<char>(0xC0 | (code >> 6)));
+          out.push_back(static_cast<char>(0x80 | (code & 0x3F)));
+        } else {
+          out.push_back(static_cast<char>(0xE0 | (code >> 12)));
+          out.push_back(static_cast<char>(0x80 | ((code >> 6) & 0x3F)));
+          out.push_back(static_cast<char>(0x80 | (code & 0x3F)));
+        }
+        break;
+      }
+      default: --pos_; fail(std::string("unknown escape '\\") + e + "'");
+    }
+  }
+}
+
+std::string_view TextReader::number_token() {
+  skip_ws();
+  const std::size_t start = pos_;
+  if (pos_ < text_.size() && (text_[pos_] == '-' || text_[pos_] == '+')) ++pos_;
+  while (pos_ < text_.size()) {
+    const char c = text_[pos_];
+    if (std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '.' ||
+        ((c == '-' || c == '+') && (text_[pos_ - 1] == 'e' || text_[pos_ - 1] == 'E')))
+      ++pos_;
+    else
+      break;
+  }
+  if (pos_ == start) fail("expected a number");
+  return text_.substr(start, pos_ - start);
+}
+
+std::int64_t TextReader::integer() {
+  const std::size_t at = (skip_ws(), pos_);
+  auto tok = number_token();
+  if (!tok.empty() && tok[0] == '+') tok.remove_prefix(1);
+  std::int64_t v = 0;
+  auto [p, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
+  if (ec != std::errc() || p != tok.data() + tok.size()) {
+    pos_ = at;
+    fail("'" + std::string(tok) + "' is not an integer" + (ec == std::errc::result_out_of_range ? " in range" : ""));
+  }
+  return v;
+}
+
+std::uint64_t TextReader::unsigned_integer() {
+  const std::size_t at = (skip_ws(), pos_);
+  auto tok = number_token();
+  if (!tok.empty() && tok[0] == '+') tok.remove_prefix(1);
+  std::uint64_t v = 0;
+  auto [p, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
+  if (ec != std::errc() || p != tok.data() + tok.size()) {
+    pos_ = at;
+    fail("'" + std::string(tok) + "' is not an unsigned integer" +
+         (ec == std::errc::result_out_of_range ? " in range" : ""));
+  }
+  return v;
+}
+
+double TextReader::real() {
+  const std::size_t at = (skip_ws(), pos_);
+  auto tok = number_token();
+  if (!tok.empty() && tok[0] == '+') tok.remove_prefix(1);
+  if (tok == "nan" || tok == "-nan") return std::numeric_limits<double>::quiet_NaN();
+  if (tok == "inf") return std::numeric_limits<double>::infinity();
+  if (tok == "-inf") return -std::numeric_limits<double>::infinity();
+  double v = 0;
+  auto [p, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
+  if (ec != std::errc() || p != tok.data() + tok.size()) {
+    pos_ = at;
+    fail("'" + std::string(tok) + "' is not a number");
+  }
+  return v;
+}
+
+void TextReader::expect_end() {
+  if (!at_end()) fail(std::string("unexpected '") + text_[pos_] + "' after the value");
+}
+
+std::size_t TextReader::line() const noexcept {
+  std::size_t l = 1;
+  for (std::size_t i = 0; i < pos_ && i < text_.size(); ++i) l += text_[i] == '\n' ? 1 : 0;
+  return l;
+}
+
+std::size_t TextReader::column() const noexcept {
+  std::size_t c = 1;
+  for (std::size_t i = 0; i < pos_ && i < text_.size(); ++i) c = text_[i] == '\n' ? 1 : c + 1;
+  return c;
+}
+
+void TextReader::fail(std::string_view what) const {
+  std::string msg;
+  if (!origin_.empty()) msg.append(origin_).push_back(':');
+  msg += std::to_string(line()) + ":" + std::to_string(column()) + ": " + std::string(what);
+  throw Error(msg);
+}
+
+void write_quoted(std::string& out, std::string_view s) {
+  out.push_back('"');
+  for (const char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      case '\r': out += "\\r"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+          out += buf;
+        } else {
+          out.push_back(c);
+        }
+    }
+  }
+  out.push_back('"');
+}
+
+void write_real(std::string& out, double v) {
+  if (std::isnan(v)) {
+    out += "nan";
+    return;
+  }
+  if (std::isinf(v)) {
+    out += v < 0 ? "-inf" : "inf";
+    return;
+  }
+  char buf[32];
+  auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  (void)ec;
+  out.append(buf, p);
+}
+
+}  // namespace vsd

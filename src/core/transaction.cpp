@@ -1,0 +1,436 @@
+// Transaction bundles: encoding, parsing, inversion, and applying with an all-or-nothing check first.
+#include "vsd/core/transaction.hpp"
+
+#include <cstring>
+#include <map>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "vsd/core/bytes.hpp"
+#include "vsd/core/detail/tx_codec.hpp"
+#include "vsd/core/environment.hpp"
+#include "vsd/core/error.hpp"
+#include "vsd/core/sim_state.hpp"
+
+namespace vsd {
+
+namespace detail {
+
+namespace {
+constexpr std::uint8_t magic[4] = {'V', 'S', 'D', 'T'};
+constexpr std::size_t header_size = 5;
+
+// Writes a value framed by a 4-byte length, so that readers can skip or check it without its type.
+void write_framed(std::vector<std::uint8_t>& out, const MetaType& type, const void* value) {
+  const std::size_t at = out.size();
+  out.resize(at + 4);
+  ByteWriter w(out);
+  type.write_bytes(value, w);
+  const auto n = static_cast<std::uint32_t>(out.size() - at - 4);
+  std::memcpy(out.data() + at, &n, 4);
+}
+
+std::span<const std::uint8_t> read_framed(ByteReader& r) {
+  const auto n = r.fixed<std::uint32_t>();
+  if (n > r.remaining()) r.fail("a value of " + std::to_string(n) + " bytes runs past the end of the bundle");
+  return {r.skip(n), n};
+}
+}  // namespace
+
+bool carried_in_payload(const MetaProperty& p) noexcept { return !p.type().is_reference() && !p.has(Transient); }
+
+void write_tx_header(std::vector<std::uint8_t>& out) {
+  out.insert(out.end(), std::begin(magic), std::end(magic));
+  out.push_back(Transaction::format_version);
+}
+
+void write_lifecycle(std::vector<std::uint8_t>& out, Transaction::Op op, const SimStateInstance& inst) {
+  ByteWriter w(out);
+  w.u8(static_cast<std::uint8_t>(op));
+  w.varint(inst.id());
+  w.string(inst.meta().name());
+  std::size_t n = 0;
+  for (const MetaProperty* p : inst.meta().properties()) n += carried_in_payload(*p) ? 1 : 0;
+  w.varint(n);
+  for (const MetaProperty* p : inst.meta().properties()) {
+    if (!carried_in_payload(*p)) continue;
+    w.string(p->name());
+    write_framed(out, p->type(), p->address(inst));
+  }
+}
+
+void write_set(std::vector<std::uint8_t>& out, const SimStateInstance& inst, const MetaProperty& p,
+               const void* old_value, const void* new_value) {
+  ByteWriter w(out);
+  w.u8(static_cast<std::uint8_t>(Transaction::Op::Set));
+  w.varint(inst.id());
+  w.string(p.name());
+  write_framed(out, p.type(), old_value);
+  write_framed(out, p.type(), new_value);
+}
+
+void write_list(std::vector<std::uint8_t>& out, Transaction::Op op, Id holder, const MetaProperty& p,
+                std::size_t index, Id target) {
+  ByteWriter w(out);
+  w.u8(static_cast<std::uint8_t>(op));
+  w.varint(holder);
+  w.string(p.name());
+  w.varint(index);
+  w.varint(target);
+}
+
+}  // namespace detail
+}  // namespace vsd
+
+namespace vsd {
+namespace detail {
+
+std::vector<TxOp> parse_tx(const Transaction& t) {
+  const auto& b = t.bytes();
+  ByteReader r(b.data(), b.size());
+  std::vector<TxOp> ops;
+  if (b.empty()) return ops;
+  r.skip(header_size);
+  while (!r.at_end()) {
+    TxOp op;
+    op.offset = r.position();
+    const std::uint8_t code = r.u8();
+    if (code < 1 || code > 5) {
+      ByteReader at(b.data(), b.size());
+      at.skip(op.offset);
+      at.fail("unknown operation code " + std::to_string(code));
+    }
+    op.op = static_cast<Transaction::Op>(code);
+    op.id = r.varint();
+    op.name = r.string_view();
+    switch (op.op) {
+      case Transaction::Op::Create:
+      case Transaction::Op::Delete: {
+        const std::size_t n = r.size_prefix(6);  // a name and a frame take at least 6 bytes
+        op.values.reserve(n);
+        for (std::size_t i = 0; i < n; ++i) {
+          const auto name = r.string_view();
+          op.values.emplace_back(name, read_framed(r));
+        }
+        break;
+      }
+      case Transaction::Op::Set:
+        op.old_value = read_framed(r);
+        op.new_value = read_framed(r);
+        break;
+      case Transaction::Op::Insert:
+      case Transaction::Op::Erase:
+        op.index = r.varint();
+        op.target = r.varint();
+        break;
+    }
+    ops.push_back(std::move(op));
+  }
+  return ops;
+}
+
+namespace {
+void write_span(std::vector<std::uint8_t>& out, std::span<const std::uint8_t> s) {
+  const auto n = static_cast<std::uint32_t>(s.size());
+  ByteWriter w(out);
+  w.fixed(n);
+  w.raw(s.data(), s.size());
+}
+}  // namespace
+
+}  // namespace detail
+
+Transaction::Transaction() = default;
+
+Transaction Transaction::from_bytes(std::vector<std::uint8_t> bytes) {
+  Transaction t;
+  if (bytes.empty()) return t;
+  if (bytes.size() < detail::header_size || std::memcmp(bytes.data(), detail::magic, 4) != 0)
+    throw Error("byte 0: not a vsd transaction bundle (no VSDT header)");
+  if (bytes[4] != format_version)
+    throw Error("byte 4: transaction format version " + std::to_string(bytes[4]) + " is not supported (this is " +
+                std::to_string(format_version) + ")");
+  t.bytes_ = std::move(bytes);
+  t.ops_ = detail::parse_tx(t).size();
+  return t;
+}
+
+Transaction Transaction::inverted() const {
+  Transaction inv;
+  const auto ops = detail::parse_tx(*this);
+  if (ops.empty()) return inv;
+  auto& out = inv.bytes_;
+  detail::write_tx_header(out);
+  ByteWriter w(out);
+  for (auto it = ops.rbegin(); it != ops.rend(); ++it) {
+    const detail::TxOp& op = *it;
+    Op code = op.op;
+    switch (op.op) {
+      case Op::Create: code = Op::Delete; break;
+      case Op::Delete: code = Op::Create; break;
+      case Op::Insert: code = Op::Erase; break;
+      case Op::Erase: code = Op::Insert; break;
+      case Op::Set: break;
+    }
+    w.u8(static_cast<std::uint8_t>(code));
+    w.varint(op.id);
+    w.string(op.name);
+    if (op.op == Op::Create || op.op == Op::Delete) {
+      w.varint(op.values.size());
+      for (const auto& [name, v] : op.values) {
+        w.string(name);
+        detail::write_span(out, v);
+      }
+    } else if (op.op == Op::Set) {
+      detail::write_span(out, op.new_value);
+      detail::write_span(out, op.old_value);
+    } else {
+      w.varint(op.index);
+      w.varint(op.target);
+    }
+    ++inv.ops_;
+  }
+  return inv;
+}
+
+std::string Transaction::describe() const {
+  std::string s;
+  for (const auto& op : detail::parse_tx(*this)) {
+    switch (op.op) {
+      case Op::Create: s += "create #" + std::to_string(op.id) + " " + std::string(op.name); break;
+      case Op::Delete: s += "delete #" + std::to_string(op.id) + " " + std::string(op.name); break;
+      case Op::Set: s += "set #" + std::to_string(op.id) + "." + std::string(op.name); break;
+      case Op::Insert:
+        s += "insert #" + std::to_string(op.target) + " into #" + std::to_string(op.id) + "." + std::string(op.name) +
+             "[" + std::to_string(op.index) + "]";
+        break;
+      case Op::Erase:
+        s += "erase #" + std::to_string(op.target) + " from #" + std::to_string(op.id) + "." + std::string(op.name) +
+             "[" + std::to_string(op.index) + "]";
+        break;
+    }
+    s += "\n";
+  }
+  return s;
+}
+
+// ---- applying ---------------------------------------------------------------------------------------------
+
+namespace detail {
+
+/// Applies a bundle to a SimState: a full dry run over a model of the state first, then the real run.
+class Applier {
+ public:
+  Applier(SimState& s, const Transaction& t) : s_(s), t_(t) {}
+
+  void run() {
+    const auto ops = parse_tx(t_);
+    for (std::size_t i = 0; i < ops.size(); ++i) check(ops[i], i);
+    ++s_.applying_;
+    struct Done {
+      SimState& s;
+      ~Done() { --s.applying_; }
+    } done{s_};
+    for (const auto& op : ops) apply(op);
+  }
+
+ private:
+  struct StateResolver final : RefResolver {
+    SimState* s;
+    SimStateInstance* resolve(Id id) const override { return s->find(id); }
+  };
+
+  [[noreturn]] void fail(const TxOp& op, std::size_t n, const std::string& what) const {
+    throw Error("byte " + std::to_string(op.offset) + ", operation " + std::to_string(n + 1) + " (" + op_name(op) +
+                "): " + what + "; nothing was applied to SimState '" + s_.name() + "'");
+  }
+  static std::string op_name(const TxOp& op) {
+    switch (op.op) {
+      case Transaction::Op::Create: return "create #" + std::to_string(op.id);
+      case Transaction::Op::Delete: return "delete #" + std::to_string(op.id);
+      case Transaction::Op::Set: return "set #" + std::to_string(op.id) + "." + std::string(op.name);
+      case Transaction::Op::Insert: return "insert into #" + std::to_string(op.id) + "." + std::string(op.name);
+      case Transaction::Op::Erase: return "erase from #" + std::to_string(op.id) + "." + std::string(op.name);
+    }
+    return "?";
+  }
+
+  // ---- the model used by the dry run ----
+  const MetaInstance* class_of(Id id) const {
+    if (deleted_.count(id) != 0) return nullptr;
+    if (auto it = created_.find(id); it != created_.end()) return it->second;
+    const SimStateInstance* x = s_.find(id);
+    return x != nullptr ? &x->meta() : nullptr;
+  }
+  std::vector<Id>& list_model(Id holder, const MetaProperty& p) {
+    auto key = std::make_pair(holder, &p);
+    auto it = lists_.find(key);
+    if (it != lists_.end()) return it->second;
+    std::vector<Id> ids;
+    if (created_.count(holder) == 0) {
+      if (const SimStateInstance* x = s_.find(holder)) {
+        const auto& list = *static_cast<const RefListBase*>(p.address(*x));
+        for (std::size_t i = 0; i < list.size(); ++i)
+          if (deleted_.count(list.at(i)->id()) == 0) ids.push_back(list.at(i)->id());
+      }
+    }
+    return lists_.emplace(key, std::move(ids)).first->second;
+  }
+  const MetaProperty& property_of(const TxOp& op, std::size_t n, const MetaInstance& cls) const {
+    const MetaProperty* p = cls.find_property(op.name);
+    if (p == nullptr) fail(op, n, "class '" + cls.name() + "' has no property '" + std::string(op.name) + "'");
+    return *p;
+  }
+  void check_target(const TxOp& op, std::size_t n, Id id, const MetaType& t) const {
+    if (id == null_id) return;
+    const MetaInstance* cls = class_of(id);
+    if (cls == nullptr) fail(op, n, "dangling reference: no instance #" + std::to_string(id));
+    if (t.target() != nullptr && !cls->is_a(*t.target()))
+      fail(op, n, "#" + std::to_string(id) + " is a '" + cls->name() + "', not a '" + t.target()->name() + "'");
+  }
+  // Checks that @p bytes hold exactly one value of @p p's type; returns the ids of a list value.
+  std::vector<Id> check_value(const TxOp& op, std::size_t n, const MetaProperty& p, std::span<const std::uint8_t> bytes) {
+    ByteReader r(bytes.data(), bytes.size());
+    std::vector<Id> ids;
+    try {
+      const MetaType& t = p.type();
+      if (t.is_ref_list()) {
+        const std::size_t count = r.size_prefix(1);
+        for (std::size_t i = 0; i < count; ++i) {
+          ids.push_back(r.varint());
+          if (ids.back() == null_id) r.fail("a reference list cannot hold null");
+          check_target(op, n, ids.back(), t);
+        }
+      } else if (t.is_reference()) {
+        check_target(op, n, r.varint(), t);
+      } else {
+        Value v(t);
+        t.read_bytes(v.data(), r, nullptr);
+      }
+      if (!r.at_end()) r.fail(std::to_string(r.remaining()) + " unexpected bytes after the value");
+    } catch (const Error& e) {
+      fail(op, n, "value of '" + p.name() + "': " + e.what());
+    }
+    return ids;
+  }
+
+  void check(const TxOp& op, std::size_t n) {
+    switch (op.op) {
+      case Transaction::Op::Create: {
+        const MetaInstance* cls = s_.environment().registry().find_class(op.name);
+        if (cls == nullptr) fail(op, n, "unknown class '" + std::string(op.name) + "'");
+        if (cls->is_abstract() || !cls->is_a(SimStateInstance::static_meta()) || cls->is_a(Database::static_meta()))
+          fail(op, n, "class '" + cls->name() + "' cannot be instantiated here");
+        if (op.id == null_id || class_of(op.id) != nullptr || (created_.count(op.id) == 0 && deleted_.count(op.id) == 0 &&
+                                                                  s_.by_id_.count(op.id) != 0))
+          fail(op, n, "instance #" + std::to_string(op.id) + " already exists");
+        for (const auto& [name, bytes] : op.values) {
+          TxOp sub = op;
+          sub.name = name;
+          const MetaProperty& p = property_of(sub, n, *cls);
+          if (!carried_in_payload(p)) fail(op, n, "property '" + p.name() + "' cannot be part of a create");
+          check_value(op, n, p, bytes);
+        }
+        deleted_.erase(op.id);
+        created_[op.id] = cls;
+        break;
+      }
+      case Transaction::Op::Delete: {
+        if (op.id == 1) fail(op, n, "the Database cannot be deleted");
+        if (class_of(op.id) == nullptr) fail(op, n, "no instance #" + std::to_string(op.id));
+        created_.erase(op.id);
+        deleted_.insert(op.id);
+        for (auto& [key, ids] : lists_) std::erase(ids, op.id);
+        break;
+      }
+      case Transaction::Op::Set: {
+        const MetaInstance* cls = class_of(op.id);
+        if (cls == nullptr) fail(op, n, "no instance #" + std::to_string(op.id));
+        const MetaProperty& p = property_of(op, n, *cls);
+        if (p.has(Transient)) fail(op, n, "property '" + p.name() + "' is transient");
+        check_value(op, n, p, op.old_value);
+        auto ids = check_value(op, n, p, op.new_value);
+        if (p.type().is_ref_list()) list_model(op.id, p) = std::move(ids);
+        break;
+      }
+      case Transaction::Op::Insert:
+      case Transaction::Op::Erase: {
+        const MetaInstance* cls = class_of(op.id);
+        if (cls == nullptr) fail(op, n, "no instance #" + std::to_string(op.id));
+        const MetaProperty& p = property_of(op, n, *cls);
+        if (!p.type().is_ref_list()) fail(op, n, "property '" + p.name() + "' is not a reference list");
+        if (op.target == null_id) fail(op, n, "a reference list cannot hold null");
+        check_target(op, n, op.target, p.type());
+        auto& ids = list_model(op.id, p);
+        if (op.op == Transaction::Op::Insert) {
+          if (op.index > ids.size())
+            fail(op, n, "index " + std::to_string(op.index) + " is past the end (size " + std::to_string(ids.size()) + ")");
+          ids.insert(ids.begin() + static_cast<std::ptrdiff_t>(op.index), op.target);
+        } else {
+          if (op.index >= ids.size() || ids[op.index] != op.target)
+            fail(op, n, "#" + std::to_string(op.target) + " is not at index " + std::to_string(op.index));
+          ids.erase(ids.begin() + static_cast<std::ptrdiff_t>(op.index));
+        }
+        break;
+      }
+    }
+  }
+
+  Value decode(const MetaProperty& p, std::span<const std::uint8_t> bytes) const {
+    StateResolver refs;
+    refs.s = &s_;
+    Value v(p.type());
+    ByteReader r(bytes.data(), bytes.size());
+    p.type().read_bytes(v.data(), r, &refs);
+    return v;
+  }
+
+  void apply(const TxOp& op) {
+    switch (op.op) {
+      case Transaction::Op::Create: {
+        const MetaInstance& cls = s_.environment().registry().get_class(op.name);
+        SimStateInstance& x = s_.make(cls, op.id);
+        for (const auto& [name, bytes] : op.values) {
+          const MetaProperty& p = *cls.find_property(name);
+          const Value v = decode(p, bytes);
+          p.type().assign(const_cast<void*>(p.address(x)), v.data());  // initial values: not changes
+        }
+        s_.finish_create(x);
+        break;
+      }
+      case Transaction::Op::Delete: s_.destroy(*s_.find(op.id)); break;
+      case Transaction::Op::Set: {
+        SimStateInstance& x = *s_.find(op.id);
+        const MetaProperty& p = *x.meta().find_property(op.name);
+        const Value v = decode(p, op.new_value);
+        p.assign_raw(x, v.data());
+        break;
+      }
+      case Transaction::Op::Insert: {
+        SimStateInstance& x = *s_.find(op.id);
+        x.list_insert(*x.meta().find_property(op.name), op.index, *s_.find(op.target));
+        break;
+      }
+      case Transaction::Op::Erase: {
+        SimStateInstance& x = *s_.find(op.id);
+        x.list_erase(*x.meta().find_property(op.name), op.index);
+        break;
+      }
+    }
+  }
+
+  SimState& s_;
+  const Transaction& t_;
+  std::unordered_map<Id, const MetaInstance*> created_;
+  std::unordered_set<Id> deleted_;
+  std::map<std::pair<Id, const MetaProperty*>, std::vector<Id>> lists_;
+};
+
+}  // namespace detail
+
+void SimState::apply(const Transaction& t) {
+  if (t.empty()) return;
+  detail::Applier(*this, t).run();
+}
+
+}  // namespace vsd
