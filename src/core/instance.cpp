@@ -91,7 +91,7 @@ void SimStateInstance::list_erase(const MetaProperty& p, std::size_t index) {
   SimStateInstance& target = *list.at(index);
   // Hold the element while the change is recorded and announced; it may go when the guard does.
   detail::RefLink guard(true);
-  if (!target.is_being_deleted()) guard.reset(&target);
+  if (list.is_composite() && !target.is_being_deleted()) guard.reset(&target);
   static_cast<ListEdit&>(list).erase_at(index);
   state_->list_changed(*this, p, index, target, false);
 }

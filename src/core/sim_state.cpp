@@ -105,7 +105,8 @@ std::vector<SimStateInstance*> SimState::instances() const {
 }
 
 void SimState::released(SimStateInstance& inst) {
-  if (applying_ == 0 && !inst.is_being_deleted()) destroy(inst);
+  // While a bundle is applied, deletions come from the bundle itself; the Database is never released.
+  if (applying_ == 0 && !inst.is_being_deleted() && &inst != root_) destroy(inst);
 }
 
 void SimState::destroy(SimStateInstance& x) {

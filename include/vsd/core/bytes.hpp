@@ -41,6 +41,7 @@ class ByteWriter {
     out_->insert(out_->end(), s.begin(), s.end());
   }
   void raw(const void* p, std::size_t n) {
+    if (n == 0) return;  // p may be null (an empty vector)
     const auto* b = static_cast<const std::uint8_t*>(p);
     out_->insert(out_->end(), b, b + n);
   }
@@ -75,7 +76,7 @@ class ByteReader {
   std::string_view string_view();
   void raw(void* p, std::size_t n) {
     need(n);
-    std::memcpy(p, data_ + pos_, n);
+    if (n != 0) std::memcpy(p, data_ + pos_, n);  // p may be null when n is 0 (an empty vector)
     pos_ += n;
   }
 

@@ -1,0 +1,188 @@
+#include "vsd/core/reference.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "test_classes.hpp"
+
+using testing::HasSubstr;
+using vsd_test::TRobot;
+using vsd_test::TTool;
+
+namespace {
+
+struct ReferenceTest : testing::Test {
+  vsd::Environment env;
+  vsd::SimState& state = env.main_state();
+  vsd::Database& root = state.database();
+};
+
+TEST_F(ReferenceTest, ChildrenAreCompositeAndCounted) {
+  auto& n = state.create<vsd::Node>();
+  EXPECT_EQ(n.composite_count(), 0u);  // floating until attached
+  root.add_child(n);
+  EXPECT_EQ(n.composite_count(), 1u);
+  EXPECT_EQ(n.parent(), &root);
+}
+
+TEST_F(ReferenceTest, ReleasingTheLastCompositeReferenceDeletes) {
+  auto& r = state.create<TRobot>();
+  root.add_child(r);
+  auto& tool = state.create<TTool>();
+  r.set_tool(&tool);
+  r.add_child(tool);  // two composite holders now
+  EXPECT_EQ(tool.composite_count(), 2u);
+  const vsd::Id id = tool.id();
+  r.remove_child(tool);
+  ASSERT_NE(state.find(id), nullptr) << "still held by the tool property";
+  r.set_tool(nullptr);
+  EXPECT_EQ(state.find(id), nullptr);
+}
+
+TEST_F(ReferenceTest, DeletingANodeDeletesItsCompositeSubtree) {
+  auto& a = state.create<vsd::Node>();
+  auto& b = state.create<vsd::Node>();
+  auto& c = state.create<vsd::Node>();
+  auto& keep = state.create<TRobot>();
+  root.add_child(a);
+  a.add_child(b);
+  b.add_child(c);
+  root.add_child(keep);
+  auto& shared_child = state.create<TTool>();
+  b.add_child(shared_child);
+  keep.set_tool(&shared_child);  // held by another composite holder: survives
+  const vsd::Id ia = a.id(), ib = b.id(), ic = c.id(), is = shared_child.id();
+  state.destroy(a);
+  EXPECT_EQ(state.find(ia), nullptr);
+  EXPECT_EQ(state.find(ib), nullptr);
+  EXPECT_EQ(state.find(ic), nullptr);
+  ASSERT_NE(state.find(is), nullptr);
+  EXPECT_EQ(shared_child.composite_count(), 1u);
+  EXPECT_EQ(shared_child.parent(), nullptr);
+  EXPECT_EQ(vsd_test::check_reference_counts(state), "");
+}
+
+TEST_F(ReferenceTest, DeletingTargetNullsSharedRefsAndNotifiesHolders) {
+  auto& r = state.create<TRobot>();
+  auto& goal = state.create<vsd::Node>();
+  root.add_child(r);
+  root.add_child(goal);
+  r.set_target(&goal);
+  r.set_watched([&] {
+    vsd::SharedRefList<vsd::Node> l;
+    l.push_back(&goal);
+    l.push_back(&root);
+    return l;
+  }());
+  std::vector<std::string> changes;
+  auto c = r.on_changed().connect(
+      [&](vsd::SimStateInstance&, const vsd::MetaProperty& p) { changes.push_back(p.name()); });
+  state.destroy(goal);
+  EXPECT_EQ(r.target().get(), nullptr);
+  ASSERT_EQ(r.watched().size(), 1u);
+  EXPECT_EQ(r.watched()[0], &root);
+  EXPECT_THAT(changes, testing::UnorderedElementsAre("target", "watched"));
+}
+
+TEST_F(ReferenceTest, SharedReferencesDoNotCount) {
+  auto& r = state.create<TRobot>();
+  auto& goal = state.create<vsd::Node>();
+  r.set_target(&goal);
+  EXPECT_EQ(goal.composite_count(), 0u);
+}
+
+TEST_F(ReferenceTest, FreeSharedRefIsAWeakHandle) {
+  auto& n = state.create<vsd::Node>();
+  vsd::SharedRef<vsd::Node> handle(&n);
+  EXPECT_EQ(handle.get(), &n);
+  EXPECT_EQ(handle.holder(), nullptr);
+  state.destroy(n);
+  EXPECT_EQ(handle.get(), nullptr);
+  EXPECT_FALSE(handle);
+}
+
+TEST_F(ReferenceTest, FreeRefOwnsLikeASharedPointer) {
+  auto& n = state.create<vsd::Node>();
+  root.add_child(n);
+  const vsd::Id id = n.id();
+  {
+    vsd::Ref<vsd::Node> keep(&n);
+    root.remove_child(n);
+    EXPECT_NE(state.find(id), nullptr);
+  }
+  EXPECT_EQ(state.find(id), nullptr);
+}
+
+TEST_F(ReferenceTest, FreeReferencesOutlivingTheEnvironmentBecomeNull) {
+  vsd::SharedRef<vsd::Node> weak;
+  vsd::Ref<vsd::Node> strong;
+  {
+    vsd::Environment other;
+    auto& n = other.main_state().create<vsd::Node>();
+    weak = &n;
+    strong = &n;
+  }
+  EXPECT_EQ(weak.get(), nullptr);
+  EXPECT_EQ(strong.get(), nullptr);
+}
+
+TEST_F(ReferenceTest, CompositeCyclesAreRejected) {
+  auto& a = state.create<vsd::Node>();
+  auto& b = state.create<vsd::Node>();
+  root.add_child(a);
+  a.add_child(b);
+  EXPECT_THAT([&] { b.add_child(a); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("its own ancestor")));
+  EXPECT_THAT([&] { a.add_child(a); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("its own ancestor")));
+  EXPECT_EQ(a.parent(), &root);
+  EXPECT_EQ(vsd_test::check_reference_counts(state), "");
+}
+
+TEST_F(ReferenceTest, ReferencesCannotCrossSimStates) {
+  auto& other = env.create_state("other");
+  auto& r = state.create<TRobot>();
+  auto& far = other.create<vsd::Node>();
+  EXPECT_THAT([&] { r.set_target(&far); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("different SimStates")));
+  EXPECT_THAT([&] { root.add_child(far); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("different SimStates")));
+}
+
+TEST_F(ReferenceTest, GenericSetChecksTheTargetClass) {
+  auto& r = state.create<TRobot>();
+  auto& plain = state.create<vsd::Node>();
+  // tool is a ref<TTool>: a plain Node does not fit.
+  vsd::Ref<vsd::Node> wrong(&plain);
+  EXPECT_THROW(r.set("tool", vsd::Value(wrong)), vsd::Error);
+  auto& tool = state.create<TTool>();
+  r.set("tool", vsd::Value(vsd::Ref<TTool>(&tool)));
+  EXPECT_EQ(r.tool().get(), &tool);
+  const vsd::MetaProperty& children = vsd::Node::vsd_prop_children();
+  auto& ext = state.create<vsd::Extension>();
+  EXPECT_THAT([&] { r.list_insert(children, 0, ext); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("holds Node")));
+  EXPECT_THAT([&] { r.list_insert(children, 5, plain); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("past the end")));
+  EXPECT_THAT([&] { r.list_erase(children, 0); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("out of")));
+  EXPECT_THAT([&] { r.list_insert(TRobot::vsd_prop_speed(), 0, plain); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("not a reference list")));
+}
+
+TEST_F(ReferenceTest, ValuesHoldingReferencesCount) {
+  auto& n = state.create<vsd::Node>();
+  root.add_child(n);
+  {
+    vsd::Value v{vsd::Ref<vsd::Node>(&n)};
+    EXPECT_EQ(n.composite_count(), 2u);
+    vsd::Value copy = v;
+    EXPECT_EQ(n.composite_count(), 3u);
+    EXPECT_EQ(copy.to_text(), "@" + std::to_string(n.id()));
+  }
+  EXPECT_EQ(n.composite_count(), 1u);
+}
+
+TEST_F(ReferenceTest, ReferenceTextNeedsAResolver) {
+  const auto& t = vsd::meta_type<vsd::SharedRef<vsd::Node>>();
+  EXPECT_EQ(t.name(), "shared<Node>");
+  EXPECT_EQ(t.target(), &vsd::Node::static_meta());
+  vsd::Value null = vsd::Value::from_text(t, "null");
+  EXPECT_EQ(static_cast<const vsd::RefBase*>(null.data())->get(), nullptr);
+  EXPECT_THAT([&] { (void)vsd::Value::from_text(t, "@12"); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("1:")));
+}
+
+}  // namespace

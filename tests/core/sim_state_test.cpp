@@ -1,0 +1,176 @@
+#include "vsd/core/sim_state.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "test_classes.hpp"
+
+using testing::ElementsAre;
+using testing::HasSubstr;
+using vsd_test::TGripper;
+using vsd_test::TRobot;
+
+namespace {
+
+struct SimStateTest : testing::Test {
+  vsd::Environment env;
+  vsd::SimState& state = env.main_state();
+};
+
+TEST_F(SimStateTest, CreatesByClassAndByName) {
+  auto& r = state.create<TRobot>();
+  auto& n = state.create("Node");
+  auto& g = state.create(TGripper::static_meta());
+  EXPECT_EQ(&r.meta(), &TRobot::static_meta());
+  EXPECT_EQ(&n.meta(), &vsd::Node::static_meta());
+  EXPECT_TRUE(g.is_a<TRobot>());
+  EXPECT_EQ(&r.state(), &state);
+  EXPECT_EQ(state.size(), 4u);  // and the Database
+}
+
+TEST_F(SimStateTest, RejectsUnknownAbstractAndForeignClasses) {
+  EXPECT_THAT([&] { state.create("NoSuchClass"); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("NoSuchClass")));
+  EXPECT_THAT([&] { state.create(vsd::Instance::static_meta()); }, testing::Throws<vsd::Error>());
+  EXPECT_THAT([&] { state.create(vsd::Environment::static_meta()); }, testing::Throws<vsd::Error>());
+  EXPECT_THAT([&] { state.create<vsd::Database>(); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("Database")));
+}
+
+TEST_F(SimStateTest, IdsAreUniqueStableAndFindable) {
+  auto& a = state.create<vsd::Node>();
+  auto& b = state.create<vsd::Node>();
+  EXPECT_NE(a.id(), b.id());
+  EXPECT_NE(a.id(), vsd::null_id);
+  EXPECT_EQ(state.find(a.id()), &a);
+  EXPECT_EQ(state.find<TRobot>(a.id()), nullptr);
+  EXPECT_EQ(state.find(999999), nullptr);
+  auto all = state.instances();
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_TRUE(std::is_sorted(all.begin(), all.end(), [](auto* x, auto* y) { return x->id() < y->id(); }));
+}
+
+TEST_F(SimStateTest, DestroyingAnInstanceOfAnotherStateIsAnError) {
+  auto& other = env.create_state("other");
+  auto& n = other.create<vsd::Node>();
+  EXPECT_THAT([&] { state.destroy(n); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("belongs to SimState")));
+}
+
+TEST_F(SimStateTest, SignalsCreationAndDeletion) {
+  std::vector<std::string> log;
+  auto c1 = state.on_created().connect([&](vsd::SimStateInstance& i) { log.push_back("+" + i.meta().name()); });
+  auto c2 = state.on_deleted().connect([&](vsd::SimStateInstance& i) {
+    // Deletion is announced while the instance is still whole.
+    log.push_back("-" + i.meta().name() + ":" + static_cast<vsd::Node&>(i).name());
+  });
+  auto& r = state.create<TRobot>();
+  r.set_name("r");
+  state.destroy(r);
+  EXPECT_THAT(log, ElementsAre("+TRobot", "-TRobot:r"));
+}
+
+TEST_F(SimStateTest, PropertyChangesSignalPerInstanceTypeAndState) {
+  auto& r = state.create<TRobot>();
+  auto& g = state.create<TGripper>();
+  auto& n = state.create<vsd::Node>();
+  int own = 0, exact = 0, tree = 0, all = 0;
+  auto c1 = r.on_changed().connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++own; });
+  auto c2 = state.on_property_changed(TRobot::static_meta(), false).connect(
+      [&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++exact; });
+  auto c3 = state.on_property_changed(TRobot::static_meta(), true).connect(
+      [&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++tree; });
+  auto c4 = state.on_property_changed().connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++all; });
+  r.set_speed(2.0);
+  g.set_speed(3.0);
+  n.set_name("x");
+  EXPECT_EQ(own, 1);
+  EXPECT_EQ(exact, 1);
+  EXPECT_EQ(tree, 2);
+  EXPECT_EQ(all, 3);
+}
+
+TEST_F(SimStateTest, SettingAnEqualValueSignalsNothing) {
+  auto& r = state.create<TRobot>();
+  int n = 0;
+  auto c = r.on_changed().connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++n; });
+  r.set_speed(r.speed());
+  r.set("speed", vsd::Value(1.0));
+  EXPECT_EQ(n, 0);
+  r.set_speed(1.5);
+  EXPECT_EQ(n, 1);
+}
+
+TEST_F(SimStateTest, ListenersSeeTheNewValueAndTheProperty) {
+  auto& r = state.create<TRobot>();
+  std::string seen;
+  auto c = state.on_property_changed().connect([&](vsd::SimStateInstance& i, const vsd::MetaProperty& p) {
+    seen = p.name() + "=" + p.get_value(i).to_text();
+  });
+  r.set_joints({1.0, 2.5});
+  EXPECT_EQ(seen, "joints=[1, 2.5]");
+}
+
+TEST_F(SimStateTest, DisconnectingStopsNotificationAndTheFastPathReturns) {
+  auto& r = state.create<TRobot>();
+  int n = 0;
+  {
+    auto c = r.on_changed().connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++n; });
+    r.set_speed(5.0);
+  }
+  r.set_speed(6.0);
+  r.set_speed(7.0);
+  EXPECT_EQ(n, 1);
+}
+
+TEST_F(SimStateTest, AListenerMayDeleteTheInstanceItIsToldAbout) {
+  auto& r = state.create<TRobot>();
+  auto& other = state.create<TRobot>();
+  const vsd::Id id = r.id();
+  std::vector<vsd::Id> later;
+  auto c1 = state.on_property_changed().connect([&](vsd::SimStateInstance& i, const vsd::MetaProperty&) {
+    if (i.id() == id && !i.is_being_deleted()) state.destroy(i);
+  });
+  auto c2 = state.on_property_changed().connect(
+      [&](vsd::SimStateInstance& i, const vsd::MetaProperty&) { later.push_back(i.id()); });
+  r.set_speed(9.0);
+  EXPECT_EQ(state.find(id), nullptr);
+  other.set_speed(2.0);
+  EXPECT_THAT(later, testing::Contains(other.id()));
+}
+
+TEST_F(SimStateTest, AListenerMayDisconnectAnotherDuringDispatch) {
+  auto& r = state.create<TRobot>();
+  int first = 0, second = 0;
+  vsd::Connection c2;
+  auto c1 = state.on_property_changed().connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) {
+    ++first;
+    c2.disconnect();
+  });
+  c2 = state.on_property_changed().connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++second; });
+  r.set_speed(2.0);
+  r.set_speed(3.0);
+  EXPECT_EQ(first, 2);
+  EXPECT_EQ(second, 0);
+}
+
+TEST_F(SimStateTest, EqualsComparesDeeplyAndNamesTheDifference) {
+  auto& a = env.create_state("a");
+  auto& b = env.create_state("b");
+  auto& ra = a.create<TRobot>();
+  a.database().add_child(ra);
+  b.copy_from(a);
+  std::string diff;
+  EXPECT_TRUE(a.equals(b, &diff)) << diff;
+  ra.set_speed(4.0);
+  EXPECT_FALSE(a.equals(b, &diff));
+  EXPECT_THAT(diff, HasSubstr("speed"));
+  ra.set_cache("local only");  // Transient: not compared
+  static_cast<TRobot*>(b.find(ra.id()))->set_speed(4.0);
+  EXPECT_TRUE(a.equals(b, &diff)) << diff;
+}
+
+TEST_F(SimStateTest, CopyFromNeedsAnEmptyState) {
+  auto& a = env.create_state("a");
+  state.create<vsd::Node>();
+  EXPECT_THAT([&] { state.copy_from(a); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("empty")));
+}
+
+}  // namespace

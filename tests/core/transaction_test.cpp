@@ -1,0 +1,240 @@
+#include "vsd/core/transaction.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <future>
+#include <thread>
+
+#include "test_classes.hpp"
+
+using testing::HasSubstr;
+using vsd_test::TRobot;
+using vsd_test::TTool;
+
+namespace {
+
+struct TransactionTest : testing::Test {
+  vsd::Environment env;
+  vsd::SimState& source = env.main_state();
+  vsd::SimState& replica = env.create_state("replica");
+
+  void expect_equal(const vsd::SimState& a, const vsd::SimState& b) {
+    std::string diff;
+    EXPECT_TRUE(a.equals(b, &diff)) << diff;
+  }
+};
+
+TEST_F(TransactionTest, RecordsEveryKindOfChange) {
+  source.start_recording();
+  auto& r = source.create<TRobot>();
+  source.database().add_child(r);
+  r.set_speed(2.0);
+  auto& child = source.create<vsd::Node>();
+  const std::string ir = std::to_string(r.id()), ic = std::to_string(child.id());
+  r.add_child(child);
+  r.remove_child(child);  // its last composite holder: deleted
+  const vsd::Transaction t = source.stop_recording();
+  EXPECT_EQ(t.describe(), "create #" + ir + " TRobot\ninsert #" + ir + " into #1.children[0]\nset #" + ir +
+                              ".speed\ncreate #" + ic + " Node\ninsert #" + ic + " into #" + ir +
+                              ".children[0]\nerase #" + ic + " from #" + ir + ".children[0]\ndelete #" + ic +
+                              " Node\n");
+  EXPECT_EQ(t.size(), 7u);
+}
+
+TEST_F(TransactionTest, ReplicaAppliesToEquality) {
+  source.start_recording();
+  auto& r = source.create<TRobot>();
+  r.set_name("arm");
+  source.database().add_child(r);
+  auto& tool = source.create<TTool>();
+  r.set_tool(&tool);
+  r.set_target(&source.database());
+  r.set_joints({0.1, 0.2, 0.3});
+  Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
+  f.translate(Eigen::Vector3d(1, 2, 3));
+  r.set_frame(f);
+  replica.apply(source.take_recording());
+  expect_equal(source, replica);
+  // Recording goes on after take_recording; deletions replicate too.
+  source.destroy(r);
+  replica.apply(source.take_recording());
+  expect_equal(source, replica);
+  EXPECT_EQ(replica.size(), 1u);
+}
+
+TEST_F(TransactionTest, TransientPropertiesAreNotRecorded) {
+  auto& r = source.create<TRobot>();
+  source.start_recording();
+  r.set_cache("scratch");
+  EXPECT_TRUE(source.stop_recording().empty());
+}
+
+TEST_F(TransactionTest, BundlesTravelAsBytes) {
+  source.start_recording();
+  auto& r = source.create<TRobot>();
+  source.database().add_child(r);
+  r.set_speed(0.25);
+  const std::vector<std::uint8_t> wire = source.stop_recording().bytes();
+  const vsd::Transaction received = vsd::Transaction::from_bytes(wire);
+  replica.apply(received);
+  expect_equal(source, replica);
+}
+
+// The paper's streaming example: a loader thread fills its own SimState and hands the result over.
+TEST_F(TransactionTest, LoaderThreadHandsASubtreeToTheMainState) {
+  vsd::SimState& loader_state = env.create_state("loader");
+  std::promise<std::vector<std::uint8_t>> handover;
+  std::thread loader([&] {
+    loader_state.start_recording();
+    auto& site = loader_state.create<vsd::Node>();
+    site.set_name("site");
+    loader_state.database().add_child(site);
+    for (int i = 0; i < 100; ++i) {
+      auto& r = loader_state.create<TRobot>();
+      r.set_name("robot" + std::to_string(i));
+      r.set_speed(i);
+      site.add_child(r);
+    }
+    handover.set_value(loader_state.stop_recording().bytes());
+  });
+  const auto bytes = handover.get_future().get();
+  loader.join();
+  source.apply(vsd::Transaction::from_bytes(bytes));
+  vsd::Node* site = source.database().find_child("site");
+  ASSERT_NE(site, nullptr);
+  EXPECT_EQ(site->children().size(), 100u);
+  EXPECT_EQ(static_cast<TRobot*>(site->children()[42])->speed(), 42.0);
+  expect_equal(loader_state, source);
+}
+
+TEST_F(TransactionTest, InvertedBundleUndoes) {
+  auto& keep = source.create<TRobot>();
+  source.database().add_child(keep);
+  auto& gone = source.create<vsd::Node>();
+  keep.add_child(gone);
+  keep.set_target(&gone);
+  replica.copy_from(source);  // the state before
+
+  source.start_recording();
+  keep.set_speed(3.0);
+  auto& added = source.create<TTool>();
+  keep.set_tool(&added);
+  source.destroy(gone);  // detaches, nulls the shared target, deletes
+  auto& other = source.create<vsd::Node>();
+  source.database().add_child(other);
+  const vsd::Transaction t = source.stop_recording();
+
+  source.apply(t.inverted());
+  expect_equal(source, replica);
+  // And redo.
+  source.apply(t);
+  replica.apply(t);
+  expect_equal(source, replica);
+}
+
+TEST_F(TransactionTest, ApplyingToAStateThatLacksTheInstancesChangesNothing) {
+  auto& r = source.create<TRobot>();
+  source.database().add_child(r);
+  source.start_recording();
+  r.set_speed(7.0);
+  auto& n = source.create<vsd::Node>();
+  r.add_child(n);
+  const vsd::Transaction t = source.stop_recording();
+
+  auto& unrelated = replica.create<vsd::Node>();
+  replica.database().add_child(unrelated);
+  auto& before = env.create_state("before");
+  before.copy_from(replica);
+  EXPECT_THAT([&] { replica.apply(t); },
+              testing::ThrowsMessage<vsd::Error>(testing::AllOf(HasSubstr("no instance #" + std::to_string(r.id())),
+                                                                HasSubstr("nothing was applied"))));
+  expect_equal(replica, before);
+}
+
+TEST_F(TransactionTest, ApplyingTwiceIsRejectedAsAWhole) {
+  source.start_recording();
+  auto& r = source.create<TRobot>();
+  source.database().add_child(r);
+  const vsd::Transaction t = source.stop_recording();
+  replica.apply(t);
+  EXPECT_THAT([&] { replica.apply(t); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("already exists")));
+  EXPECT_EQ(replica.size(), 2u);
+}
+
+TEST_F(TransactionTest, HeaderAndVersionAreChecked) {
+  EXPECT_THAT([] { (void)vsd::Transaction::from_bytes({'X', 'Y', 'Z', 'W', 1}); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("byte 0")));
+  EXPECT_THAT([] { (void)vsd::Transaction::from_bytes({'V', 'S', 'D', 'T', 99}); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("version 99")));
+  EXPECT_TRUE(vsd::Transaction::from_bytes({}).empty());
+}
+
+TEST_F(TransactionTest, EveryTruncationIsAClearErrorAndChangesNothing) {
+  source.start_recording();
+  auto& r = source.create<TRobot>();
+  r.set_name("truncated");
+  source.database().add_child(r);
+  r.set_joints({1, 2, 3});
+  const auto bytes = source.stop_recording().bytes();
+  int rejected = 0;
+  for (std::size_t n = 5; n < bytes.size(); ++n) {
+    std::vector<std::uint8_t> cut(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n));
+    auto& target = env.create_state("cut");
+    try {
+      target.apply(vsd::Transaction::from_bytes(cut));
+      // A cut exactly between operations is a valid, shorter bundle.
+    } catch (const vsd::Error& e) {
+      ++rejected;
+      EXPECT_THAT(e.what(), HasSubstr("byte ")) << "cut at " << n;
+      EXPECT_EQ(target.size(), 1u) << "cut at " << n;
+    }
+    env.remove_state(target);
+  }
+  EXPECT_GT(rejected, static_cast<int>(bytes.size()) / 2);
+}
+
+TEST_F(TransactionTest, CorruptedBytesNeverCrash) {
+  source.start_recording();
+  auto& r = source.create<TRobot>();
+  source.database().add_child(r);
+  r.set_joints({1, 2, 3});
+  r.set_target(&source.database());
+  const auto bytes = source.stop_recording().bytes();
+  std::uint32_t seed = 12345;
+  for (int round = 0; round < 2000; ++round) {
+    auto bad = bytes;
+    for (int k = 0; k < 3; ++k) {
+      seed = seed * 1664525u + 1013904223u;
+      bad[5 + seed % (bad.size() - 5)] = static_cast<std::uint8_t>(seed >> 24);
+    }
+    auto& target = env.create_state("fuzz");
+    try {
+      target.apply(vsd::Transaction::from_bytes(bad));
+    } catch (const vsd::Error&) {
+      EXPECT_EQ(target.size(), 1u) << "a rejected bundle must change nothing";
+    }
+    env.remove_state(target);
+  }
+}
+
+TEST_F(TransactionTest, UnknownClassesAndPropertiesAreReported) {
+  source.start_recording();
+  auto& r = source.create<TRobot>();
+  r.set_speed(5);
+  auto bytes = source.stop_recording().bytes();
+  // Rename the class in the bundle: "TRobot" -> "XRobot".
+  auto at = std::search(bytes.begin(), bytes.end(), std::begin("TRobot"), std::end("TRobot") - 1);
+  ASSERT_NE(at, bytes.end());
+  *at = 'X';
+  EXPECT_THAT([&] { replica.apply(vsd::Transaction::from_bytes(bytes)); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("unknown class 'XRobot'")));
+  *at = 'T';
+  auto sp = std::search(bytes.begin(), bytes.end(), std::begin("speed"), std::end("speed") - 1);
+  *sp = 'z';
+  EXPECT_THAT([&] { replica.apply(vsd::Transaction::from_bytes(bytes)); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("no property 'zpeed'")));
+  EXPECT_EQ(replica.size(), 1u);
+}
+
+}  // namespace
