@@ -39,8 +39,10 @@ std::string_view ByteReader::string_view() {
 
 std::string ByteReader::string() { return std::string(string_view()); }
 
-void ByteReader::fail(std::string_view what) const {
-  throw Error("byte " + std::to_string(pos_) + ": " + std::string(what));
+void ByteReader::fail(std::string_view what) const { fail_at(pos_, what); }
+
+void ByteReader::fail_at(std::size_t pos, std::string_view what) const {
+  throw Error("byte " + std::to_string(pos) + ": " + std::string(what));
 }
 
 }  // namespace vsd

@@ -298,6 +298,16 @@ void MetaProperty::set_value(SimStateInstance& obj, const Value& v) const {
   }
 }
 
+bool MetaProperty::views_as(const MetaType& wanted) const noexcept {
+  return type_->is_reference() && wanted.kind() == type_->kind() && wanted.target() != nullptr &&
+         type_->target() != nullptr && type_->target()->is_a(*wanted.target());
+}
+
+bool MetaProperty::stores_from(const MetaType& given) const noexcept {
+  return settable_ != nullptr && type_->is_reference() && given.kind() == type_->kind() &&
+         given.target() == type_->target();
+}
+
 void MetaProperty::throw_type(const MetaType& wanted) const {
   detail::throw_error("property '" + owner_->name() + "::" + name_ + "' holds " + type_->name() + ", not " +
                       wanted.name());
@@ -379,9 +389,26 @@ Value Value::convert_to(const MetaType& target) const {
   if (type_->is_arithmetic() && target.is_arithmetic()) {
     const long double x = load_number(*type_, data());
     Value out(target);
+    auto exact = [&](long double back) {
+      if (!std::isnan(x) && back != x)
+        detail::throw_error("expected " + target.name() + ", got " + type_->name() + " " + to_text() +
+                            " which " + target.name() + " cannot hold exactly");
+    };
     switch (target.kind()) {
-      case TypeKind::Double: *static_cast<double*>(out.data()) = static_cast<double>(x); return out;
-      case TypeKind::Float: *static_cast<float*>(out.data()) = static_cast<float>(x); return out;
+      case TypeKind::Double: {
+        const auto d = static_cast<double>(x);
+        exact(d);
+        *static_cast<double*>(out.data()) = d;
+        return out;
+      }
+      case TypeKind::Float: {
+        if (std::isfinite(x) && (x > std::numeric_limits<float>::max() || x < std::numeric_limits<float>::lowest()))
+          exact(std::numeric_limits<long double>::infinity());
+        const auto f = static_cast<float>(x);
+        exact(f);
+        *static_cast<float*>(out.data()) = f;
+        return out;
+      }
       default: {
         const bool is_signed = target.kind() == TypeKind::Int;
         const int bits = static_cast<int>(target.size() * 8);
@@ -400,16 +427,21 @@ Value Value::convert_to(const MetaType& target) const {
     }
   }
   if (type_->is_reference() && target.is_reference() && type_->kind() == target.kind()) {
-    // A reference converts to a reference type of a base class, or of a subclass when the target fits.
-    Value out(target);
-    const auto* src = static_cast<const RefBase*>(data());
-    if (!type_->is_ref_list()) {
-      SimStateInstance* t = src->get();
-      if (t != nullptr && !t->is_a(*target.target()))
+    // A reference (list) converts to another reference (list) type of the same kind when every target
+    // fits the new target class: references to a base, or to a subclass when the instance is one.
+    auto fits = [&](const SimStateInstance* t) {
+      if (t != nullptr && target.target() != nullptr && !t->is_a(*target.target()))
         detail::throw_error("expected " + target.name() + ", got a reference to a '" + t->meta().name() + "'");
-      target.assign(out.data(), data());
-      return out;
+    };
+    if (type_->is_ref_list()) {
+      const auto& src = *static_cast<const RefListBase*>(data());
+      for (std::size_t i = 0; i < src.size(); ++i) fits(src.at(i));
+    } else {
+      fits(static_cast<const RefBase*>(data())->get());
     }
+    Value out(target);
+    target.assign(out.data(), data());  // both share the layout and the ops of their kind
+    return out;
   }
   detail::throw_error("expected " + target.name() + ", got " + type_->name());
 }

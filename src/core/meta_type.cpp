@@ -25,8 +25,15 @@ bool MetaType::enum_value(std::string_view n, std::int64_t& out) const noexcept 
   return false;
 }
 
+bool MetaType::integer_fits(std::int64_t v) const noexcept {
+  if (size_ >= 8) return !unsigned_ || v >= 0 || kind_ == TypeKind::Flags;
+  const int bits = static_cast<int>(size_ * 8);
+  if (unsigned_ || kind_ == TypeKind::Flags) return v >= 0 && v < (std::int64_t{1} << bits);
+  return v >= -(std::int64_t{1} << (bits - 1)) && v < (std::int64_t{1} << (bits - 1));
+}
+
 std::int64_t MetaType::load_integer(const void* obj) const noexcept {
-  const bool is_unsigned = kind_ == TypeKind::UInt || kind_ == TypeKind::Flags || kind_ == TypeKind::Bool;
+  const bool is_unsigned = unsigned_ || kind_ == TypeKind::Flags || kind_ == TypeKind::Bool;
   switch (size_) {
     case 1: {
       std::uint8_t v;
@@ -186,11 +193,12 @@ void struct_read_text(const MetaType& t, void* obj, TextReader& in, const RefRes
   in.expect('{');
   if (in.accept('}')) return;
   do {
+    const std::size_t at = in.token_start();
     const auto name = in.identifier();
     const MetaType::Field* field = nullptr;
     for (const auto& f : fields)
       if (f.name == name) field = &f;
-    if (field == nullptr) in.fail(t.name() + " has no field '" + std::string(name) + "'");
+    if (field == nullptr) in.fail_at(at, t.name() + " has no field '" + std::string(name) + "'");
     in.expect(':');
     FieldValue fv(*field, obj);
     field->type->read_text(fv.mut(), in, refs);
@@ -247,12 +255,14 @@ void enum_read_text(const MetaType& t, void* obj, TextReader& in) {
   std::int64_t total = 0;
   do {
     std::int64_t v = 0;
+    const std::size_t at = in.token_start();
     const char c = in.peek();
     if (c == '-' || (c >= '0' && c <= '9')) {
       v = in.integer();
+      if (!t.integer_fits(v)) in.fail_at(at, std::to_string(v) + " is out of range for " + t.name());
     } else {
       const auto name = in.identifier();
-      if (!t.enum_value(name, v)) in.fail("'" + std::string(name) + "' is not a value of " + t.name());
+      if (!t.enum_value(name, v)) in.fail_at(at, "'" + std::string(name) + "' is not a value of " + t.name());
     }
     total = t.kind() == TypeKind::Flags ? (total | v) : v;
   } while (t.kind() == TypeKind::Flags && in.accept('|'));

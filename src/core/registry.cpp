@@ -56,24 +56,39 @@ void Registry::add(const MetaInstance& cls) {
 }
 
 void Registry::add_locked(const MetaInstance& cls) {
-  auto [it, inserted] = classes_.emplace(cls.name(), &cls);
-  if (!inserted && it->second != &cls)
-    detail::throw_error("class name '" + cls.name() + "' is already registered for another class");
-  if (!inserted) return;
-  for (const MetaProperty* p : cls.own_properties())
-    if (!p->type().is_reference()) add_type_locked(p->type());
+  if (auto it = classes_.find(cls.name()); it != classes_.end()) {
+    if (it->second != &cls)
+      detail::throw_error("class name '" + cls.name() + "' is already registered for another class");
+    return;
+  }
+  // All or nothing: check every type before anything is registered.
+  for (const MetaProperty* p : cls.own_properties()) check_type_locked(p->type());
+  classes_.emplace(cls.name(), &cls);
+  for (const MetaProperty* p : cls.own_properties()) add_type_locked(p->type());
+}
+
+void Registry::check_type_locked(const MetaType& type) const {
+  if (auto it = types_.find(type.name()); it != types_.end() && it->second != &type && !same_reference(*it->second, type))
+    detail::throw_error("type name '" + type.name() + "' is already registered for another type");
+  if (type.element() != nullptr) check_type_locked(*type.element());
+  for (const auto& f : type.fields()) check_type_locked(*f.type);
+}
+
+bool Registry::same_reference(const MetaType& a, const MetaType& b) noexcept {
+  // Reference types are made per C++ class and on demand for run-time classes: two objects of one name
+  // are the same type when kind and target agree.
+  return a.is_reference() && a.kind() == b.kind() && a.target() == b.target();
 }
 
 void Registry::add(const MetaType& type) {
   std::unique_lock lock(mutex_);
+  check_type_locked(type);
   add_type_locked(type);
 }
 
 void Registry::add_type_locked(const MetaType& type) {
-  auto [it, inserted] = types_.emplace(type.name(), &type);
-  if (!inserted && it->second != &type)
-    detail::throw_error("type name '" + type.name() + "' is already registered for another type");
-  if (type.element() != nullptr && !type.element()->is_reference()) add_type_locked(*type.element());
+  types_.emplace(type.name(), &type);  // checked before: an existing entry is this type or its equal
+  if (type.element() != nullptr) add_type_locked(*type.element());
   for (const auto& f : type.fields()) add_type_locked(*f.type);
 }
 
@@ -151,11 +166,12 @@ std::vector<const MetaType*> Registry::types() const {
 const MetaInstance& Registry::define(std::unique_ptr<MetaInstance> cls) {
   std::unique_lock lock(mutex_);
   if (classes_.count(cls->name()) != 0) detail::throw_error("class name '" + cls->name() + "' is already registered");
+  for (const MetaProperty* p : cls->own_properties()) check_type_locked(p->type());
+  runtime_classes_.reserve(runtime_classes_.size() + 1);  // nothing below may fail half way
   cls->link_to_base();
   const MetaInstance& ref = *cls;
   classes_.emplace(ref.name(), &ref);
-  for (const MetaProperty* p : ref.own_properties())
-    if (!p->type().is_reference()) add_type_locked(p->type());
+  for (const MetaProperty* p : ref.own_properties()) add_type_locked(p->type());
   runtime_classes_.push_back(std::move(cls));
   return ref;
 }
@@ -168,6 +184,16 @@ void Registry::undefine(const MetaInstance& cls) {
   if (!cls.derived().empty()) detail::throw_error("class '" + cls.name() + "' still has subclasses");
   auto it = std::find_if(runtime_classes_.begin(), runtime_classes_.end(), [&](auto& p) { return p.get() == &cls; });
   if (it == runtime_classes_.end()) detail::throw_error("class '" + cls.name() + "' is not defined in this registry");
+  // A property of another class that references cls would be left pointing at nothing.
+  for (const auto& [name, other] : classes_) {
+    if (other == &cls) continue;
+    for (const MetaProperty* p : other->own_properties())
+      if (p->type().is_reference() && p->type().target() == &cls)
+        detail::throw_error("class '" + cls.name() + "' is still referenced by property '" + other->name() +
+                            "::" + p->name() + "'");
+  }
+  std::erase_if(types_, [&](const auto& entry) { return entry.second->is_reference() && entry.second->target() == &cls; });
+  std::erase_if(runtime_types_, [&](const auto& t) { return t->target() == &cls; });
   classes_.erase(cls.name());
   runtime_classes_.erase(it);  // ~MetaInstance unlinks it from its base
 }

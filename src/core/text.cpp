@@ -174,6 +174,20 @@ double TextReader::real() {
   return v;
 }
 
+float TextReader::real_float() {
+  const std::size_t at = (skip_ws(), pos_);
+  auto tok = number_token();
+  if (!tok.empty() && tok[0] == '+') tok.remove_prefix(1);
+  if (tok == "nan" || tok == "-nan") return std::numeric_limits<float>::quiet_NaN();
+  if (tok == "inf") return std::numeric_limits<float>::infinity();
+  if (tok == "-inf") return -std::numeric_limits<float>::infinity();
+  float v = 0;
+  auto [p, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
+  if (ec == std::errc::result_out_of_range) fail_at(at, "'" + std::string(tok) + "' is out of range for float");
+  if (ec != std::errc() || p != tok.data() + tok.size()) fail_at(at, "'" + std::string(tok) + "' is not a number");
+  return v;
+}
+
 void TextReader::expect_end() {
   if (!at_end()) fail(std::string("unexpected '") + text_[pos_] + "' after the value");
 }
@@ -195,6 +209,12 @@ void TextReader::fail(std::string_view what) const {
   if (!origin_.empty()) msg.append(origin_).push_back(':');
   msg += std::to_string(line()) + ":" + std::to_string(column()) + ": " + std::string(what);
   throw Error(msg);
+}
+
+void TextReader::fail_at(std::size_t pos, std::string_view what) const {
+  TextReader at = *this;
+  at.pos_ = pos;
+  at.fail(what);
 }
 
 void write_quoted(std::string& out, std::string_view s) {
@@ -219,7 +239,9 @@ void write_quoted(std::string& out, std::string_view s) {
   out.push_back('"');
 }
 
-void write_real(std::string& out, double v) {
+namespace {
+template <class F>
+void write_floating(std::string& out, F v) {
   if (std::isnan(v)) {
     out += "nan";
     return;
@@ -233,5 +255,9 @@ void write_real(std::string& out, double v) {
   (void)ec;
   out.append(buf, p);
 }
+}  // namespace
+
+void write_real(std::string& out, double v) { write_floating(out, v); }
+void write_real(std::string& out, float v) { write_floating(out, v); }
 
 }  // namespace vsd

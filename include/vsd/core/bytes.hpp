@@ -91,6 +91,8 @@ class ByteReader {
   [[nodiscard]] std::size_t remaining() const noexcept { return size_ - pos_; }
   [[nodiscard]] bool at_end() const noexcept { return pos_ == size_; }
   [[noreturn]] void fail(std::string_view what) const;
+  /// @brief Like fail(), reporting byte @p pos.
+  [[noreturn]] void fail_at(std::size_t pos, std::string_view what) const;
 
  private:
   void need(std::size_t n) const {

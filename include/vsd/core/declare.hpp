@@ -37,6 +37,10 @@ namespace vsd::detail {
 template <int N>
 struct Slot {};
 
+/// Lets `Type(def)` work for any spelling of a type ("long long", "std::vector<int>").
+template <class T>
+using TypeOf = T;
+
 constexpr PropertyFlags flags_or_default() noexcept { return DefaultFlags; }
 constexpr PropertyFlags flags_or_default(PropertyFlags f) noexcept { return f; }
 
@@ -97,7 +101,8 @@ void declare_property(MetaInstance& m, std::size_t slot, const char* name, std::
   static void vsd_register(::vsd::MetaInstance& m, ::vsd::detail::Slot<vsd_slot_##name>) {                \
     _Pragma("GCC diagnostic push") _Pragma("GCC diagnostic ignored \"-Winvalid-offsetof\"")               \
     ::vsd::detail::declare_property<Type>(m, vsd_slot_##name, #name, offsetof(vsd_self, name##_),         \
-                                          ::vsd::detail::flags_or_default(__VA_ARGS__), Type(def));       \
+                                          ::vsd::detail::flags_or_default(__VA_ARGS__),                   \
+                                          ::vsd::detail::TypeOf<Type>(def));                                  \
     _Pragma("GCC diagnostic pop")                                                                         \
     vsd_register(m, ::vsd::detail::Slot<vsd_slot_##name + 1>{});                                          \
   }                                                                                                       \

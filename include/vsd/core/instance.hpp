@@ -177,7 +177,7 @@ class SimStateInstance : public Instance {
 
 template <class T>
 void MetaProperty::set(SimStateInstance& obj, const T& v) const {
-  if (VSD_UNLIKELY(settable_ != &meta_type<T>())) throw_set(meta_type<T>());
+  if (VSD_UNLIKELY(settable_ != &meta_type<T>()) && !stores_from(meta_type<T>())) throw_set(meta_type<T>());
   if (VSD_UNLIKELY(!instance_fits(obj))) throw_owner(obj);
   obj.assign_at(*static_cast<T*>(const_cast<void*>(address(obj))), v, *this);
 }

@@ -57,7 +57,7 @@ class MetaProperty {
   /// @brief The value as a T; throws vsd::Error when T is not the property's type.
   template <class T>
   [[nodiscard]] const T& get(const SimStateInstance& obj) const {
-    if (VSD_UNLIKELY(type_ != &meta_type<T>())) throw_type(meta_type<T>());
+    if (VSD_UNLIKELY(type_ != &meta_type<T>()) && !views_as(meta_type<T>())) throw_type(meta_type<T>());
     if (VSD_UNLIKELY(!instance_fits(obj))) throw_owner(obj);
     return *static_cast<const T*>(address(obj));
   }
@@ -67,7 +67,10 @@ class MetaProperty {
   void set(SimStateInstance& obj, const T& v) const;
 
   /// @brief A copy of the value.
-  [[nodiscard]] Value get_value(const SimStateInstance& obj) const { return Value(*type_, address(obj)); }
+  [[nodiscard]] Value get_value(const SimStateInstance& obj) const {
+    if (VSD_UNLIKELY(!instance_fits(obj))) throw_owner(obj);
+    return Value(*type_, address(obj));
+  }
   /// @brief Sets from a Value, converting numbers where exact; throws vsd::Error on a wrong type.
   void set_value(SimStateInstance& obj, const Value& v) const;
   /// @brief Sets from raw memory holding a value of type(); ignores ReadOnly (transactions, loaders).
@@ -76,6 +79,10 @@ class MetaProperty {
  private:
   friend class MetaInstance;
   [[nodiscard]] bool instance_fits(const SimStateInstance& obj) const noexcept;
+  // A reference type made at run time and the C++ one of the same kind and target (or, for reading, a
+  // base of the target) are interchangeable: same layout, same ops.
+  [[nodiscard]] bool views_as(const MetaType& wanted) const noexcept;
+  [[nodiscard]] bool stores_from(const MetaType& given) const noexcept;
   [[noreturn]] void throw_type(const MetaType& wanted) const;
   [[noreturn]] void throw_set(const MetaType& given) const;  // wrong type or ReadOnly
   [[noreturn]] void throw_read_only_named() const;

@@ -105,6 +105,10 @@ class MetaType {
     return kind_ == TypeKind::Ref || kind_ == TypeKind::RefList;
   }
   [[nodiscard]] bool is_arithmetic() const noexcept { return kind_ <= TypeKind::Double && kind_ != TypeKind::Bool; }
+  /// @brief True for unsigned integers and for enums and flags whose underlying type is unsigned.
+  [[nodiscard]] bool is_unsigned() const noexcept { return unsigned_; }
+  /// @brief True when @p v is representable by this integer, enum or flags type.
+  [[nodiscard]] bool integer_fits(std::int64_t v) const noexcept;
 
   /// @brief Named values of an Enum or Flags type.
   [[nodiscard]] const std::vector<EnumValue>& enum_values() const noexcept { return enum_values_; }
@@ -156,6 +160,10 @@ class MetaType {
     fields_.push_back(std::move(f));
     return *this;
   }
+  MetaType& set_unsigned(bool u) noexcept {
+    unsigned_ = u;
+    return *this;
+  }
   MetaType& set_element(const MetaType* e) noexcept {
     element_ = e;
     return *this;
@@ -176,6 +184,7 @@ class MetaType {
   std::size_t size_;
   std::size_t align_;
   TypeKind kind_;
+  bool unsigned_ = false;
   std::vector<EnumValue> enum_values_;
   std::vector<Field> fields_;
   const MetaType* element_ = nullptr;
@@ -195,10 +204,26 @@ concept HasAdlType = requires(T* p) {
 };
 }  // namespace detail
 
+namespace detail {
+/// The fixed-width integer with the size and signedness of T: `long long` and `long` (or `char` and
+/// `signed char`) share one MetaType, as they share one representation.
+template <class T>
+using CanonicalInt = std::conditional_t<
+    std::is_signed_v<T>,
+    std::conditional_t<sizeof(T) == 1, std::int8_t,
+                       std::conditional_t<sizeof(T) == 2, std::int16_t,
+                                          std::conditional_t<sizeof(T) == 4, std::int32_t, std::int64_t>>>,
+    std::conditional_t<sizeof(T) == 1, std::uint8_t,
+                       std::conditional_t<sizeof(T) == 2, std::uint16_t,
+                                          std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>>>>;
+}  // namespace detail
+
 /// @brief The MetaType of C++ type T (built-in, or declared with VSD_ENUM / VSD_FLAGS / VSD_STRUCT).
 template <class T>
 const MetaType& meta_type() {
-  if constexpr (detail::HasTraits<T>) {
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool> && !std::is_same_v<T, detail::CanonicalInt<T>>) {
+    return meta_type<detail::CanonicalInt<T>>();
+  } else if constexpr (detail::HasTraits<T>) {
     static const MetaType type = TypeTraits<T>::make();
     return type;
   } else {
@@ -289,7 +314,13 @@ struct ValueOps {
 /// Makes the MetaType of a C++ type with ValueOps<T>.
 template <class T>
 MetaType make_type(std::string name, TypeKind kind) {
-  return MetaType(std::move(name), kind, sizeof(T), alignof(T), ValueOps<T>::table);
+  MetaType t(std::move(name), kind, sizeof(T), alignof(T), ValueOps<T>::table);
+  if constexpr (std::is_enum_v<T>) {
+    t.set_unsigned(std::is_unsigned_v<std::underlying_type_t<T>>);
+  } else if constexpr (std::is_integral_v<T>) {
+    t.set_unsigned(std::is_unsigned_v<T>);
+  }
+  return t;
 }
 
 template <class T>

@@ -67,6 +67,8 @@ class Registry {
  private:
   void add_locked(const MetaInstance& cls);
   void add_type_locked(const MetaType& type);
+  void check_type_locked(const MetaType& type) const;
+  static bool same_reference(const MetaType& a, const MetaType& b) noexcept;
 
   mutable std::shared_mutex mutex_;
   std::unordered_map<std::string, const MetaInstance*> classes_;

@@ -38,8 +38,17 @@ class TextReader {
   std::int64_t integer();
   std::uint64_t unsigned_integer();
   double real();
+  /// @brief Reads a number as a float (the shortest float text reads back exactly; overflow throws).
+  float real_float();
   /// @brief Throws vsd::Error that names origin:line:col and @p what.
   [[noreturn]] void fail(std::string_view what) const;
+  /// @brief Like fail(), reporting the position @p pos (where the offending token started).
+  [[noreturn]] void fail_at(std::size_t pos, std::string_view what) const;
+  /// @brief Position of the next non-blank character (the start of the next token).
+  std::size_t token_start() noexcept {
+    skip_ws();
+    return pos_;
+  }
   /// @brief Throws unless only blanks remain.
   void expect_end();
 
@@ -70,5 +79,6 @@ class TextReader {
 void write_quoted(std::string& out, std::string_view s);
 /// @brief Appends the shortest text that reads back as exactly @p v.
 void write_real(std::string& out, double v);
+void write_real(std::string& out, float v);
 
 }  // namespace vsd

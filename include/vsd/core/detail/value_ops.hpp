@@ -3,6 +3,7 @@
  */
 #pragma once
 
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <string>
@@ -34,6 +35,7 @@ bool equal_values(const T& a, const T& b) {
 template <class T>
 std::size_t hash_value(const T& v) {
   if constexpr (std::is_floating_point_v<T>) {
+    if (v != v) return 0x7ff8000000000000ULL;     // every NaN equals every NaN here, so they hash alike
     return std::hash<T>{}(v == T(0) ? T(0) : v);  // +0 and -0 are equal, so they hash alike
   } else if constexpr (is_std_vector<T>::value) {
     std::size_t h = v.size();
@@ -55,7 +57,7 @@ void text_out(const MetaType& t, const T& v, std::string& out) {
   } else if constexpr (std::is_integral_v<T>) {
     out += std::to_string(v);
   } else if constexpr (std::is_floating_point_v<T>) {
-    write_real(out, static_cast<double>(v));
+    write_real(out, v);  // the shortest text for T itself: 0.1f prints as 0.1
   } else if constexpr (std::is_same_v<T, std::string>) {
     write_quoted(out, v);
   } else if constexpr (std::is_enum_v<T>) {
@@ -77,25 +79,29 @@ void text_out(const MetaType& t, const T& v, std::string& out) {
 template <class T>
 void text_in(const MetaType& t, T& v, TextReader& in, const RefResolver* refs) {
   if constexpr (std::is_same_v<T, bool>) {
+    const std::size_t at = in.token_start();
     const auto id = in.identifier();
     if (id == "true") {
       v = true;
     } else if (id == "false") {
       v = false;
     } else {
-      in.fail("expected true or false, found '" + std::string(id) + "'");
+      in.fail_at(at, "expected true or false, found '" + std::string(id) + "'");
     }
   } else if constexpr (std::is_integral_v<T>) {
+    const std::size_t at = in.token_start();
     if constexpr (std::is_signed_v<T>) {
       const std::int64_t x = in.integer();
       if (x < std::numeric_limits<T>::min() || x > std::numeric_limits<T>::max())
-        in.fail(std::to_string(x) + " is out of range for " + t.name());
+        in.fail_at(at, std::to_string(x) + " is out of range for " + t.name());
       v = static_cast<T>(x);
     } else {
       const std::uint64_t x = in.unsigned_integer();
-      if (x > std::numeric_limits<T>::max()) in.fail(std::to_string(x) + " is out of range for " + t.name());
+      if (x > std::numeric_limits<T>::max()) in.fail_at(at, std::to_string(x) + " is out of range for " + t.name());
       v = static_cast<T>(x);
     }
+  } else if constexpr (std::is_same_v<T, float>) {
+    v = in.real_float();
   } else if constexpr (std::is_floating_point_v<T>) {
     v = static_cast<T>(in.real());
   } else if constexpr (std::is_same_v<T, std::string>) {
@@ -143,8 +149,9 @@ void bytes_out(const MetaType& t, const T& v, ByteWriter& out) {
 template <class T>
 void bytes_in(const MetaType& t, T& v, ByteReader& in, const RefResolver* refs) {
   if constexpr (std::is_same_v<T, bool>) {
+    const std::size_t at = in.position();
     const auto b = in.u8();
-    if (b > 1) in.fail("a bool must be 0 or 1, found " + std::to_string(b));
+    if (b > 1) in.fail_at(at, "a bool must be 0 or 1, found " + std::to_string(b));
     v = b != 0;
   } else if constexpr (std::is_arithmetic_v<T> || std::is_enum_v<T>) {
     v = in.fixed<T>();
