@@ -6,7 +6,6 @@
 //  4. records the changes as a transaction, sends it as bytes to a second SimState, and undoes it.
 #include <cstdio>
 #include <string>
-
 #include <vsd/vsd.hpp>
 
 namespace cell {
@@ -40,11 +39,12 @@ class ConveyorModule : public vsd::Module {
   void attach(vsd::Environment& env) override {
     const vsd::MetaProperty& pos = conveyor_->property("position");
     const vsd::MetaProperty& belt = conveyor_->property("belt_speed");
-    env.scheduler().add_periodic("conveyor kinematics", 0.05, [&env, &pos, &belt, this](const vsd::StepInfo& step) {
-      env.main_state().index().for_each(*conveyor_, true, [&](vsd::SimStateInstance& c) {
-        pos.set<double>(c, pos.get<double>(c) + belt.get<double>(c) * step.dt);
-      });
-    });
+    env.scheduler().add_periodic(
+        "conveyor kinematics", 0.05, [&env, &pos, &belt, this](const vsd::StepInfo& step) {
+          env.main_state().index().for_each(*conveyor_, true, [&](vsd::SimStateInstance& c) {
+            pos.set<double>(c, pos.get<double>(c) + belt.get<double>(c) * step.dt);
+          });
+        });
   }
 
  private:
@@ -57,13 +57,15 @@ namespace {
 
 std::string describe(const vsd::SimStateInstance& i) {
   const auto* n = i.as<vsd::NamedModelInstance>();
-  return i.meta().name() + " #" + std::to_string(i.id()) + (n != nullptr && !n->name().empty() ? " '" + n->name() + "'" : "");
+  return i.meta().name() + " #" + std::to_string(i.id()) +
+         (n != nullptr && !n->name().empty() ? " '" + n->name() + "'" : "");
 }
 
 void print_tree(const vsd::Node& n, int depth) {
   std::printf("%*s- %s", depth * 2, "", describe(n).c_str());
   for (const vsd::MetaProperty* p : n.meta().own_properties())
-    if (!p->type().is_ref_list()) std::printf("  %s=%s", p->name().c_str(), p->get_value(n).to_text().c_str());
+    if (!p->type().is_ref_list())
+      std::printf("  %s=%s", p->name().c_str(), p->get_value(n).to_text().c_str());
   for (const vsd::Extension* e : n.extensions()) std::printf("  [+%s]", describe(*e).c_str());
   std::printf("\n");
   for (const vsd::Node* c : n.children()) print_tree(*c, depth + 1);
@@ -92,7 +94,8 @@ int main() {
     const vsd::MetaInstance& cls = env.registry().get_class(name);
     std::printf("%-9s (%s, base %s):", cls.name().c_str(), cls.is_runtime() ? "run-time" : "built-in",
                 cls.base()->name().c_str());
-    for (const vsd::MetaProperty* p : cls.own_properties()) std::printf(" %s:%s", p->name().c_str(), p->type().name().c_str());
+    for (const vsd::MetaProperty* p : cls.own_properties())
+      std::printf(" %s:%s", p->name().c_str(), p->type().name().c_str());
     for (const vsd::MetaMethod* m : cls.methods()) std::printf(" %s", m->signature().c_str());
     std::printf("\n");
   }
@@ -102,11 +105,13 @@ int main() {
       [](vsd::SimStateInstance& i) { std::printf("  created  %s\n", describe(i).c_str()); });
   auto on_delete = state.on_deleted().connect(
       [](vsd::SimStateInstance& i) { std::printf("  deleted  %s\n", describe(i).c_str()); });
-  auto on_robot = state.on_property_changed(cell::Robot::static_meta()).connect(
-      [](vsd::SimStateInstance& i, const vsd::MetaProperty& p) {
-        std::printf("  changed  %s.%s = %s\n", describe(i).c_str(), p.name().c_str(), p.get_value(i).to_text().c_str());
-      });
-  std::printf("listening to creations and deletions in the main state, and to property changes of every Robot\n");
+  auto on_robot = state.on_property_changed(cell::Robot::static_meta())
+                      .connect([](vsd::SimStateInstance& i, const vsd::MetaProperty& p) {
+                        std::printf("  changed  %s.%s = %s\n", describe(i).c_str(), p.name().c_str(),
+                                    p.get_value(i).to_text().c_str());
+                      });
+  std::printf(
+      "listening to creations and deletions in the main state, and to property changes of every Robot\n");
 
   std::printf("\n== 3. Building a work cell\n");
   auto& cell = state.create<vsd::Node>();
@@ -127,12 +132,12 @@ int main() {
   vsd::SimState& replica = env.create_state("replica");
   replica.copy_from(state);
   state.start_recording();
-  robot.set_speed(1.5);                          // typed setter
-  robot.set("speed", vsd::Value(2));             // generic, by name: the int converts to double
-  env.run_for(0.2);                              // the conveyor module moves the belt
-  belt.call("stop");                             // vsdMetaCall on a run-time method
-  robot.call("home");                            // ... and on a built-in one
-  state.destroy(belt);                           // the robot's shared target becomes null
+  robot.set_speed(1.5);               // typed setter
+  robot.set("speed", vsd::Value(2));  // generic, by name: the int converts to double
+  env.run_for(0.2);                   // the conveyor module moves the belt
+  belt.call("stop");                  // vsdMetaCall on a run-time method
+  robot.call("home");                 // ... and on a built-in one
+  state.destroy(belt);                // the robot's shared target becomes null
   const vsd::Transaction bundle = state.stop_recording();
   std::printf("recorded %zu operations (%zu bytes):\n%s", bundle.size(), bundle.bytes().size(),
               bundle.describe().c_str());
@@ -140,7 +145,8 @@ int main() {
   // The bundle travels as bytes, as it would to another thread or machine.
   replica.apply(vsd::Transaction::from_bytes(bundle.bytes()));
   std::string difference;
-  std::printf("replica equals the source: %s\n", replica.equals(state, &difference) ? "yes" : ("no: " + difference).c_str());
+  std::printf("replica equals the source: %s\n",
+              replica.equals(state, &difference) ? "yes" : ("no: " + difference).c_str());
   print_tree(replica.database(), 1);
 
   std::printf("\n== 5. Undo on the replica\n");

@@ -6,7 +6,6 @@
 #include <string>
 #include <thread>
 #include <vector>
-
 #include <vsd/vsd.hpp>
 
 namespace {
@@ -38,9 +37,10 @@ std::vector<std::uint8_t> load_site(vsd::SimState& loader, int site, int buildin
 int main() {
   vsd::Environment env;
   vsd::SimState& main_state = env.main_state();
-  auto created = main_state.index().on_created(Building::static_meta()).connect([n = 0](vsd::SimStateInstance&) mutable {
-    if (++n % 250 == 0) std::printf("  main state: %d buildings arrived\n", n);
-  });
+  auto created =
+      main_state.index().on_created(Building::static_meta()).connect([n = 0](vsd::SimStateInstance&) mutable {
+        if (++n % 250 == 0) std::printf("  main state: %d buildings arrived\n", n);
+      });
 
   std::vector<std::future<std::vector<std::uint8_t>>> pending;
   for (int site = 0; site < 3; ++site) {

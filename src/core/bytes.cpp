@@ -7,7 +7,8 @@
 
 namespace vsd {
 
-static_assert(std::endian::native == std::endian::little, "vsd's binary encoding assumes a little-endian host");
+static_assert(std::endian::native == std::endian::little,
+              "vsd's binary encoding assumes a little-endian host");
 
 std::uint64_t ByteReader::varint() {
   std::uint64_t v = 0;

@@ -26,7 +26,9 @@ View::View(SimState& state, Filter filter, Order order)
 
 View::~View() = default;
 
-bool View::contains(const Node& n) const { return std::find(nodes_.begin(), nodes_.end(), &n) != nodes_.end(); }
+bool View::contains(const Node& n) const {
+  return std::find(nodes_.begin(), nodes_.end(), &n) != nodes_.end();
+}
 
 void View::for_each(const std::function<void(Node&)>& fn) const {
   const std::vector<Node*> copy = nodes_;  // fn may change the view
@@ -60,7 +62,8 @@ void View::place(Node& n) {
     nodes_.push_back(&n);
     return;
   }
-  auto at = std::upper_bound(nodes_.begin(), nodes_.end(), &n, [&](Node* a, Node* b) { return order_(*a, *b); });
+  auto at =
+      std::upper_bound(nodes_.begin(), nodes_.end(), &n, [&](Node* a, Node* b) { return order_(*a, *b); });
   nodes_.insert(at, &n);
 }
 

@@ -50,7 +50,9 @@ void ElementIndex::remove(SimStateInstance& i) noexcept {
 std::vector<ElementIndex::InstanceSignal*> ElementIndex::listeners(const SimStateInstance& i, bool created) {
   // Collected before emitting: a listener may define a class and grow the bucket table.
   std::vector<InstanceSignal*> out;
-  auto live = [](const std::unique_ptr<InstanceSignal>& s) { return s && s->has_listeners() ? s.get() : nullptr; };
+  auto live = [](const std::unique_ptr<InstanceSignal>& s) {
+    return s && s->has_listeners() ? s.get() : nullptr;
+  };
   for (const MetaInstance* m = &i.meta(); m != nullptr; m = m->base()) {
     if (m->index() >= buckets_.size()) continue;
     Bucket& b = buckets_[m->index()];

@@ -25,9 +25,11 @@ SimState& Environment::create_state(std::string name) {
 }
 
 void Environment::remove_state(SimState& state) {
-  if (&state == states_.front().get()) detail::throw_error("the main SimState of an Environment cannot be removed");
+  if (&state == states_.front().get())
+    detail::throw_error("the main SimState of an Environment cannot be removed");
   auto it = std::find_if(states_.begin(), states_.end(), [&](auto& s) { return s.get() == &state; });
-  if (it == states_.end()) detail::throw_error("SimState '" + state.name() + "' does not belong to this Environment");
+  if (it == states_.end())
+    detail::throw_error("SimState '" + state.name() + "' does not belong to this Environment");
   states_.erase(it);
 }
 

@@ -22,7 +22,9 @@ const MetaInstance& Instance::static_meta() {
 
 Instance::~Instance() = default;
 
-Value Instance::call(std::string_view name, std::span<const Value> args) { return meta_->call(*this, name, args); }
+Value Instance::call(std::string_view name, std::span<const Value> args) {
+  return meta_->call(*this, name, args);
+}
 
 // ---- SimStateInstance -------------------------------------------------------------------------------------
 
@@ -38,7 +40,8 @@ SimStateInstance::~SimStateInstance() = default;
 std::vector<SimStateInstance*> SimStateInstance::composite_holders() const {
   std::vector<SimStateInstance*> out;
   for (const detail::RefLink* l = composite_head_; l != nullptr; l = l->next)
-    if (l->holder != nullptr && std::find(out.begin(), out.end(), l->holder) == out.end()) out.push_back(l->holder);
+    if (l->holder != nullptr && std::find(out.begin(), out.end(), l->holder) == out.end())
+      out.push_back(l->holder);
   std::reverse(out.begin(), out.end());  // oldest first
   return out;
 }
@@ -52,7 +55,9 @@ SimStateInstance* SimStateInstance::composite_holder(const MetaProperty& p) cons
 
 Value SimStateInstance::get(std::string_view name) const { return meta().property(name).get_value(*this); }
 
-void SimStateInstance::set(std::string_view name, const Value& v) { meta().property(name).set_value(*this, v); }
+void SimStateInstance::set(std::string_view name, const Value& v) {
+  meta().property(name).set_value(*this, v);
+}
 
 namespace {
 RefListBase& list_of(SimStateInstance& holder, const MetaProperty& p) {
@@ -74,8 +79,8 @@ struct ListEdit : RefListBase {  // the SimState's access to a list's editing op
 void SimStateInstance::list_insert(const MetaProperty& p, std::size_t index, SimStateInstance& target) {
   RefListBase& list = list_of(*this, p);
   if (!target.is_a(*p.type().target()))
-    detail::throw_error("list '" + p.owner().name() + "::" + p.name() + "' holds " + p.type().target()->name() +
-                        ", not '" + target.meta().name() + "'");
+    detail::throw_error("list '" + p.owner().name() + "::" + p.name() + "' holds " +
+                        p.type().target()->name() + ", not '" + target.meta().name() + "'");
   if (index > list.size())
     detail::throw_error("index " + std::to_string(index) + " is past the end of '" + p.name() + "' (size " +
                         std::to_string(list.size()) + ")");
@@ -132,7 +137,8 @@ void NamedModelInstance::add_extension(Extension& e) {
 void NamedModelInstance::remove_extension(Extension& e) {
   const std::size_t i = extensions_.index_of(&e);
   if (i == RefListBase::npos)
-    detail::throw_error("extension #" + std::to_string(e.id()) + " is not attached to #" + std::to_string(id()));
+    detail::throw_error("extension #" + std::to_string(e.id()) + " is not attached to #" +
+                        std::to_string(id()));
   list_erase(vsd_prop_extensions(), i);
 }
 
@@ -165,7 +171,8 @@ Node& Node::insert_child(std::size_t index, Node& child) {
 void Node::remove_child(Node& child) {
   const std::size_t i = children_.index_of(&child);
   if (i == RefListBase::npos)
-    detail::throw_error("node #" + std::to_string(child.id()) + " is not a child of #" + std::to_string(id()));
+    detail::throw_error("node #" + std::to_string(child.id()) + " is not a child of #" +
+                        std::to_string(id()));
   list_erase(vsd_prop_children(), i);
 }
 

@@ -119,7 +119,8 @@ std::vector<const MetaInstance*> MetaInstance::derived() const {
 
 MetaProperty& MetaInstance::add_property(std::unique_ptr<MetaProperty> p) {
   for (const auto& q : own_props_)
-    if (q->name() == p->name()) detail::throw_error("class '" + name_ + "' declares property '" + p->name() + "' twice");
+    if (q->name() == p->name())
+      detail::throw_error("class '" + name_ + "' declares property '" + p->name() + "' twice");
   if (base_ != nullptr && base_->find_property(p->name()) != nullptr)
     detail::throw_error("class '" + name_ + "' redeclares inherited property '" + p->name() + "'");
   p->owner_ = this;
@@ -129,7 +130,8 @@ MetaProperty& MetaInstance::add_property(std::unique_ptr<MetaProperty> p) {
 
 MetaMethod& MetaInstance::add_method(std::unique_ptr<MetaMethod> m) {
   for (const auto& q : own_methods_)
-    if (q->name() == m->name()) detail::throw_error("class '" + name_ + "' declares method '" + m->name() + "' twice");
+    if (q->name() == m->name())
+      detail::throw_error("class '" + name_ + "' declares method '" + m->name() + "' twice");
   m->owner_ = this;
   own_methods_.push_back(std::move(m));
   return *own_methods_.back();
@@ -155,7 +157,8 @@ void MetaInstance::finish() {
     props_.push_back(own_props_[i].get());
   }
   for (const auto& m : own_methods_) {
-    auto same = std::find_if(methods_.begin(), methods_.end(), [&](const MetaMethod* x) { return x->name() == m->name(); });
+    auto same = std::find_if(methods_.begin(), methods_.end(),
+                             [&](const MetaMethod* x) { return x->name() == m->name(); });
     if (same != methods_.end()) {
       *same = m.get();  // a subclass's method hides the base's
     } else {
@@ -244,8 +247,8 @@ void MetaInstance::destroy(SimStateInstance* obj) const noexcept {
 ClassBuilder::ClassBuilder(std::string name, const MetaInstance& base)
     : meta_(new MetaInstance(std::move(name), base, false)) {
   if (base.builtin_->construct_ == nullptr && !base.is_a(SimStateInstance::static_meta()))
-    detail::throw_error("run-time class '" + meta_->name() + "' needs a base derived from SimStateInstance, not '" +
-                        base.name() + "'");
+    detail::throw_error("run-time class '" + meta_->name() +
+                        "' needs a base derived from SimStateInstance, not '" + base.name() + "'");
 }
 
 ClassBuilder& ClassBuilder::property(std::string name, const MetaType& type, Value default_value,
@@ -264,10 +267,11 @@ ClassBuilder& ClassBuilder::property(std::string name, const MetaType& type, Val
   return *this;
 }
 
-ClassBuilder& ClassBuilder::method(std::string name, std::vector<const MetaType*> arguments, const MetaType* result,
-                                   MetaMethod::Invoker fn) {
+ClassBuilder& ClassBuilder::method(std::string name, std::vector<const MetaType*> arguments,
+                                   const MetaType* result, MetaMethod::Invoker fn) {
   if (!fn) detail::throw_error("method '" + name + "' of run-time class '" + meta_->name() + "' has no body");
-  meta_->add_method(std::make_unique<MetaMethod>(std::move(name), result, std::move(arguments), std::move(fn)));
+  meta_->add_method(
+      std::make_unique<MetaMethod>(std::move(name), result, std::move(arguments), std::move(fn)));
   return *this;
 }
 
@@ -367,18 +371,22 @@ Value MetaMethod::invoke(Instance& self, std::span<const Value> args) const {
 // ---- Value ------------------------------------------------------------------------------------------------
 
 void Value::throw_mismatch(const MetaType& wanted) const {
-  detail::throw_error("value holds " + (type_ != nullptr ? type_->name() : std::string("nothing")) + ", not " +
-                      wanted.name());
+  detail::throw_error("value holds " + (type_ != nullptr ? type_->name() : std::string("nothing")) +
+                      ", not " + wanted.name());
 }
 
 namespace {
 // Reads a number of any arithmetic kind as a long double, exactly enough for the range checks below.
 long double load_number(const MetaType& t, const void* p) {
   switch (t.kind()) {
-    case TypeKind::Float: return *static_cast<const float*>(p);
-    case TypeKind::Double: return *static_cast<const double*>(p);
-    case TypeKind::UInt: return static_cast<long double>(static_cast<std::uint64_t>(t.load_integer(p)));
-    default: return static_cast<long double>(t.load_integer(p));
+    case TypeKind::Float:
+      return *static_cast<const float*>(p);
+    case TypeKind::Double:
+      return *static_cast<const double*>(p);
+    case TypeKind::UInt:
+      return static_cast<long double>(static_cast<std::uint64_t>(t.load_integer(p)));
+    default:
+      return static_cast<long double>(t.load_integer(p));
   }
 }
 }  // namespace
@@ -402,7 +410,8 @@ Value Value::convert_to(const MetaType& target) const {
         return out;
       }
       case TypeKind::Float: {
-        if (std::isfinite(x) && (x > std::numeric_limits<float>::max() || x < std::numeric_limits<float>::lowest()))
+        if (std::isfinite(x) &&
+            (x > std::numeric_limits<float>::max() || x < std::numeric_limits<float>::lowest()))
           exact(std::numeric_limits<long double>::infinity());
         const auto f = static_cast<float>(x);
         exact(f);
@@ -431,7 +440,8 @@ Value Value::convert_to(const MetaType& target) const {
     // fits the new target class: references to a base, or to a subclass when the instance is one.
     auto fits = [&](const SimStateInstance* t) {
       if (t != nullptr && target.target() != nullptr && !t->is_a(*target.target()))
-        detail::throw_error("expected " + target.name() + ", got a reference to a '" + t->meta().name() + "'");
+        detail::throw_error("expected " + target.name() + ", got a reference to a '" + t->meta().name() +
+                            "'");
     };
     if (type_->is_ref_list()) {
       const auto& src = *static_cast<const RefListBase*>(data());

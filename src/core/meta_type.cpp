@@ -38,17 +38,20 @@ std::int64_t MetaType::load_integer(const void* obj) const noexcept {
     case 1: {
       std::uint8_t v;
       std::memcpy(&v, obj, 1);
-      return is_unsigned ? static_cast<std::int64_t>(v) : static_cast<std::int64_t>(static_cast<std::int8_t>(v));
+      return is_unsigned ? static_cast<std::int64_t>(v)
+                         : static_cast<std::int64_t>(static_cast<std::int8_t>(v));
     }
     case 2: {
       std::uint16_t v;
       std::memcpy(&v, obj, 2);
-      return is_unsigned ? static_cast<std::int64_t>(v) : static_cast<std::int64_t>(static_cast<std::int16_t>(v));
+      return is_unsigned ? static_cast<std::int64_t>(v)
+                         : static_cast<std::int64_t>(static_cast<std::int16_t>(v));
     }
     case 4: {
       std::uint32_t v;
       std::memcpy(&v, obj, 4);
-      return is_unsigned ? static_cast<std::int64_t>(v) : static_cast<std::int64_t>(static_cast<std::int32_t>(v));
+      return is_unsigned ? static_cast<std::int64_t>(v)
+                         : static_cast<std::int64_t>(static_cast<std::int32_t>(v));
     }
     default: {
       std::int64_t v;
@@ -75,7 +78,8 @@ void MetaType::store_integer(void* obj, std::int64_t v) const noexcept {
       std::memcpy(obj, &x, 4);
       break;
     }
-    default: std::memcpy(obj, &v, 8);
+    default:
+      std::memcpy(obj, &v, 8);
   }
 }
 
@@ -312,10 +316,12 @@ void make_isometry_fields(MetaType& t) {
                }});
   t.add_field({"rotation", &meta_type<Eigen::Quaterniond>(), MetaType::npos,
                [](const void* o, void* out) {
-                 *static_cast<Eigen::Quaterniond*>(out) = Eigen::Quaterniond(static_cast<const I*>(o)->linear());
+                 *static_cast<Eigen::Quaterniond*>(out) =
+                     Eigen::Quaterniond(static_cast<const I*>(o)->linear());
                },
                [](void* o, const void* in) {
-                 static_cast<I*>(o)->linear() = static_cast<const Eigen::Quaterniond*>(in)->normalized().toRotationMatrix();
+                 static_cast<I*>(o)->linear() =
+                     static_cast<const Eigen::Quaterniond*>(in)->normalized().toRotationMatrix();
                }});
 }
 

@@ -64,8 +64,8 @@ struct RefAccess {
       throw_error("instance #" + std::to_string(l.holder->id()) + " cannot reference instance #" +
                   std::to_string(t.id()) + ": they live in different SimStates");
     if (l.composite && composite_ancestor(t, *l.holder))
-      throw_error("a composite reference from #" + std::to_string(l.holder->id()) + " to #" + std::to_string(t.id()) +
-                  " would make an instance its own ancestor");
+      throw_error("a composite reference from #" + std::to_string(l.holder->id()) + " to #" +
+                  std::to_string(t.id()) + " would make an instance its own ancestor");
   }
 
   static void reset(RefLink& l, SimStateInstance* t) {
@@ -167,8 +167,9 @@ bool operator==(const RefListBase& a, const RefListBase& b) noexcept {
 
 void RefListBase::insert_at(std::size_t i, SimStateInstance* p) {
   if (p == nullptr) detail::throw_error("a reference list cannot hold null");
-  if (i > links_.size()) detail::throw_error("index " + std::to_string(i) + " is past the end of a list of " +
-                                             std::to_string(links_.size()));
+  if (i > links_.size())
+    detail::throw_error("index " + std::to_string(i) + " is past the end of a list of " +
+                        std::to_string(links_.size()));
   auto* l = new detail::RefLink(composite_);
   l->holder = holder_;
   l->prop = prop_;
@@ -188,8 +189,9 @@ void RefListBase::insert_at(std::size_t i, SimStateInstance* p) {
 }
 
 void RefListBase::erase_at(std::size_t i) {
-  if (i >= links_.size()) detail::throw_error("index " + std::to_string(i) + " is out of a list of " +
-                                              std::to_string(links_.size()));
+  if (i >= links_.size())
+    detail::throw_error("index " + std::to_string(i) + " is out of a list of " +
+                        std::to_string(links_.size()));
   detail::RefLink* l = links_[i];
   links_.erase(links_.begin() + static_cast<std::ptrdiff_t>(i));
   delete l;  // releases last: a cascade sees the list already updated
@@ -204,7 +206,9 @@ void RefListBase::clear_all() {
 namespace detail {
 namespace {
 
-bool is_composite_kind(const MetaType& t) { return t.kind() == TypeKind::Ref || t.kind() == TypeKind::RefList; }
+bool is_composite_kind(const MetaType& t) {
+  return t.kind() == TypeKind::Ref || t.kind() == TypeKind::RefList;
+}
 
 SimStateInstance* resolve(const MetaType& t, Id id, const RefResolver* refs, const auto& fail) {
   if (id == null_id) return nullptr;
@@ -227,7 +231,9 @@ struct ListCore : RefListBase {
 };
 
 void ref_construct(const MetaType& t, void* dst) { ::new (dst) RefCore(is_composite_kind(t), nullptr); }
-void ref_copy(const MetaType&, void* dst, const void* src) { ::new (dst) RefBase(*static_cast<const RefBase*>(src)); }
+void ref_copy(const MetaType&, void* dst, const void* src) {
+  ::new (dst) RefBase(*static_cast<const RefBase*>(src));
+}
 void ref_move(const MetaType&, void* dst, void* src) noexcept {
   // Copying a link cannot fail for a valid source (same target), so this is safe as noexcept.
   ::new (dst) RefBase(*static_cast<const RefBase*>(src));
@@ -239,7 +245,9 @@ void ref_assign(const MetaType&, void* dst, const void* src) {
 bool ref_equal(const MetaType&, const void* a, const void* b) {
   return static_cast<const RefBase*>(a)->id() == static_cast<const RefBase*>(b)->id();
 }
-std::size_t ref_hash(const MetaType&, const void* p) { return std::hash<Id>{}(static_cast<const RefBase*>(p)->id()); }
+std::size_t ref_hash(const MetaType&, const void* p) {
+  return std::hash<Id>{}(static_cast<const RefBase*>(p)->id());
+}
 void write_id(std::string& out, Id id) {
   if (id == null_id) {
     out += "null";
@@ -337,11 +345,11 @@ void list_bind(const MetaType&, void* p, SimStateInstance* holder, const MetaPro
 
 }  // namespace
 
-const TypeOps ref_ops{&ref_construct, &ref_copy,       &ref_move,      &ref_destroy,
-                      &ref_assign,    &ref_equal,      &ref_hash,      &ref_write_text,
+const TypeOps ref_ops{&ref_construct, &ref_copy,        &ref_move,       &ref_destroy,
+                      &ref_assign,    &ref_equal,       &ref_hash,       &ref_write_text,
                       &ref_read_text, &ref_write_bytes, &ref_read_bytes, &ref_bind};
-const TypeOps ref_list_ops{&list_construct, &list_copy,       &list_move,      &list_destroy,
-                           &list_assign,    &list_equal,      &list_hash,      &list_write_text,
+const TypeOps ref_list_ops{&list_construct, &list_copy,        &list_move,       &list_destroy,
+                           &list_assign,    &list_equal,       &list_hash,       &list_write_text,
                            &list_read_text, &list_write_bytes, &list_read_bytes, &list_bind};
 
 }  // namespace detail

@@ -31,15 +31,29 @@ Registry& Registry::global() {
 
 Registry::Registry() {
   // Built-in value types and core classes are always known by name.
-  for (const MetaType* t :
-       {&meta_type<bool>(), &meta_type<std::int8_t>(), &meta_type<std::int16_t>(), &meta_type<std::int32_t>(),
-        &meta_type<std::int64_t>(), &meta_type<std::uint8_t>(), &meta_type<std::uint16_t>(),
-        &meta_type<std::uint32_t>(), &meta_type<std::uint64_t>(), &meta_type<float>(), &meta_type<double>(),
-        &meta_type<std::string>(), &meta_type<Eigen::Vector2d>(), &meta_type<Eigen::Vector3d>(),
-        &meta_type<Eigen::Vector4d>(), &meta_type<Eigen::Quaterniond>(), &meta_type<Eigen::Isometry3d>(),
-        &meta_type<std::vector<bool>>(), &meta_type<std::vector<std::int32_t>>(),
-        &meta_type<std::vector<std::int64_t>>(), &meta_type<std::vector<double>>(),
-        &meta_type<std::vector<std::string>>(), &meta_type<std::vector<Eigen::Vector3d>>()})
+  for (const MetaType* t : {&meta_type<bool>(),
+                            &meta_type<std::int8_t>(),
+                            &meta_type<std::int16_t>(),
+                            &meta_type<std::int32_t>(),
+                            &meta_type<std::int64_t>(),
+                            &meta_type<std::uint8_t>(),
+                            &meta_type<std::uint16_t>(),
+                            &meta_type<std::uint32_t>(),
+                            &meta_type<std::uint64_t>(),
+                            &meta_type<float>(),
+                            &meta_type<double>(),
+                            &meta_type<std::string>(),
+                            &meta_type<Eigen::Vector2d>(),
+                            &meta_type<Eigen::Vector3d>(),
+                            &meta_type<Eigen::Vector4d>(),
+                            &meta_type<Eigen::Quaterniond>(),
+                            &meta_type<Eigen::Isometry3d>(),
+                            &meta_type<std::vector<bool>>(),
+                            &meta_type<std::vector<std::int32_t>>(),
+                            &meta_type<std::vector<std::int64_t>>(),
+                            &meta_type<std::vector<double>>(),
+                            &meta_type<std::vector<std::string>>(),
+                            &meta_type<std::vector<Eigen::Vector3d>>()})
     add_type_locked(*t);
   for (const MetaInstance* c :
        {&Instance::static_meta(), &SimStateInstance::static_meta(), &NamedModelInstance::static_meta(),
@@ -68,7 +82,8 @@ void Registry::add_locked(const MetaInstance& cls) {
 }
 
 void Registry::check_type_locked(const MetaType& type) const {
-  if (auto it = types_.find(type.name()); it != types_.end() && it->second != &type && !same_reference(*it->second, type))
+  if (auto it = types_.find(type.name());
+      it != types_.end() && it->second != &type && !same_reference(*it->second, type))
     detail::throw_error("type name '" + type.name() + "' is already registered for another type");
   if (type.element() != nullptr) check_type_locked(*type.element());
   for (const auto& f : type.fields()) check_type_locked(*f.type);
@@ -111,10 +126,11 @@ const MetaType* Registry::find_type(std::string_view name) const {
 
 const MetaType& Registry::get_type(std::string_view name) {
   if (const MetaType* t = find_type(name)) return *t;
-  static constexpr std::pair<std::string_view, TypeKind> kinds[] = {{"ref<", TypeKind::Ref},
-                                                                     {"shared<", TypeKind::SharedRef},
-                                                                     {"list<", TypeKind::RefList},
-                                                                     {"shared_list<", TypeKind::SharedRefList}};
+  static constexpr std::pair<std::string_view, TypeKind> kinds[] = {
+      {"ref<", TypeKind::Ref},
+      {"shared<", TypeKind::SharedRef},
+      {"list<", TypeKind::RefList},
+      {"shared_list<", TypeKind::SharedRefList}};
   for (const auto& [prefix, kind] : kinds) {
     if (name.size() > prefix.size() + 1 && name.substr(0, prefix.size()) == prefix && name.back() == '>') {
       const auto cls = name.substr(prefix.size(), name.size() - prefix.size() - 1);
@@ -127,11 +143,20 @@ const MetaType& Registry::get_type(std::string_view name) {
 const MetaType& Registry::reference_type(TypeKind kind, const MetaInstance& target) {
   std::string prefix;
   switch (kind) {
-    case TypeKind::Ref: prefix = "ref"; break;
-    case TypeKind::SharedRef: prefix = "shared"; break;
-    case TypeKind::RefList: prefix = "list"; break;
-    case TypeKind::SharedRefList: prefix = "shared_list"; break;
-    default: detail::throw_error("reference_type: not a reference kind");
+    case TypeKind::Ref:
+      prefix = "ref";
+      break;
+    case TypeKind::SharedRef:
+      prefix = "shared";
+      break;
+    case TypeKind::RefList:
+      prefix = "list";
+      break;
+    case TypeKind::SharedRefList:
+      prefix = "shared_list";
+      break;
+    default:
+      detail::throw_error("reference_type: not a reference kind");
   }
   const std::string name = prefix + "<" + target.name() + ">";
   std::unique_lock lock(mutex_);
@@ -165,7 +190,8 @@ std::vector<const MetaType*> Registry::types() const {
 
 const MetaInstance& Registry::define(std::unique_ptr<MetaInstance> cls) {
   std::unique_lock lock(mutex_);
-  if (classes_.count(cls->name()) != 0) detail::throw_error("class name '" + cls->name() + "' is already registered");
+  if (classes_.count(cls->name()) != 0)
+    detail::throw_error("class name '" + cls->name() + "' is already registered");
   for (const MetaProperty* p : cls->own_properties()) check_type_locked(p->type());
   runtime_classes_.reserve(runtime_classes_.size() + 1);  // nothing below may fail half way
   cls->link_to_base();
@@ -180,10 +206,13 @@ void Registry::undefine(const MetaInstance& cls) {
   std::unique_lock lock(mutex_);
   if (!cls.is_runtime()) detail::throw_error("built-in class '" + cls.name() + "' cannot be undefined");
   if (cls.live_instances() != 0)
-    detail::throw_error("class '" + cls.name() + "' still has " + std::to_string(cls.live_instances()) + " instance(s)");
+    detail::throw_error("class '" + cls.name() + "' still has " + std::to_string(cls.live_instances()) +
+                        " instance(s)");
   if (!cls.derived().empty()) detail::throw_error("class '" + cls.name() + "' still has subclasses");
-  auto it = std::find_if(runtime_classes_.begin(), runtime_classes_.end(), [&](auto& p) { return p.get() == &cls; });
-  if (it == runtime_classes_.end()) detail::throw_error("class '" + cls.name() + "' is not defined in this registry");
+  auto it = std::find_if(runtime_classes_.begin(), runtime_classes_.end(),
+                         [&](auto& p) { return p.get() == &cls; });
+  if (it == runtime_classes_.end())
+    detail::throw_error("class '" + cls.name() + "' is not defined in this registry");
   // A property of another class that references cls would be left pointing at nothing.
   for (const auto& [name, other] : classes_) {
     if (other == &cls) continue;
@@ -192,7 +221,9 @@ void Registry::undefine(const MetaInstance& cls) {
         detail::throw_error("class '" + cls.name() + "' is still referenced by property '" + other->name() +
                             "::" + p->name() + "'");
   }
-  std::erase_if(types_, [&](const auto& entry) { return entry.second->is_reference() && entry.second->target() == &cls; });
+  std::erase_if(types_, [&](const auto& entry) {
+    return entry.second->is_reference() && entry.second->target() == &cls;
+  });
   std::erase_if(runtime_types_, [&](const auto& t) { return t->target() == &cls; });
   classes_.erase(cls.name());
   runtime_classes_.erase(it);  // ~MetaInstance unlinks it from its base

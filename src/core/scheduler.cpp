@@ -16,7 +16,8 @@ Scheduler::Scheduler(double base_step) : base_step_(base_step) {
 }
 
 void Scheduler::set_base_step(double seconds) {
-  if (!(seconds > 0.0)) detail::throw_error("scheduler base step must be > 0, got " + std::to_string(seconds));
+  if (!(seconds > 0.0))
+    detail::throw_error("scheduler base step must be > 0, got " + std::to_string(seconds));
   base_step_ = seconds;
 }
 
@@ -62,7 +63,8 @@ void Scheduler::remove(TaskId id) {
 }
 
 std::size_t Scheduler::task_count() const noexcept {
-  return static_cast<std::size_t>(std::count_if(tasks_.begin(), tasks_.end(), [](auto& e) { return !e.removed; }));
+  return static_cast<std::size_t>(
+      std::count_if(tasks_.begin(), tasks_.end(), [](auto& e) { return !e.removed; }));
 }
 
 const std::string& Scheduler::task_name(TaskId id) const {
@@ -88,8 +90,8 @@ void Scheduler::step() {
   }
   for (int round = 0; any_pending_; ++round) {
     if (round == max_event_rounds)
-      detail::throw_error("event-driven tasks kept triggering each other for " + std::to_string(max_event_rounds) +
-                          " rounds in step " + std::to_string(steps_));
+      detail::throw_error("event-driven tasks kept triggering each other for " +
+                          std::to_string(max_event_rounds) + " rounds in step " + std::to_string(steps_));
     any_pending_ = false;
     for (std::size_t i = 0; i < tasks_.size(); ++i) {
       if (!tasks_[i].pending || tasks_[i].removed) continue;

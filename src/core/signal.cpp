@@ -31,7 +31,8 @@ void SignalCore::disconnect(std::uint32_t id) noexcept {
 
 void SignalCore::sweep() noexcept {
   dirty = false;
-  auto dead = std::stable_partition(slots.begin(), slots.end(), [](const Slot& s) { return s.fn != nullptr; });
+  auto dead =
+      std::stable_partition(slots.begin(), slots.end(), [](const Slot& s) { return s.fn != nullptr; });
   for (auto it = dead; it != slots.end(); ++it)
     if (it->drop != nullptr) it->drop(it->ctx);
   slots.erase(dead, slots.end());

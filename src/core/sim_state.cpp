@@ -52,7 +52,8 @@ void SimState::free_graveyard() noexcept {
 SimStateInstance& SimState::make(const MetaInstance& cls, Id id) {
   if (!cls.is_a(SimStateInstance::static_meta()))
     detail::throw_error("class '" + cls.name() + "' is not a SimStateInstance and cannot live in a SimState");
-  if (cls.is_abstract()) detail::throw_error("class '" + cls.name() + "' is abstract and cannot be instantiated");
+  if (cls.is_abstract())
+    detail::throw_error("class '" + cls.name() + "' is abstract and cannot be instantiated");
   if (root_ != nullptr && cls.is_a(Database::static_meta()))
     detail::throw_error("SimState '" + name_ + "' already has its Database");
   if (by_id_.count(id) != 0)
@@ -233,8 +234,8 @@ void SimState::list_changed(SimStateInstance& holder, const MetaProperty& p, std
                             SimStateInstance& target, bool inserted) {
   Dispatch d(*this);
   if (recording_ && !p.has(Transient)) {
-    detail::write_list(recorded_, inserted ? Transaction::Op::Insert : Transaction::Op::Erase, holder.id(), p, index,
-                       target.id());
+    detail::write_list(recorded_, inserted ? Transaction::Op::Insert : Transaction::Op::Erase, holder.id(), p,
+                       index, target.id());
     ++recorded_ops_;
   }
   if (&p == &Node::vsd_prop_children()) {
@@ -285,7 +286,8 @@ Transaction SimState::snapshot() const {
   for (SimStateInstance* x : all) {
     if (x == root_) {
       for (const MetaProperty* p : x->meta().properties()) {
-        if (!detail::carried_in_payload(*p) || p->type().equal(p->address(*x), p->default_value().data())) continue;
+        if (!detail::carried_in_payload(*p) || p->type().equal(p->address(*x), p->default_value().data()))
+          continue;
         detail::write_set(out, *x, *p, p->default_value().data(), p->address(*x));
         ++t.ops_;
       }
@@ -316,8 +318,8 @@ Transaction SimState::snapshot() const {
 
 void SimState::copy_from(const SimState& other) {
   if (size() != 1 || !root_->children().empty())
-    detail::throw_error("copy_from needs an empty SimState, but '" + name_ + "' holds " + std::to_string(size()) +
-                        " instances");
+    detail::throw_error("copy_from needs an empty SimState, but '" + name_ + "' holds " +
+                        std::to_string(size()) + " instances");
   apply(other.snapshot());
 }
 
@@ -332,12 +334,13 @@ bool SimState::equals(const SimState& other, std::string* difference) const {
     const SimStateInstance* y = other.find(x->id());
     if (y == nullptr) return differ("#" + std::to_string(x->id()) + " missing");
     if (&x->meta() != &y->meta())
-      return differ("#" + std::to_string(x->id()) + " is a " + x->meta().name() + " vs a " + y->meta().name());
+      return differ("#" + std::to_string(x->id()) + " is a " + x->meta().name() + " vs a " +
+                    y->meta().name());
     for (const MetaProperty* p : x->meta().properties()) {
       if (p->has(Transient)) continue;
       if (!p->type().equal(p->address(*x), p->address(*y)))
-        return differ("#" + std::to_string(x->id()) + "." + p->name() + ": " + p->type().to_text(p->address(*x)) +
-                      " vs " + p->type().to_text(p->address(*y)));
+        return differ("#" + std::to_string(x->id()) + "." + p->name() + ": " +
+                      p->type().to_text(p->address(*x)) + " vs " + p->type().to_text(p->address(*y)));
     }
   }
   return true;

@@ -83,14 +83,30 @@ std::string TextReader::string() {
     if (pos_ >= text_.size()) fail("unterminated escape in string");
     const char e = text_[pos_++];
     switch (e) {
-      case '"': out.push_back('"'); break;
-      case '\\': out.push_back('\\'); break;
-      case '/': out.push_back('/'); break;
-      case 'n': out.push_back('\n'); break;
-      case 't': out.push_back('\t'); break;
-      case 'r': out.push_back('\r'); break;
-      case 'b': out.push_back('\b'); break;
-      case 'f': out.push_back('\f'); break;
+      case '"':
+        out.push_back('"');
+        break;
+      case '\\':
+        out.push_back('\\');
+        break;
+      case '/':
+        out.push_back('/');
+        break;
+      case 'n':
+        out.push_back('\n');
+        break;
+      case 't':
+        out.push_back('\t');
+        break;
+      case 'r':
+        out.push_back('\r');
+        break;
+      case 'b':
+        out.push_back('\b');
+        break;
+      case 'f':
+        out.push_back('\f');
+        break;
       case 'u': {
         if (text_.size() - pos_ < 4) fail("truncated \\u escape");
         unsigned code = 0;
@@ -110,7 +126,9 @@ std::string TextReader::string() {
         }
         break;
       }
-      default: --pos_; fail(std::string("unknown escape '\\") + e + "'");
+      default:
+        --pos_;
+        fail(std::string("unknown escape '\\") + e + "'");
     }
   }
 }
@@ -139,7 +157,8 @@ std::int64_t TextReader::integer() {
   auto [p, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
   if (ec != std::errc() || p != tok.data() + tok.size()) {
     pos_ = at;
-    fail("'" + std::string(tok) + "' is not an integer" + (ec == std::errc::result_out_of_range ? " in range" : ""));
+    fail("'" + std::string(tok) + "' is not an integer" +
+         (ec == std::errc::result_out_of_range ? " in range" : ""));
   }
   return v;
 }
@@ -183,8 +202,10 @@ float TextReader::real_float() {
   if (tok == "-inf") return -std::numeric_limits<float>::infinity();
   float v = 0;
   auto [p, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
-  if (ec == std::errc::result_out_of_range) fail_at(at, "'" + std::string(tok) + "' is out of range for float");
-  if (ec != std::errc() || p != tok.data() + tok.size()) fail_at(at, "'" + std::string(tok) + "' is not a number");
+  if (ec == std::errc::result_out_of_range)
+    fail_at(at, "'" + std::string(tok) + "' is out of range for float");
+  if (ec != std::errc() || p != tok.data() + tok.size())
+    fail_at(at, "'" + std::string(tok) + "' is not a number");
   return v;
 }
 
@@ -221,11 +242,21 @@ void write_quoted(std::string& out, std::string_view s) {
   out.push_back('"');
   for (const char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      case '\r': out += "\\r"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char buf[8];

@@ -37,7 +37,9 @@ std::span<const std::uint8_t> read_framed(ByteReader& r) {
 }
 }  // namespace
 
-bool carried_in_payload(const MetaProperty& p) noexcept { return !p.type().is_reference() && !p.has(Transient); }
+bool carried_in_payload(const MetaProperty& p) noexcept {
+  return !p.type().is_reference() && !p.has(Transient);
+}
 
 void write_tx_header(std::vector<std::uint8_t>& out) {
   out.insert(out.end(), std::begin(magic), std::end(magic));
@@ -148,8 +150,8 @@ Transaction Transaction::from_bytes(std::vector<std::uint8_t> bytes) {
   if (bytes.size() < detail::header_size || std::memcmp(bytes.data(), detail::magic, 4) != 0)
     throw Error("byte 0: not a vsd transaction bundle (no VSDT header)");
   if (bytes[4] != format_version)
-    throw Error("byte 4: transaction format version " + std::to_string(bytes[4]) + " is not supported (this is " +
-                std::to_string(format_version) + ")");
+    throw Error("byte 4: transaction format version " + std::to_string(bytes[4]) +
+                " is not supported (this is " + std::to_string(format_version) + ")");
   t.bytes_ = std::move(bytes);
   t.ops_ = detail::parse_tx(t).size();
   return t;
@@ -166,11 +168,20 @@ Transaction Transaction::inverted() const {
     const detail::TxOp& op = *it;
     Op code = op.op;
     switch (op.op) {
-      case Op::Create: code = Op::Delete; break;
-      case Op::Delete: code = Op::Create; break;
-      case Op::Insert: code = Op::Erase; break;
-      case Op::Erase: code = Op::Insert; break;
-      case Op::Set: break;
+      case Op::Create:
+        code = Op::Delete;
+        break;
+      case Op::Delete:
+        code = Op::Create;
+        break;
+      case Op::Insert:
+        code = Op::Erase;
+        break;
+      case Op::Erase:
+        code = Op::Insert;
+        break;
+      case Op::Set:
+        break;
     }
     w.u8(static_cast<std::uint8_t>(code));
     w.varint(op.id);
@@ -197,16 +208,22 @@ std::string Transaction::describe() const {
   std::string s;
   for (const auto& op : detail::parse_tx(*this)) {
     switch (op.op) {
-      case Op::Create: s += "create #" + std::to_string(op.id) + " " + std::string(op.name); break;
-      case Op::Delete: s += "delete #" + std::to_string(op.id) + " " + std::string(op.name); break;
-      case Op::Set: s += "set #" + std::to_string(op.id) + "." + std::string(op.name); break;
+      case Op::Create:
+        s += "create #" + std::to_string(op.id) + " " + std::string(op.name);
+        break;
+      case Op::Delete:
+        s += "delete #" + std::to_string(op.id) + " " + std::string(op.name);
+        break;
+      case Op::Set:
+        s += "set #" + std::to_string(op.id) + "." + std::string(op.name);
+        break;
       case Op::Insert:
-        s += "insert #" + std::to_string(op.target) + " into #" + std::to_string(op.id) + "." + std::string(op.name) +
-             "[" + std::to_string(op.index) + "]";
+        s += "insert #" + std::to_string(op.target) + " into #" + std::to_string(op.id) + "." +
+             std::string(op.name) + "[" + std::to_string(op.index) + "]";
         break;
       case Op::Erase:
-        s += "erase #" + std::to_string(op.target) + " from #" + std::to_string(op.id) + "." + std::string(op.name) +
-             "[" + std::to_string(op.index) + "]";
+        s += "erase #" + std::to_string(op.target) + " from #" + std::to_string(op.id) + "." +
+             std::string(op.name) + "[" + std::to_string(op.index) + "]";
         break;
     }
     s += "\n";
@@ -241,16 +258,21 @@ class Applier {
   };
 
   [[noreturn]] void fail(const TxOp& op, std::size_t n, const std::string& what) const {
-    throw Error("byte " + std::to_string(op.offset) + ", operation " + std::to_string(n + 1) + " (" + op_name(op) +
-                "): " + what + "; nothing was applied to SimState '" + s_.name() + "'");
+    throw Error("byte " + std::to_string(op.offset) + ", operation " + std::to_string(n + 1) + " (" +
+                op_name(op) + "): " + what + "; nothing was applied to SimState '" + s_.name() + "'");
   }
   static std::string op_name(const TxOp& op) {
     switch (op.op) {
-      case Transaction::Op::Create: return "create #" + std::to_string(op.id);
-      case Transaction::Op::Delete: return "delete #" + std::to_string(op.id);
-      case Transaction::Op::Set: return "set #" + std::to_string(op.id) + "." + std::string(op.name);
-      case Transaction::Op::Insert: return "insert into #" + std::to_string(op.id) + "." + std::string(op.name);
-      case Transaction::Op::Erase: return "erase from #" + std::to_string(op.id) + "." + std::string(op.name);
+      case Transaction::Op::Create:
+        return "create #" + std::to_string(op.id);
+      case Transaction::Op::Delete:
+        return "delete #" + std::to_string(op.id);
+      case Transaction::Op::Set:
+        return "set #" + std::to_string(op.id) + "." + std::string(op.name);
+      case Transaction::Op::Insert:
+        return "insert into #" + std::to_string(op.id) + "." + std::string(op.name);
+      case Transaction::Op::Erase:
+        return "erase from #" + std::to_string(op.id) + "." + std::string(op.name);
     }
     return "?";
   }
@@ -278,7 +300,8 @@ class Applier {
   }
   const MetaProperty& property_of(const TxOp& op, std::size_t n, const MetaInstance& cls) const {
     const MetaProperty* p = cls.find_property(op.name);
-    if (p == nullptr) fail(op, n, "class '" + cls.name() + "' has no property '" + std::string(op.name) + "'");
+    if (p == nullptr)
+      fail(op, n, "class '" + cls.name() + "' has no property '" + std::string(op.name) + "'");
     return *p;
   }
   void check_target(const TxOp& op, std::size_t n, Id id, const MetaType& t) const {
@@ -286,10 +309,12 @@ class Applier {
     const MetaInstance* cls = class_of(id);
     if (cls == nullptr) fail(op, n, "dangling reference: no instance #" + std::to_string(id));
     if (t.target() != nullptr && !cls->is_a(*t.target()))
-      fail(op, n, "#" + std::to_string(id) + " is a '" + cls->name() + "', not a '" + t.target()->name() + "'");
+      fail(op, n,
+           "#" + std::to_string(id) + " is a '" + cls->name() + "', not a '" + t.target()->name() + "'");
   }
   // Checks that @p bytes hold exactly one value of @p p's type; returns the ids of a list value.
-  std::vector<Id> check_value(const TxOp& op, std::size_t n, const MetaProperty& p, std::span<const std::uint8_t> bytes) {
+  std::vector<Id> check_value(const TxOp& op, std::size_t n, const MetaProperty& p,
+                              std::span<const std::uint8_t> bytes) {
     ByteReader r(bytes.data(), bytes.size());
     std::vector<Id> ids;
     try {
@@ -319,10 +344,11 @@ class Applier {
       case Transaction::Op::Create: {
         const MetaInstance* cls = s_.environment().registry().find_class(op.name);
         if (cls == nullptr) fail(op, n, "unknown class '" + std::string(op.name) + "'");
-        if (cls->is_abstract() || !cls->is_a(SimStateInstance::static_meta()) || cls->is_a(Database::static_meta()))
+        if (cls->is_abstract() || !cls->is_a(SimStateInstance::static_meta()) ||
+            cls->is_a(Database::static_meta()))
           fail(op, n, "class '" + cls->name() + "' cannot be instantiated here");
-        if (op.id == null_id || class_of(op.id) != nullptr || (created_.count(op.id) == 0 && deleted_.count(op.id) == 0 &&
-                                                                  s_.by_id_.count(op.id) != 0))
+        if (op.id == null_id || class_of(op.id) != nullptr ||
+            (created_.count(op.id) == 0 && deleted_.count(op.id) == 0 && s_.by_id_.count(op.id) != 0))
           fail(op, n, "instance #" + std::to_string(op.id) + " already exists");
         for (const auto& [name, bytes] : op.values) {
           TxOp sub = op;
@@ -364,7 +390,9 @@ class Applier {
         auto& ids = list_model(op.id, p);
         if (op.op == Transaction::Op::Insert) {
           if (op.index > ids.size())
-            fail(op, n, "index " + std::to_string(op.index) + " is past the end (size " + std::to_string(ids.size()) + ")");
+            fail(op, n,
+                 "index " + std::to_string(op.index) + " is past the end (size " +
+                     std::to_string(ids.size()) + ")");
           ids.insert(ids.begin() + static_cast<std::ptrdiff_t>(op.index), op.target);
         } else {
           if (op.index >= ids.size() || ids[op.index] != op.target)
@@ -398,7 +426,9 @@ class Applier {
         s_.finish_create(x);
         break;
       }
-      case Transaction::Op::Delete: s_.destroy(*s_.find(op.id)); break;
+      case Transaction::Op::Delete:
+        s_.destroy(*s_.find(op.id));
+        break;
       case Transaction::Op::Set: {
         SimStateInstance& x = *s_.find(op.id);
         const MetaProperty& p = *x.meta().find_property(op.name);

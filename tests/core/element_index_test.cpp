@@ -49,8 +49,9 @@ TEST_F(ElementIndexTest, StaysCurrentOnDelete) {
 }
 
 TEST_F(ElementIndexTest, RunTimeSubclassesAreFound) {
-  const vsd::MetaInstance& cls =
-      vsd::ClassBuilder("TIndexedRuntimeRobot", TRobot::static_meta()).property<double>("reach", 1.5).define();
+  const vsd::MetaInstance& cls = vsd::ClassBuilder("TIndexedRuntimeRobot", TRobot::static_meta())
+                                     .property<double>("reach", 1.5)
+                                     .define();
   auto& x = state.create(cls);
   EXPECT_THAT(index.exact(cls), testing::ElementsAre(&x));
   EXPECT_THAT(index.all<TRobot>(), testing::Contains(static_cast<TRobot*>(&x)));

@@ -51,7 +51,8 @@ TEST(Environment, OwnsAMainStateAndMore) {
   EXPECT_EQ(env.states().size(), 2u);
   env.remove_state(extra);
   EXPECT_EQ(env.states().size(), 1u);
-  EXPECT_THAT([&] { env.remove_state(env.main_state()); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("main")));
+  EXPECT_THAT([&] { env.remove_state(env.main_state()); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("main")));
 }
 
 TEST(Environment, IdsAreUniqueAcrossStatesAndThreads) {

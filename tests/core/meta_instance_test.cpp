@@ -8,7 +8,6 @@
 #include <functional>
 #include <string>
 #include <vector>
-
 #include <vsd/vsd.hpp>
 
 namespace mi {
@@ -42,7 +41,9 @@ class MiTruck : public MiVehicle {
   VSD_PROPERTY(double, load, 0.0)
 
  public:
-  [[nodiscard]] std::string describe() const { return "truck carrying " + std::to_string(static_cast<int>(load())); }
+  [[nodiscard]] std::string describe() const {
+    return "truck carrying " + std::to_string(static_cast<int>(load()));
+  }
   VSD_METHOD(describe)
 };
 
@@ -150,7 +151,8 @@ TEST(MetaInstance, DerivedListsSubclasses) {
   const auto nodes = vsd::Node::static_meta().derived();
   EXPECT_NE(std::find(nodes.begin(), nodes.end(), &MiVehicle::static_meta()), nodes.end());
   EXPECT_NE(std::find(nodes.begin(), nodes.end(), &MiGadget::static_meta()), nodes.end());
-  EXPECT_EQ(std::find(nodes.begin(), nodes.end(), &MiTruck::static_meta()), nodes.end()) << "only direct subclasses";
+  EXPECT_EQ(std::find(nodes.begin(), nodes.end(), &MiTruck::static_meta()), nodes.end())
+      << "only direct subclasses";
 }
 
 TEST(MetaInstance, PropertiesInheritedFirst) {
@@ -158,14 +160,16 @@ TEST(MetaInstance, PropertiesInheritedFirst) {
               ElementsAre("name", "extensions", "children", "speed", "wheels", "label", "serial", "samples"));
   EXPECT_THAT(names_of(MiVehicle::static_meta().own_properties()),
               ElementsAre("speed", "wheels", "label", "serial", "samples"));
-  EXPECT_THAT(names_of(MiTruck::static_meta().properties()),
-              ElementsAre("name", "extensions", "children", "speed", "wheels", "label", "serial", "samples", "load"));
+  EXPECT_THAT(
+      names_of(MiTruck::static_meta().properties()),
+      ElementsAre("name", "extensions", "children", "speed", "wheels", "label", "serial", "samples", "load"));
   EXPECT_THAT(names_of(MiTruck::static_meta().own_properties()), ElementsAre("load"));
   EXPECT_THAT(names_of(vsd::Node::static_meta().own_properties()), ElementsAre("children"));
 }
 
 TEST(MetaInstance, ReferencePropertiesAreListed) {
-  EXPECT_THAT(names_of(MiVehicle::static_meta().reference_properties()), ElementsAre("extensions", "children"));
+  EXPECT_THAT(names_of(MiVehicle::static_meta().reference_properties()),
+              ElementsAre("extensions", "children"));
 }
 
 TEST(MetaInstance, FindProperty) {
@@ -182,8 +186,10 @@ TEST(MetaInstance, FindProperty) {
   EXPECT_EQ(m.find_property("nope"), nullptr);
   EXPECT_EQ(m.find_property(""), nullptr);
   EXPECT_EQ(m.find_property("Speed"), nullptr) << "names are case-sensitive";
-  EXPECT_EQ(vsd::Node::static_meta().find_property("speed"), nullptr) << "a base does not see subclass properties";
-  EXPECT_EQ(MiTruck::static_meta().find_property("speed"), speed) << "inherited properties are the same object";
+  EXPECT_EQ(vsd::Node::static_meta().find_property("speed"), nullptr)
+      << "a base does not see subclass properties";
+  EXPECT_EQ(MiTruck::static_meta().find_property("speed"), speed)
+      << "inherited properties are the same object";
   EXPECT_EQ(&m.property("label"), &MiVehicle::vsd_prop_label());
 }
 
@@ -218,7 +224,8 @@ TEST(MetaInstance, DefaultValues) {
   EXPECT_EQ(MiVehicle::vsd_prop_wheels().default_value().as<std::int32_t>(), 4);
   EXPECT_EQ(MiVehicle::vsd_prop_label().default_value().as<std::string>(), "car");
   EXPECT_EQ(MiVehicle::vsd_prop_serial().default_value().as<std::int64_t>(), 7);
-  EXPECT_EQ(MiVehicle::vsd_prop_samples().default_value().as<std::vector<double>>(), (std::vector<double>{1.0, 2.0}));
+  EXPECT_EQ(MiVehicle::vsd_prop_samples().default_value().as<std::vector<double>>(),
+            (std::vector<double>{1.0, 2.0}));
   EXPECT_EQ(vsd::NamedModelInstance::vsd_prop_name().default_value().as<std::string>(), "");
 }
 

@@ -3,14 +3,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Geometry>
 #include <vsd/vsd.hpp>
 
 namespace mt {
@@ -157,13 +156,15 @@ TEST(MetaType, NamesAndKindsOfBuiltInTypes) {
       {&vsd::meta_type<Eigen::Vector2d>(), "Vector2d", vsd::TypeKind::Struct, sizeof(Eigen::Vector2d)},
       {&vsd::meta_type<Eigen::Vector3d>(), "Vector3d", vsd::TypeKind::Struct, sizeof(Eigen::Vector3d)},
       {&vsd::meta_type<Eigen::Vector4d>(), "Vector4d", vsd::TypeKind::Struct, sizeof(Eigen::Vector4d)},
-      {&vsd::meta_type<Eigen::Quaterniond>(), "Quaterniond", vsd::TypeKind::Struct, sizeof(Eigen::Quaterniond)},
+      {&vsd::meta_type<Eigen::Quaterniond>(), "Quaterniond", vsd::TypeKind::Struct,
+       sizeof(Eigen::Quaterniond)},
       {&vsd::meta_type<Eigen::Isometry3d>(), "Isometry3d", vsd::TypeKind::Struct, sizeof(Eigen::Isometry3d)},
-      {&vsd::meta_type<std::vector<double>>(), "vector<double>", vsd::TypeKind::Vector, sizeof(std::vector<double>)},
+      {&vsd::meta_type<std::vector<double>>(), "vector<double>", vsd::TypeKind::Vector,
+       sizeof(std::vector<double>)},
       {&vsd::meta_type<std::vector<std::string>>(), "vector<string>", vsd::TypeKind::Vector,
        sizeof(std::vector<std::string>)},
-      {&vsd::meta_type<std::vector<std::vector<std::int32_t>>>(), "vector<vector<int32>>", vsd::TypeKind::Vector,
-       sizeof(std::vector<std::vector<std::int32_t>>)},
+      {&vsd::meta_type<std::vector<std::vector<std::int32_t>>>(), "vector<vector<int32>>",
+       vsd::TypeKind::Vector, sizeof(std::vector<std::vector<std::int32_t>>)},
       {&vsd::meta_type<std::vector<Eigen::Vector3d>>(), "vector<Vector3d>", vsd::TypeKind::Vector,
        sizeof(std::vector<Eigen::Vector3d>)},
   };
@@ -180,7 +181,8 @@ TEST(MetaType, OneMetaTypePerCppType) {
   EXPECT_EQ(&vsd::meta_type<double>(), &vsd::meta_type<double>());
   EXPECT_NE(&vsd::meta_type<double>(), &vsd::meta_type<float>());
   EXPECT_EQ(vsd::meta_type<std::vector<double>>().element(), &vsd::meta_type<double>());
-  EXPECT_EQ(vsd::meta_type<std::vector<std::vector<double>>>().element(), &vsd::meta_type<std::vector<double>>());
+  EXPECT_EQ(vsd::meta_type<std::vector<std::vector<double>>>().element(),
+            &vsd::meta_type<std::vector<double>>());
 }
 
 TEST(MetaType, ArithmeticClassification) {
@@ -214,10 +216,13 @@ TEST(MetaType, DefaultValues) {
   EXPECT_EQ(vsd::Value(vsd::meta_type<double>()).as<double>(), 0.0);
   EXPECT_EQ(vsd::Value(vsd::meta_type<std::string>()).as<std::string>(), "");
   EXPECT_TRUE(vsd::Value(vsd::meta_type<Eigen::Vector3d>()).as<Eigen::Vector3d>().isZero(0));
-  EXPECT_TRUE(vsd::Value(vsd::meta_type<Eigen::Quaterniond>()).as<Eigen::Quaterniond>().coeffs().isApprox(
-      Eigen::Quaterniond::Identity().coeffs(), 0));
-  EXPECT_TRUE(vsd::Value(vsd::meta_type<Eigen::Isometry3d>()).as<Eigen::Isometry3d>().isApprox(
-      Eigen::Isometry3d::Identity(), 0));
+  EXPECT_TRUE(vsd::Value(vsd::meta_type<Eigen::Quaterniond>())
+                  .as<Eigen::Quaterniond>()
+                  .coeffs()
+                  .isApprox(Eigen::Quaterniond::Identity().coeffs(), 0));
+  EXPECT_TRUE(vsd::Value(vsd::meta_type<Eigen::Isometry3d>())
+                  .as<Eigen::Isometry3d>()
+                  .isApprox(Eigen::Isometry3d::Identity(), 0));
 }
 
 // ---- text round trips -------------------------------------------------------------------------------------
@@ -537,8 +542,10 @@ TEST(MetaTypeBytes, ScalarsRoundTrip) {
   EXPECT_EQ(binary_round_trip(std::int8_t{-128}), -128);
   EXPECT_EQ(binary_round_trip(std::uint16_t{65535}), 65535);
   EXPECT_EQ(binary_round_trip(std::int32_t{-123456}), -123456);
-  EXPECT_EQ(binary_round_trip(std::numeric_limits<std::int64_t>::min()), std::numeric_limits<std::int64_t>::min());
-  EXPECT_EQ(binary_round_trip(std::numeric_limits<std::uint64_t>::max()), std::numeric_limits<std::uint64_t>::max());
+  EXPECT_EQ(binary_round_trip(std::numeric_limits<std::int64_t>::min()),
+            std::numeric_limits<std::int64_t>::min());
+  EXPECT_EQ(binary_round_trip(std::numeric_limits<std::uint64_t>::max()),
+            std::numeric_limits<std::uint64_t>::max());
   EXPECT_EQ(binary_round_trip(0.1f), 0.1f);
   EXPECT_EQ(binary_round_trip(0.1), 0.1);
   EXPECT_TRUE(std::signbit(binary_round_trip(-0.0)));
@@ -564,7 +571,8 @@ TEST(MetaTypeBytes, StringsAndVectorsRoundTrip) {
   EXPECT_EQ(binary_round_trip(std::string()), "");
   EXPECT_EQ(binary_round_trip(std::vector<double>{}), std::vector<double>{});
   EXPECT_EQ(binary_round_trip(std::vector<double>{1, -2.5, 1e-300}), (std::vector<double>{1, -2.5, 1e-300}));
-  EXPECT_EQ(binary_round_trip(std::vector<std::string>{"a", "", "ccc"}), (std::vector<std::string>{"a", "", "ccc"}));
+  EXPECT_EQ(binary_round_trip(std::vector<std::string>{"a", "", "ccc"}),
+            (std::vector<std::string>{"a", "", "ccc"}));
   EXPECT_EQ(binary_round_trip(std::vector<bool>{true, false, true}), (std::vector<bool>{true, false, true}));
   EXPECT_EQ(binary_round_trip(std::vector<std::vector<std::int32_t>>{{1}, {}, {2, 3}}),
             (std::vector<std::vector<std::int32_t>>{{1}, {}, {2, 3}}));
@@ -693,7 +701,8 @@ TEST(MetaTypeEquality, AllNaNsAreEqualAndHashAlike) {
   EXPECT_EQ(hash_of(nan), hash_of(neg_nan));
   EXPECT_EQ(hash_of(nan), hash_of(payload_nan));
   EXPECT_EQ(hash_of(std::vector<double>{nan}), hash_of(std::vector<double>{neg_nan}));
-  EXPECT_EQ(hash_of(std::numeric_limits<float>::quiet_NaN()), hash_of(-std::numeric_limits<float>::quiet_NaN()));
+  EXPECT_EQ(hash_of(std::numeric_limits<float>::quiet_NaN()),
+            hash_of(-std::numeric_limits<float>::quiet_NaN()));
 }
 
 TEST(MetaTypeEquality, EqualityAfterRoundTrips) {
@@ -707,7 +716,8 @@ TEST(MetaTypeEquality, EqualityAfterRoundTrips) {
   EXPECT_TRUE(equal(binary_round_trip(f), f)) << "a frame equals itself after a binary round trip";
 }
 
-// ---- text errors: vsd::Error with line:col and what was wrong ----------------------------------------------
+// ---- text errors: vsd::Error with line:col and what was wrong
+// ----------------------------------------------
 
 TEST(MetaTypeTextErrors, TextReaderNamesTheOrigin) {
   vsd::TextReader in("\n  x", "robot.vsd");
@@ -910,7 +920,8 @@ TEST(MetaTypeTextErrors, ErrorsLeaveTheTargetUsable) {
   EXPECT_FALSE(v.empty());
 }
 
-// ---- binary errors: vsd::Error with "byte N" ----------------------------------------------------------------
+// ---- binary errors: vsd::Error with "byte N"
+// ----------------------------------------------------------------
 
 TEST(MetaTypeBytesErrors, TruncatedData) {
   auto b = bytes_of(1.5);
@@ -946,8 +957,8 @@ TEST(MetaTypeBytesErrors, AbsurdSizesThrowWithoutAllocating) {
   w.varint(std::uint64_t{1} << 60);
   for (int i = 0; i < 16; ++i) w.u8(0);
   for (const std::string& e :
-       {bytes_error<std::vector<double>>(b), bytes_error<std::vector<std::string>>(b), bytes_error<std::string>(b),
-        bytes_error<std::vector<MtPose>>(b), bytes_error<std::vector<bool>>(b),
+       {bytes_error<std::vector<double>>(b), bytes_error<std::vector<std::string>>(b),
+        bytes_error<std::string>(b), bytes_error<std::vector<MtPose>>(b), bytes_error<std::vector<bool>>(b),
         bytes_error<std::vector<std::vector<std::int32_t>>>(b)}) {
     EXPECT_THAT(e, StartsWith("byte 0: "));
     EXPECT_THAT(e, HasSubstr("exceeds"));

@@ -84,7 +84,8 @@ class RandomModel {
           break;
         }
         case 9: {  // generic path by name
-          if (auto* x = pick()->as<vsd::NamedModelInstance>()) x->set("name", vsd::Value("g" + std::to_string(uniform(50))));
+          if (auto* x = pick()->as<vsd::NamedModelInstance>())
+            x->set("name", vsd::Value("g" + std::to_string(uniform(50))));
           break;
         }
       }
@@ -96,7 +97,9 @@ class RandomModel {
   [[nodiscard]] int rejected() const { return rejected_; }
 
  private:
-  unsigned uniform(std::size_t n) { return static_cast<unsigned>(std::uniform_int_distribution<std::size_t>(0, n - 1)(rng_)); }
+  unsigned uniform(std::size_t n) {
+    return static_cast<unsigned>(std::uniform_int_distribution<std::size_t>(0, n - 1)(rng_));
+  }
   vsd::SimState& s_;
   std::mt19937 rng_;
   int rejected_ = 0;

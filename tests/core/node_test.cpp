@@ -135,7 +135,8 @@ TEST_F(NodeTest, ExtensionsMoveBetweenOwners) {
   b.remove_extension(e);  // its last composite holder: e is deleted
   EXPECT_EQ(state.find(id), nullptr);
   auto& loose = state.create<vsd::Extension>();
-  EXPECT_THAT([&] { b.remove_extension(loose); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("not attached")));
+  EXPECT_THAT([&] { b.remove_extension(loose); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("not attached")));
 }
 
 TEST_F(NodeTest, DatabaseIsTheContainerOfTheTree) {
@@ -151,7 +152,8 @@ TEST_F(NodeTest, DatabaseIsTheContainerOfTheTree) {
   root.for_each([&](vsd::Node& n) { order.push_back(n.name()); });
   EXPECT_THAT(order, ElementsAre("", "a", "b"));
   EXPECT_EQ(root.id(), 1u);
-  EXPECT_THAT([&] { state.destroy(root); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("cannot be deleted")));
+  EXPECT_THAT([&] { state.destroy(root); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("cannot be deleted")));
 }
 
 TEST_F(NodeTest, DatabaseSignalsAttachAndDetach) {

@@ -141,8 +141,10 @@ TEST_F(ReferenceTest, ReferencesCannotCrossSimStates) {
   auto& other = env.create_state("other");
   auto& r = state.create<TRobot>();
   auto& far = other.create<vsd::Node>();
-  EXPECT_THAT([&] { r.set_target(&far); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("different SimStates")));
-  EXPECT_THAT([&] { root.add_child(far); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("different SimStates")));
+  EXPECT_THAT([&] { r.set_target(&far); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("different SimStates")));
+  EXPECT_THAT([&] { root.add_child(far); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("different SimStates")));
 }
 
 TEST_F(ReferenceTest, GenericSetChecksTheTargetClass) {
@@ -156,8 +158,10 @@ TEST_F(ReferenceTest, GenericSetChecksTheTargetClass) {
   EXPECT_EQ(r.tool().get(), &tool);
   const vsd::MetaProperty& children = vsd::Node::vsd_prop_children();
   auto& ext = state.create<vsd::Extension>();
-  EXPECT_THAT([&] { r.list_insert(children, 0, ext); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("holds Node")));
-  EXPECT_THAT([&] { r.list_insert(children, 5, plain); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("past the end")));
+  EXPECT_THAT([&] { r.list_insert(children, 0, ext); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("holds Node")));
+  EXPECT_THAT([&] { r.list_insert(children, 5, plain); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("past the end")));
   EXPECT_THAT([&] { r.list_erase(children, 0); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("out of")));
   EXPECT_THAT([&] { r.list_insert(TRobot::vsd_prop_speed(), 0, plain); },
               testing::ThrowsMessage<vsd::Error>(HasSubstr("not a reference list")));
@@ -182,7 +186,8 @@ TEST_F(ReferenceTest, ReferenceTextNeedsAResolver) {
   EXPECT_EQ(t.target(), &vsd::Node::static_meta());
   vsd::Value null = vsd::Value::from_text(t, "null");
   EXPECT_EQ(static_cast<const vsd::RefBase*>(null.data())->get(), nullptr);
-  EXPECT_THAT([&] { (void)vsd::Value::from_text(t, "@12"); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("1:")));
+  EXPECT_THAT([&] { (void)vsd::Value::from_text(t, "@12"); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("1:")));
 }
 
 }  // namespace

@@ -7,7 +7,6 @@
 #include <functional>
 #include <string>
 #include <vector>
-
 #include <vsd/vsd.hpp>
 
 namespace rg {
@@ -217,14 +216,16 @@ TEST(Registry, LocalRegistryKnowsTheCoreAndWhatIsAdded) {
   EXPECT_EQ(local.find_class("RgWidget"), &rg::RgWidget::static_meta());
 
   const auto classes = local.classes();
-  EXPECT_TRUE(std::is_sorted(classes.begin(), classes.end(),
-                             [](const vsd::MetaInstance* a, const vsd::MetaInstance* b) { return a->name() < b->name(); }));
+  EXPECT_TRUE(std::is_sorted(
+      classes.begin(), classes.end(),
+      [](const vsd::MetaInstance* a, const vsd::MetaInstance* b) { return a->name() < b->name(); }));
   EXPECT_NE(std::find(classes.begin(), classes.end(), &rg::RgWidget::static_meta()), classes.end());
   EXPECT_NE(std::find(classes.begin(), classes.end(), &vsd::Database::static_meta()), classes.end());
   const auto types = local.types();
   EXPECT_NE(std::find(types.begin(), types.end(), &vsd::meta_type<double>()), types.end());
-  EXPECT_TRUE(std::is_sorted(types.begin(), types.end(),
-                             [](const vsd::MetaType* a, const vsd::MetaType* b) { return a->name() < b->name(); }));
+  EXPECT_TRUE(std::is_sorted(types.begin(), types.end(), [](const vsd::MetaType* a, const vsd::MetaType* b) {
+    return a->name() < b->name();
+  }));
 }
 
 TEST(Registry, NameClashesAreErrors) {
@@ -236,8 +237,8 @@ TEST(Registry, NameClashesAreErrors) {
   EXPECT_THAT(t, HasSubstr("'double'"));
   EXPECT_EQ(local.find_type("double"), &vsd::meta_type<double>());
   // A different class under a registered name.
-  const vsd::MetaInstance fake_node("Node", &vsd::Node::static_meta(), sizeof(vsd::Node), alignof(vsd::Node), nullptr,
-                                    nullptr);
+  const vsd::MetaInstance fake_node("Node", &vsd::Node::static_meta(), sizeof(vsd::Node), alignof(vsd::Node),
+                                    nullptr, nullptr);
   const std::string c = error_of([&] { local.add(fake_node); });
   EXPECT_THAT(c, HasSubstr("'Node'"));
   EXPECT_EQ(local.find_class("Node"), &vsd::Node::static_meta());

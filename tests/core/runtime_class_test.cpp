@@ -4,14 +4,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
 #include <vsd/vsd.hpp>
 
 namespace rc {
@@ -106,7 +105,6 @@ const vsd::MetaInstance& define_robot(const std::string& name) {
       .define();
 }
 
-
 vsd::Node& as_node(vsd::SimStateInstance& x) { return static_cast<vsd::Node&>(x); }
 
 const vsd::SimStateInstance* target_of(const vsd::SimStateInstance& x) {
@@ -134,9 +132,10 @@ TEST(RuntimeClass, DefineDescribesTheClass) {
   EXPECT_GE(cls->alignment(), alignof(Eigen::Isometry3d));
   EXPECT_EQ(cls->size() % cls->alignment(), 0u);
 
-  EXPECT_THAT(names_of(cls->properties()),
-              ElementsAre("name", "extensions", "children", "speed", "label", "samples", "pose", "target", "count"));
-  EXPECT_THAT(names_of(cls->own_properties()), ElementsAre("speed", "label", "samples", "pose", "target", "count"));
+  EXPECT_THAT(names_of(cls->properties()), ElementsAre("name", "extensions", "children", "speed", "label",
+                                                       "samples", "pose", "target", "count"));
+  EXPECT_THAT(names_of(cls->own_properties()),
+              ElementsAre("speed", "label", "samples", "pose", "target", "count"));
   EXPECT_THAT(names_of(cls->reference_properties()), ElementsAre("extensions", "children", "target"));
 
   const vsd::MetaProperty& speed = cls->property("speed");
@@ -145,8 +144,10 @@ TEST(RuntimeClass, DefineDescribesTheClass) {
   EXPECT_EQ(speed.flags(), vsd::DefaultFlags);
   EXPECT_EQ(speed.default_value().as<double>(), 2.5);
   EXPECT_EQ(cls->property("label").default_value().as<std::string>(), "r2");
-  EXPECT_EQ(cls->property("samples").default_value().as<std::vector<double>>(), (std::vector<double>{1.0, 2.0}));
-  EXPECT_EQ(cls->property("pose").default_value().as<Eigen::Isometry3d>().translation(), Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(cls->property("samples").default_value().as<std::vector<double>>(),
+            (std::vector<double>{1.0, 2.0}));
+  EXPECT_EQ(cls->property("pose").default_value().as<Eigen::Isometry3d>().translation(),
+            Eigen::Vector3d(1, 2, 3));
   EXPECT_EQ(&cls->property("target").type(), &shared_node_type());
   EXPECT_EQ(cls->property("count").flags(), vsd::Editable | vsd::Transient);
   EXPECT_EQ(cls->find_property("nope"), nullptr);
@@ -192,7 +193,8 @@ TEST(RuntimeClass, CreateByClassAndByName) {
   }
   const auto& pose = cls->property("pose");
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(pose.address(a)) % alignof(Eigen::Isometry3d), 0u);
-  EXPECT_THAT(error_of([&] { (void)state.create("RcCreate_NoSuchClass"); }), HasSubstr("RcCreate_NoSuchClass"));
+  EXPECT_THAT(error_of([&] { (void)state.create("RcCreate_NoSuchClass"); }),
+              HasSubstr("RcCreate_NoSuchClass"));
 }
 
 TEST(RuntimeClass, InstanceWorksAsANode) {
@@ -282,7 +284,8 @@ TEST(RuntimeClass, SharedReferenceProperty) {
 }
 
 TEST(RuntimeClass, SharedListPropertyAcceptsTheCppListType) {
-  // The property's type comes from the registry by name; a C++ SharedRefList<Node> is "shared_list<Node>" too.
+  // The property's type comes from the registry by name; a C++ SharedRefList<Node> is "shared_list<Node>"
+  // too.
   Defined cls(vsd::ClassBuilder("RcList_Class", vsd::Node::static_meta())
                   .property("friends", vsd::Registry::global().get_type("shared_list<Node>"))
                   .define());
@@ -333,7 +336,8 @@ TEST(RuntimeClass, SubclassOfACppClassKeepsItsCppBehaviour) {
                   .property<std::int32_t>("gear", 3)
                   .property<std::string>("brand", std::string("acme"))
                   .define());
-  EXPECT_THAT(names_of(sub->properties()), ElementsAre("name", "extensions", "children", "torque", "gear", "brand"));
+  EXPECT_THAT(names_of(sub->properties()),
+              ElementsAre("name", "extensions", "children", "torque", "gear", "brand"));
   EXPECT_GE(sub->size(), sizeof(RcMotor) + sizeof(std::int32_t) + sizeof(std::string));
   vsd::Environment env;
   auto& state = env.main_state();
@@ -361,7 +365,8 @@ TEST(RuntimeClass, SubclassOfACppClassKeepsItsCppBehaviour) {
 }
 
 TEST(RuntimeClass, TypedSetterOfTheCppBaseSignalsAndRecords) {
-  Defined sub(vsd::ClassBuilder("RcCppSignal_Motor", RcMotor::static_meta()).property<double>("ratio", 1.0).define());
+  Defined sub(
+      vsd::ClassBuilder("RcCppSignal_Motor", RcMotor::static_meta()).property<double>("ratio", 1.0).define());
   vsd::Environment env;
   auto& state = env.main_state();
   auto& motor = static_cast<RcMotor&>(state.create(*sub));
@@ -393,15 +398,18 @@ TEST(RuntimeClass, SubclassOfARuntimeClass) {
                     .property<double>("extra", 0.5)
                     .property<std::vector<std::string>>("tags", std::vector<std::string>{"t"})
                     .method("scaled_speed", {&vsd::meta_type<double>()}, &vsd::meta_type<double>(),
-                            [](vsd::Instance&, std::span<const vsd::Value> a) { return vsd::Value(-a[0].as<double>()); })
+                            [](vsd::Instance&, std::span<const vsd::Value> a) {
+                              return vsd::Value(-a[0].as<double>());
+                            })
                     .define());
   EXPECT_EQ(child->base(), &*parent);
   EXPECT_EQ(child->depth(), parent->depth() + 1);
   EXPECT_TRUE(child->is_a(*parent));
   EXPECT_TRUE(child->is_a(vsd::Node::static_meta()));
   EXPECT_FALSE(parent->is_a(*child));
-  EXPECT_THAT(names_of(child->properties()), ElementsAre("name", "extensions", "children", "speed", "label", "samples",
-                                                         "pose", "target", "count", "extra", "tags"));
+  EXPECT_THAT(names_of(child->properties()),
+              ElementsAre("name", "extensions", "children", "speed", "label", "samples", "pose", "target",
+                          "count", "extra", "tags"));
   EXPECT_THAT(names_of(child->own_properties()), ElementsAre("extra", "tags"));
   const auto derived = parent->derived();
   EXPECT_NE(std::find(derived.begin(), derived.end(), &*child), derived.end());
@@ -418,7 +426,8 @@ TEST(RuntimeClass, SubclassOfARuntimeClass) {
   x.set("extra", vsd::Value(9.0));
   EXPECT_EQ(x.get<double>("extra"), 9.0);
   EXPECT_EQ(x.get<std::string>("label"), "r2");
-  EXPECT_EQ(x.call("scaled_speed", {vsd::Value(2.0)}).as<double>(), -2.0) << "the child's method hides the parent's";
+  EXPECT_EQ(x.call("scaled_speed", {vsd::Value(2.0)}).as<double>(), -2.0)
+      << "the child's method hides the parent's";
   EXPECT_EQ(x.call("reset_speed").empty(), true);
   EXPECT_EQ(x.get<double>("speed"), 0.0);
   EXPECT_THROW((void)child->property("extra").get<double>(state.create(*parent)), vsd::Error);
@@ -451,7 +460,8 @@ TEST(RuntimeClass, AbstractRuntimeClass) {
 
 TEST(RuntimeClass, BaseMustBeASimStateInstance) {
   EXPECT_THROW(vsd::ClassBuilder("RcBadBase_Env", vsd::Environment::static_meta()), vsd::Error);
-  const std::string e = error_of([] { vsd::ClassBuilder("RcBadBase_Instance", vsd::Instance::static_meta()); });
+  const std::string e =
+      error_of([] { vsd::ClassBuilder("RcBadBase_Instance", vsd::Instance::static_meta()); });
   EXPECT_THAT(e, HasSubstr("RcBadBase_Instance"));
   EXPECT_EQ(vsd::Registry::global().find_class("RcBadBase_Env"), nullptr);
 }
@@ -503,10 +513,12 @@ TEST(RuntimeClass, PropertyChangedSignalsFireForRuntimeProperties) {
   auto c2 = state.on_property_changed(*parent).connect(
       [&](vsd::SimStateInstance&, const vsd::MetaProperty& p) { by_type.push_back(p.name()); });
   std::vector<std::string> exact;
-  auto c3 = state.on_property_changed(*parent, false).connect(
-      [&](vsd::SimStateInstance&, const vsd::MetaProperty& p) { exact.push_back(p.name()); });
+  auto c3 =
+      state.on_property_changed(*parent, false)
+          .connect([&](vsd::SimStateInstance&, const vsd::MetaProperty& p) { exact.push_back(p.name()); });
   std::vector<std::string> own;
-  auto c4 = x.on_changed().connect([&](vsd::SimStateInstance&, const vsd::MetaProperty& p) { own.push_back(p.name()); });
+  auto c4 = x.on_changed().connect(
+      [&](vsd::SimStateInstance&, const vsd::MetaProperty& p) { own.push_back(p.name()); });
 
   x.set("speed", vsd::Value(7.0));
   x.set("speed", vsd::Value(7.0));  // unchanged: no signal
@@ -527,8 +539,10 @@ TEST(RuntimeClass, PropertyChangedSignalsFireForRuntimeProperties) {
 
 TEST(RuntimeClass, TransactionsRecordAndReplayRuntimeInstances) {
   Defined robot(define_robot("RcTx_Robot"));
-  Defined child(vsd::ClassBuilder("RcTx_Child", *robot).property<std::string>("note", std::string("n")).define());
-  Defined motor(vsd::ClassBuilder("RcTx_Motor", RcMotor::static_meta()).property<std::int32_t>("gear", 1).define());
+  Defined child(
+      vsd::ClassBuilder("RcTx_Child", *robot).property<std::string>("note", std::string("n")).define());
+  Defined motor(
+      vsd::ClassBuilder("RcTx_Motor", RcMotor::static_meta()).property<std::int32_t>("gear", 1).define());
   vsd::Environment env;
   auto& state = env.main_state();
 
@@ -619,7 +633,8 @@ TEST(RuntimeClass, CopyFromCopiesRuntimeInstances) {
 
 TEST(RuntimeClass, UndefineOnlyWithoutInstances) {
   auto& reg = vsd::Registry::global();
-  Defined cls(vsd::ClassBuilder("RcUndef_Class", vsd::Node::static_meta()).property<double>("v", 1.0).define());
+  Defined cls(
+      vsd::ClassBuilder("RcUndef_Class", vsd::Node::static_meta()).property<double>("v", 1.0).define());
   {
     vsd::Environment env;
     auto& state = env.main_state();
@@ -636,7 +651,9 @@ TEST(RuntimeClass, UndefineOnlyWithoutInstances) {
   }
   EXPECT_EQ(reg.find_class("RcUndef_Class"), nullptr);
   // The name is free again.
-  Defined again(vsd::ClassBuilder("RcUndef_Class", vsd::Node::static_meta()).property<std::string>("v", std::string()).define());
+  Defined again(vsd::ClassBuilder("RcUndef_Class", vsd::Node::static_meta())
+                    .property<std::string>("v", std::string())
+                    .define());
   EXPECT_EQ(&again->property("v").type(), &vsd::meta_type<std::string>());
 }
 
@@ -658,9 +675,10 @@ TEST(RuntimeClass, UndefineAfterTheEnvironmentIsGone) {
 TEST(RuntimeClass, UndefineRejectsAClassStillReferencedByAnotherClass) {
   auto& reg = vsd::Registry::global();
   const vsd::MetaInstance* target = &vsd::ClassBuilder("RcRefd_Target", vsd::Node::static_meta()).define();
-  const vsd::MetaInstance* holder = &vsd::ClassBuilder("RcRefd_Holder", vsd::Node::static_meta())
-                                         .property("link", reg.reference_type(vsd::TypeKind::SharedRef, *target))
-                                         .define();
+  const vsd::MetaInstance* holder =
+      &vsd::ClassBuilder("RcRefd_Holder", vsd::Node::static_meta())
+           .property("link", reg.reference_type(vsd::TypeKind::SharedRef, *target))
+           .define();
   EXPECT_EQ(reg.find_type("shared<RcRefd_Target>"), &holder->property("link").type());
   const std::string e = error_of([&] { reg.undefine(*target); });
   EXPECT_THAT(e, HasSubstr("RcRefd_Target"));
@@ -668,7 +686,8 @@ TEST(RuntimeClass, UndefineRejectsAClassStillReferencedByAnotherClass) {
   EXPECT_NO_THROW(reg.undefine(*holder));
   EXPECT_NO_THROW(reg.undefine(*target));
   EXPECT_EQ(reg.find_class("RcRefd_Target"), nullptr);
-  EXPECT_EQ(reg.find_type("shared<RcRefd_Target>"), nullptr) << "reference types to an undefined class go with it";
+  EXPECT_EQ(reg.find_type("shared<RcRefd_Target>"), nullptr)
+      << "reference types to an undefined class go with it";
   EXPECT_THROW((void)reg.get_type("shared<RcRefd_Target>"), vsd::Error);
 }
 
@@ -683,13 +702,16 @@ TEST(RuntimeClass, UndefineRejectsBuiltInAndForeignClasses) {
 }
 
 TEST(RuntimeClass, DuplicateClassName) {
-  Defined first(vsd::ClassBuilder("RcDup_Class", vsd::Node::static_meta()).property<double>("v", 1.0).define());
-  const std::string e =
-      error_of([] { (void)vsd::ClassBuilder("RcDup_Class", vsd::Node::static_meta()).property<double>("w", 2.0).define(); });
+  Defined first(
+      vsd::ClassBuilder("RcDup_Class", vsd::Node::static_meta()).property<double>("v", 1.0).define());
+  const std::string e = error_of([] {
+    (void)vsd::ClassBuilder("RcDup_Class", vsd::Node::static_meta()).property<double>("w", 2.0).define();
+  });
   EXPECT_THAT(e, HasSubstr("RcDup_Class"));
   EXPECT_EQ(vsd::Registry::global().find_class("RcDup_Class"), &*first);
   EXPECT_EQ(first->find_property("w"), nullptr);
-  EXPECT_THAT(error_of([] { (void)vsd::ClassBuilder("Node", vsd::Node::static_meta()).define(); }), HasSubstr("Node"));
+  EXPECT_THAT(error_of([] { (void)vsd::ClassBuilder("Node", vsd::Node::static_meta()).define(); }),
+              HasSubstr("Node"));
   EXPECT_THAT(error_of([] { (void)vsd::ClassBuilder("RcMotor", vsd::Node::static_meta()).define(); }),
               HasSubstr("RcMotor"));
   EXPECT_EQ(vsd::Registry::global().find_class("Node"), &vsd::Node::static_meta());
@@ -705,11 +727,13 @@ TEST(RuntimeClass, DuplicatePropertyName) {
   EXPECT_THAT(twice, HasSubstr("RcDupProp_Class"));
   EXPECT_THAT(twice, HasSubstr("'x'"));
   const std::string inherited = error_of([] {
-    (void)vsd::ClassBuilder("RcDupProp_Named", vsd::Node::static_meta()).property<std::string>("name", std::string());
+    (void)vsd::ClassBuilder("RcDupProp_Named", vsd::Node::static_meta())
+        .property<std::string>("name", std::string());
   });
   EXPECT_THAT(inherited, HasSubstr("'name'"));
-  const std::string cpp = error_of(
-      [] { (void)vsd::ClassBuilder("RcDupProp_Motor", RcMotor::static_meta()).property<double>("torque", 1.0); });
+  const std::string cpp = error_of([] {
+    (void)vsd::ClassBuilder("RcDupProp_Motor", RcMotor::static_meta()).property<double>("torque", 1.0);
+  });
   EXPECT_THAT(cpp, HasSubstr("'torque'"));
   Defined parent(define_robot("RcDupProp_Robot"));
   const std::string runtime_base =
@@ -745,8 +769,10 @@ TEST(RuntimeClass, FailedDefineLeavesNoTrace) {
     (void)vsd::ClassBuilder("RcFailed_Class", vsd::Node::static_meta()).property("v", impostor).define(local);
   });
   EXPECT_THAT(e, HasSubstr("'double'"));
-  EXPECT_EQ(local.find_class("RcFailed_Class"), nullptr) << "the failed class must not stay registered (dangling)";
-  for (const vsd::MetaInstance* d : vsd::Node::static_meta().derived()) EXPECT_NE(d->name(), "RcFailed_Class");
+  EXPECT_EQ(local.find_class("RcFailed_Class"), nullptr)
+      << "the failed class must not stay registered (dangling)";
+  for (const vsd::MetaInstance* d : vsd::Node::static_meta().derived())
+    EXPECT_NE(d->name(), "RcFailed_Class");
   // The name can be used by a correct definition.
   EXPECT_NO_THROW((void)vsd::ClassBuilder("RcFailed_Class", vsd::Node::static_meta())
                       .property<double>("v", 1.0)

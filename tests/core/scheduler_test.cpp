@@ -29,9 +29,12 @@ TEST(Scheduler, RunsPeriodicTasksAtTheirRate) {
 TEST(Scheduler, LowerPriorityRunsFirstThenInsertionOrder) {
   vsd::Scheduler s;
   std::vector<std::string> order;
-  s.add_periodic("physics", 0.01, [&](const vsd::StepInfo&) { order.push_back("physics"); }, 10);
-  s.add_periodic("kinematics", 0.01, [&](const vsd::StepInfo&) { order.push_back("kinematics"); }, 0);
-  s.add_periodic("sensors", 0.01, [&](const vsd::StepInfo&) { order.push_back("sensors"); }, 10);
+  s.add_periodic(
+      "physics", 0.01, [&](const vsd::StepInfo&) { order.push_back("physics"); }, 10);
+  s.add_periodic(
+      "kinematics", 0.01, [&](const vsd::StepInfo&) { order.push_back("kinematics"); }, 0);
+  s.add_periodic(
+      "sensors", 0.01, [&](const vsd::StepInfo&) { order.push_back("sensors"); }, 10);
   s.step();
   EXPECT_THAT(order, ElementsAre("kinematics", "physics", "sensors"));
 }

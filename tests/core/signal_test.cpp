@@ -6,7 +6,6 @@
 #include <string>
 #include <utility>
 #include <vector>
-
 #include <vsd/vsd.hpp>
 
 namespace {
@@ -54,7 +53,8 @@ TEST(Signal, EmitReachesManyListenersInConnectionOrder) {
   IntSignal sig;
   std::vector<int> order;
   std::vector<vsd::Connection> connections;
-  for (int i = 0; i < 5; ++i) connections.push_back(sig.connect([&order, i](int x) { order.push_back(i * 100 + x); }));
+  for (int i = 0; i < 5; ++i)
+    connections.push_back(sig.connect([&order, i](int x) { order.push_back(i * 100 + x); }));
   EXPECT_EQ(sig.size(), 5u);
   sig.emit(1);
   EXPECT_THAT(order, ElementsAre(1, 101, 201, 301, 401));
@@ -160,9 +160,7 @@ TEST(Signal, MovedConnectionKeepsTheListener) {
   EXPECT_TRUE(c.connected());
   sig.emit(0);
   EXPECT_EQ(calls, 2);
-  {
-    vsd::Connection d(std::move(c));
-  }  // d goes out of scope: the listener is gone
+  { vsd::Connection d(std::move(c)); }  // d goes out of scope: the listener is gone
   sig.emit(0);
   EXPECT_EQ(calls, 2);
   EXPECT_FALSE(sig.has_listeners());
@@ -417,9 +415,10 @@ TEST(Signal, DestroyingTheSignalInsideTheOnlyListenerWithReleasedConnection) {
   auto sig = std::make_unique<VoidSignal>();
   int calls = 0;
   sig->connect([&] {
-     ++calls;
-     sig.reset();
-   }).release();
+       ++calls;
+       sig.reset();
+     })
+      .release();
   sig->emit();
   EXPECT_EQ(calls, 1);
   EXPECT_EQ(sig, nullptr);

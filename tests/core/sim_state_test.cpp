@@ -29,10 +29,12 @@ TEST_F(SimStateTest, CreatesByClassAndByName) {
 }
 
 TEST_F(SimStateTest, RejectsUnknownAbstractAndForeignClasses) {
-  EXPECT_THAT([&] { state.create("NoSuchClass"); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("NoSuchClass")));
+  EXPECT_THAT([&] { state.create("NoSuchClass"); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("NoSuchClass")));
   EXPECT_THAT([&] { state.create(vsd::Instance::static_meta()); }, testing::Throws<vsd::Error>());
   EXPECT_THAT([&] { state.create(vsd::Environment::static_meta()); }, testing::Throws<vsd::Error>());
-  EXPECT_THAT([&] { state.create<vsd::Database>(); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("Database")));
+  EXPECT_THAT([&] { state.create<vsd::Database>(); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("Database")));
 }
 
 TEST_F(SimStateTest, IdsAreUniqueStableAndFindable) {
@@ -51,12 +53,14 @@ TEST_F(SimStateTest, IdsAreUniqueStableAndFindable) {
 TEST_F(SimStateTest, DestroyingAnInstanceOfAnotherStateIsAnError) {
   auto& other = env.create_state("other");
   auto& n = other.create<vsd::Node>();
-  EXPECT_THAT([&] { state.destroy(n); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("belongs to SimState")));
+  EXPECT_THAT([&] { state.destroy(n); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("belongs to SimState")));
 }
 
 TEST_F(SimStateTest, SignalsCreationAndDeletion) {
   std::vector<std::string> log;
-  auto c1 = state.on_created().connect([&](vsd::SimStateInstance& i) { log.push_back("+" + i.meta().name()); });
+  auto c1 =
+      state.on_created().connect([&](vsd::SimStateInstance& i) { log.push_back("+" + i.meta().name()); });
   auto c2 = state.on_deleted().connect([&](vsd::SimStateInstance& i) {
     // Deletion is announced while the instance is still whole.
     log.push_back("-" + i.meta().name() + ":" + static_cast<vsd::Node&>(i).name());
@@ -73,11 +77,12 @@ TEST_F(SimStateTest, PropertyChangesSignalPerInstanceTypeAndState) {
   auto& n = state.create<vsd::Node>();
   int own = 0, exact = 0, tree = 0, all = 0;
   auto c1 = r.on_changed().connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++own; });
-  auto c2 = state.on_property_changed(TRobot::static_meta(), false).connect(
-      [&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++exact; });
-  auto c3 = state.on_property_changed(TRobot::static_meta(), true).connect(
-      [&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++tree; });
-  auto c4 = state.on_property_changed().connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++all; });
+  auto c2 = state.on_property_changed(TRobot::static_meta(), false)
+                .connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++exact; });
+  auto c3 = state.on_property_changed(TRobot::static_meta(), true)
+                .connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++tree; });
+  auto c4 =
+      state.on_property_changed().connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++all; });
   r.set_speed(2.0);
   g.set_speed(3.0);
   n.set_name("x");
@@ -144,7 +149,8 @@ TEST_F(SimStateTest, AListenerMayDisconnectAnotherDuringDispatch) {
     ++first;
     c2.disconnect();
   });
-  c2 = state.on_property_changed().connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++second; });
+  c2 = state.on_property_changed().connect(
+      [&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++second; });
   r.set_speed(2.0);
   r.set_speed(3.0);
   EXPECT_EQ(first, 2);

@@ -3,7 +3,6 @@
 
 #include <string>
 #include <vector>
-
 #include <vsd/vsd.hpp>
 
 namespace vsd_test {

@@ -147,8 +147,8 @@ TEST_F(TransactionTest, ApplyingToAStateThatLacksTheInstancesChangesNothing) {
   auto& before = env.create_state("before");
   before.copy_from(replica);
   EXPECT_THAT([&] { replica.apply(t); },
-              testing::ThrowsMessage<vsd::Error>(testing::AllOf(HasSubstr("no instance #" + std::to_string(r.id())),
-                                                                HasSubstr("nothing was applied"))));
+              testing::ThrowsMessage<vsd::Error>(testing::AllOf(
+                  HasSubstr("no instance #" + std::to_string(r.id())), HasSubstr("nothing was applied"))));
   expect_equal(replica, before);
 }
 
@@ -163,10 +163,16 @@ TEST_F(TransactionTest, ApplyingTwiceIsRejectedAsAWhole) {
 }
 
 TEST_F(TransactionTest, HeaderAndVersionAreChecked) {
-  EXPECT_THAT([] { (void)vsd::Transaction::from_bytes({'X', 'Y', 'Z', 'W', 1}); },
-              testing::ThrowsMessage<vsd::Error>(HasSubstr("byte 0")));
-  EXPECT_THAT([] { (void)vsd::Transaction::from_bytes({'V', 'S', 'D', 'T', 99}); },
-              testing::ThrowsMessage<vsd::Error>(HasSubstr("version 99")));
+  EXPECT_THAT(
+      [] {
+        (void)vsd::Transaction::from_bytes({'X', 'Y', 'Z', 'W', 1});
+      },
+      testing::ThrowsMessage<vsd::Error>(HasSubstr("byte 0")));
+  EXPECT_THAT(
+      [] {
+        (void)vsd::Transaction::from_bytes({'V', 'S', 'D', 'T', 99});
+      },
+      testing::ThrowsMessage<vsd::Error>(HasSubstr("version 99")));
   EXPECT_TRUE(vsd::Transaction::from_bytes({}).empty());
 }
 

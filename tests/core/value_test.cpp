@@ -2,6 +2,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -9,8 +10,6 @@
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <Eigen/Geometry>
 #include <vsd/vsd.hpp>
 
 namespace vt {
@@ -113,8 +112,9 @@ TEST(Value, OverAlignedValuesGoToTheHeapAligned) {
 TEST(Value, DefaultValueOfAType) {
   EXPECT_EQ(vsd::Value(vsd::meta_type<std::int32_t>()).as<std::int32_t>(), 0);
   EXPECT_EQ(vsd::Value(vsd::meta_type<std::string>()).as<std::string>(), "");
-  EXPECT_TRUE(vsd::Value(vsd::meta_type<Eigen::Isometry3d>()).as<Eigen::Isometry3d>().isApprox(
-      Eigen::Isometry3d::Identity(), 0));
+  EXPECT_TRUE(vsd::Value(vsd::meta_type<Eigen::Isometry3d>())
+                  .as<Eigen::Isometry3d>()
+                  .isApprox(Eigen::Isometry3d::Identity(), 0));
 }
 
 TEST(Value, CopyFromRawMemory) {
@@ -255,7 +255,8 @@ TEST(Value, ConvertIntegerToDouble) {
   EXPECT_EQ(d.as<double>(), 7.0);
   const vsd::Value f = vsd::Value(std::int64_t{-3}).convert_to(vsd::meta_type<float>());
   EXPECT_EQ(f.as<float>(), -3.0f);
-  const vsd::Value u = vsd::Value(std::numeric_limits<std::uint32_t>::max()).convert_to(vsd::meta_type<double>());
+  const vsd::Value u =
+      vsd::Value(std::numeric_limits<std::uint32_t>::max()).convert_to(vsd::meta_type<double>());
   EXPECT_EQ(u.as<double>(), 4294967295.0);
 }
 
@@ -289,11 +290,14 @@ TEST(Value, ConvertFractionToIntegerThrows) {
   const std::string e = error_of([] { (void)vsd::Value(3.5).convert_to(vsd::meta_type<std::int32_t>()); });
   EXPECT_THAT(e, HasSubstr("int32"));
   EXPECT_THAT(e, HasSubstr("3.5"));
-  EXPECT_THROW((void)vsd::Value(std::numeric_limits<double>::quiet_NaN()).convert_to(vsd::meta_type<std::int32_t>()),
+  EXPECT_THROW(
+      (void)vsd::Value(std::numeric_limits<double>::quiet_NaN()).convert_to(vsd::meta_type<std::int32_t>()),
+      vsd::Error);
+  EXPECT_THROW(
+      (void)vsd::Value(std::numeric_limits<double>::infinity()).convert_to(vsd::meta_type<std::int64_t>()),
+      vsd::Error);
+  EXPECT_THROW((void)vsd::Value(9223372036854775808.0).convert_to(vsd::meta_type<std::int64_t>()),
                vsd::Error);
-  EXPECT_THROW((void)vsd::Value(std::numeric_limits<double>::infinity()).convert_to(vsd::meta_type<std::int64_t>()),
-               vsd::Error);
-  EXPECT_THROW((void)vsd::Value(9223372036854775808.0).convert_to(vsd::meta_type<std::int64_t>()), vsd::Error);
 }
 
 TEST(Value, ConvertOutOfRangeIntegerThrows) {
@@ -302,10 +306,12 @@ TEST(Value, ConvertOutOfRangeIntegerThrows) {
   EXPECT_THAT(e, HasSubstr("300"));
   EXPECT_THROW((void)vsd::Value(-1).convert_to(vsd::meta_type<std::uint32_t>()), vsd::Error);
   EXPECT_THROW((void)vsd::Value(128).convert_to(vsd::meta_type<std::int8_t>()), vsd::Error);
-  EXPECT_THROW((void)vsd::Value(std::numeric_limits<std::uint64_t>::max()).convert_to(vsd::meta_type<std::int64_t>()),
-               vsd::Error);
-  EXPECT_THROW((void)vsd::Value(std::numeric_limits<std::int64_t>::min()).convert_to(vsd::meta_type<std::uint64_t>()),
-               vsd::Error);
+  EXPECT_THROW(
+      (void)vsd::Value(std::numeric_limits<std::uint64_t>::max()).convert_to(vsd::meta_type<std::int64_t>()),
+      vsd::Error);
+  EXPECT_THROW(
+      (void)vsd::Value(std::numeric_limits<std::int64_t>::min()).convert_to(vsd::meta_type<std::uint64_t>()),
+      vsd::Error);
 }
 
 TEST(Value, ConvertInexactNumberThrows) {

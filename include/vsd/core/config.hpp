@@ -30,9 +30,8 @@ inline constexpr Id null_id = 0;
 #if defined(NDEBUG) || defined(VSD_DISABLE_ASSERT)
 #define VSD_ASSERT(cond, msg) ((void)0)
 #else
-#define VSD_ASSERT(cond, msg)                                                                    \
-  ((cond) ? (void)0                                                                              \
-          : (std::fprintf(stderr, "%s:%d: vsd assertion '%s' failed: %s\n", __FILE__, __LINE__, \
-                          #cond, msg),                                                           \
+#define VSD_ASSERT(cond, msg)                                                                                \
+  ((cond) ? (void)0                                                                                          \
+          : (std::fprintf(stderr, "%s:%d: vsd assertion '%s' failed: %s\n", __FILE__, __LINE__, #cond, msg), \
              std::abort()))
 #endif

@@ -55,8 +55,8 @@ SimStateInstance* construct_instance(void* memory) {
 }
 
 template <class T>
-void declare_property(MetaInstance& m, std::size_t slot, const char* name, std::size_t offset, PropertyFlags flags,
-                      T default_value) {
+void declare_property(MetaInstance& m, std::size_t slot, const char* name, std::size_t offset,
+                      PropertyFlags flags, T default_value) {
   auto& p = m.add_property(
       std::make_unique<MetaProperty>(name, meta_type<T>(), flags, offset, Value(std::move(default_value))));
   m.set_slot(slot, &p);
@@ -64,26 +64,26 @@ void declare_property(MetaInstance& m, std::size_t slot, const char* name, std::
 
 }  // namespace vsd::detail
 
-#define VSD_DETAIL_INSTANCE(Name, Base, construct)                                                        \
- public:                                                                                                  \
-  using vsd_self = Name;                                                                                  \
-  using vsd_base = Base;                                                                                  \
-  static constexpr std::string_view vsd_class_name = #Name;                                               \
-  /** @brief The MetaInstance of this class. */                                                          \
-  static const ::vsd::MetaInstance& static_meta() {                                                       \
-    /* Never destroyed: class descriptors outlive every static that might still use them. */            \
-    static const ::vsd::MetaInstance& meta = *new ::vsd::MetaInstance(                                   \
-        #Name, &Base::static_meta(), sizeof(Name), alignof(Name), construct,                               \
-        [](::vsd::MetaInstance& m) { vsd_register(m, ::vsd::detail::Slot<0>{}); });                        \
-    return meta;                                                                                          \
-  }                                                                                                       \
-                                                                                                          \
- private:                                                                                                 \
-  static constexpr int vsd_counter_base = __COUNTER__;                                                    \
-  template <int N>                                                                                        \
-  static void vsd_register(::vsd::MetaInstance&, ::vsd::detail::Slot<N>) {}                               \
-  [[maybe_unused]] static inline const bool vsd_registered_ = ::vsd::detail::auto_register(static_meta()); \
-                                                                                                          \
+#define VSD_DETAIL_INSTANCE(Name, Base, construct)                                                           \
+ public:                                                                                                     \
+  using vsd_self = Name;                                                                                     \
+  using vsd_base = Base;                                                                                     \
+  static constexpr std::string_view vsd_class_name = #Name;                                                  \
+  /** @brief The MetaInstance of this class. */                                                              \
+  static const ::vsd::MetaInstance& static_meta() {                                                          \
+    /* Never destroyed: class descriptors outlive every static that might still use them. */                 \
+    static const ::vsd::MetaInstance& meta =                                                                 \
+        *new ::vsd::MetaInstance(#Name, &Base::static_meta(), sizeof(Name), alignof(Name), construct,        \
+                                 [](::vsd::MetaInstance& m) { vsd_register(m, ::vsd::detail::Slot<0>{}); }); \
+    return meta;                                                                                             \
+  }                                                                                                          \
+                                                                                                             \
+ private:                                                                                                    \
+  static constexpr int vsd_counter_base = __COUNTER__;                                                       \
+  template <int N>                                                                                           \
+  static void vsd_register(::vsd::MetaInstance&, ::vsd::detail::Slot<N>) {}                                  \
+  [[maybe_unused]] static inline const bool vsd_registered_ = ::vsd::detail::auto_register(static_meta());   \
+                                                                                                             \
  public:
 
 /// @brief Opens the declaration of a vsd class @p Name deriving from @p Base (instances can be created).
@@ -94,35 +94,34 @@ void declare_property(MetaInstance& m, std::size_t slot, const char* name, std::
 #define VSD_DETAIL_SLOT(tag) static constexpr int tag = __COUNTER__ - vsd_counter_base - 1;
 
 /// @brief Declares a property; see the file comment.
-#define VSD_PROPERTY(Type, name, def, ...)                                                                \
- private:                                                                                                 \
-  Type name##_ = def;                                                                                     \
-  VSD_DETAIL_SLOT(vsd_slot_##name)                                                                        \
-  static void vsd_register(::vsd::MetaInstance& m, ::vsd::detail::Slot<vsd_slot_##name>) {                \
-    _Pragma("GCC diagnostic push") _Pragma("GCC diagnostic ignored \"-Winvalid-offsetof\"")               \
-    ::vsd::detail::declare_property<Type>(m, vsd_slot_##name, #name, offsetof(vsd_self, name##_),         \
-                                          ::vsd::detail::flags_or_default(__VA_ARGS__),                   \
-                                          ::vsd::detail::TypeOf<Type>(def));                                  \
-    _Pragma("GCC diagnostic pop")                                                                         \
-    vsd_register(m, ::vsd::detail::Slot<vsd_slot_##name + 1>{});                                          \
-  }                                                                                                       \
-                                                                                                          \
- public:                                                                                                  \
-  /** @brief Value of property `name`. */                                                                \
-  [[nodiscard]] const Type& name() const noexcept { return name##_; }                                    \
-  /** @brief Sets property `name` (signals and records when observed). */                                \
-  void set_##name(const Type& v) { this->vsd_assign(name##_, v, &vsd_prop_##name); }                     \
-  /** @brief The MetaProperty of `name`. */                                                              \
+#define VSD_PROPERTY(Type, name, def, ...)                                                             \
+ private:                                                                                              \
+  Type name##_ = def;                                                                                  \
+  VSD_DETAIL_SLOT(vsd_slot_##name)                                                                     \
+  static void vsd_register(::vsd::MetaInstance& m, ::vsd::detail::Slot<vsd_slot_##name>) {             \
+    _Pragma("GCC diagnostic push")                                                                     \
+        _Pragma("GCC diagnostic ignored \"-Winvalid-offsetof\"")::vsd::detail::declare_property<Type>( \
+            m, vsd_slot_##name, #name, offsetof(vsd_self, name##_),                                    \
+            ::vsd::detail::flags_or_default(__VA_ARGS__), ::vsd::detail::TypeOf<Type>(def));           \
+    _Pragma("GCC diagnostic pop") vsd_register(m, ::vsd::detail::Slot<vsd_slot_##name + 1>{});         \
+  }                                                                                                    \
+                                                                                                       \
+ public:                                                                                               \
+  /** @brief Value of property `name`. */                                                              \
+  [[nodiscard]] const Type& name() const noexcept { return name##_; }                                  \
+  /** @brief Sets property `name` (signals and records when observed). */                              \
+  void set_##name(const Type& v) { this->vsd_assign(name##_, v, &vsd_prop_##name); }                   \
+  /** @brief The MetaProperty of `name`. */                                                            \
   static const ::vsd::MetaProperty& vsd_prop_##name() { return static_meta().slot(vsd_slot_##name); }
 
 /// @brief Publishes member function @p name as a MetaMethod (callable through vsdMetaCall).
-#define VSD_METHOD(name)                                                                                  \
- private:                                                                                                 \
-  VSD_DETAIL_SLOT(vsd_slot_m_##name)                                                                      \
-  static void vsd_register(::vsd::MetaInstance& m, ::vsd::detail::Slot<vsd_slot_m_##name>) {             \
-    m.add_method(::vsd::detail::make_method<vsd_self, &vsd_self::name>(#name));                           \
-    m.set_slot(vsd_slot_m_##name, nullptr);                                                               \
-    vsd_register(m, ::vsd::detail::Slot<vsd_slot_m_##name + 1>{});                                       \
-  }                                                                                                       \
-                                                                                                          \
+#define VSD_METHOD(name)                                                                     \
+ private:                                                                                    \
+  VSD_DETAIL_SLOT(vsd_slot_m_##name)                                                         \
+  static void vsd_register(::vsd::MetaInstance& m, ::vsd::detail::Slot<vsd_slot_m_##name>) { \
+    m.add_method(::vsd::detail::make_method<vsd_self, &vsd_self::name>(#name));              \
+    m.set_slot(vsd_slot_m_##name, nullptr);                                                  \
+    vsd_register(m, ::vsd::detail::Slot<vsd_slot_m_##name + 1>{});                           \
+  }                                                                                          \
+                                                                                             \
  public:

@@ -56,8 +56,8 @@ class MetaInstance {
   using Configure = void (*)(MetaInstance& self);
 
   /// @brief Describes a built-in class. Use VSD_INSTANCE rather than calling this directly.
-  MetaInstance(std::string name, const MetaInstance* base, std::size_t size, std::size_t align, Construct construct,
-               Configure configure);
+  MetaInstance(std::string name, const MetaInstance* base, std::size_t size, std::size_t align,
+               Construct construct, Configure configure);
   ~MetaInstance();
   MetaInstance(const MetaInstance&) = delete;
   MetaInstance& operator=(const MetaInstance&) = delete;
@@ -89,7 +89,9 @@ class MetaInstance {
     return std::span<const MetaProperty* const>(props_).subspan(props_.size() - own_props_.size());
   }
   /// @brief Properties whose type is a reference or a list of references.
-  [[nodiscard]] std::span<const MetaProperty* const> reference_properties() const noexcept { return ref_props_; }
+  [[nodiscard]] std::span<const MetaProperty* const> reference_properties() const noexcept {
+    return ref_props_;
+  }
   /// @brief All methods, inherited ones included (a subclass's method hides a base's of the same name).
   [[nodiscard]] std::span<const MetaMethod* const> methods() const noexcept { return methods_; }
 
@@ -99,7 +101,9 @@ class MetaInstance {
   }
   /// @brief The property named @p name; throws vsd::Error naming the class when there is none.
   [[nodiscard]] const MetaProperty& property(std::string_view name) const;
-  [[nodiscard]] const MetaMethod* find_method(std::string_view name) const noexcept { return method_table_.find(name); }
+  [[nodiscard]] const MetaMethod* find_method(std::string_view name) const noexcept {
+    return method_table_.find(name);
+  }
   [[nodiscard]] const MetaMethod& method(std::string_view name) const;
 
   /// @brief The paper's vsdMetaCall: calls method @p name on @p self with @p args.

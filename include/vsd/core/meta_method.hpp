@@ -24,8 +24,12 @@ class MetaMethod {
   /// @brief Calls the method on an instance with arguments already checked against the signature.
   using Invoker = std::function<Value(Instance& self, std::span<const Value> args)>;
 
-  MetaMethod(std::string name, const MetaType* result, std::vector<const MetaType*> arguments, Invoker invoker)
-      : name_(std::move(name)), result_(result), arguments_(std::move(arguments)), invoker_(std::move(invoker)) {}
+  MetaMethod(std::string name, const MetaType* result, std::vector<const MetaType*> arguments,
+             Invoker invoker)
+      : name_(std::move(name)),
+        result_(result),
+        arguments_(std::move(arguments)),
+        invoker_(std::move(invoker)) {}
   MetaMethod(const MetaMethod&) = delete;
   MetaMethod& operator=(const MetaMethod&) = delete;
 
@@ -84,9 +88,10 @@ std::unique_ptr<MetaMethod> make_method(std::string name) {
   std::vector<const MetaType*> arg_types;
   [&]<std::size_t... I>(std::index_sequence<I...>) {
     (arg_types.push_back(&meta_type<std::tuple_element_t<I, Args>>()), ...);
-  }(std::make_index_sequence<std::tuple_size_v<Args>>{});
+  }
+  (std::make_index_sequence<std::tuple_size_v<Args>>{});
   auto invoker = [](Instance& self, std::span<const Value> args) -> Value {
-    return [&]<std::size_t... I>(std::index_sequence<I...>) -> Value {
+    return [&]<std::size_t... I>(std::index_sequence<I...>)->Value {
       auto& obj = static_cast<Self&>(self);
       if constexpr (std::is_void_v<typename Tr::Result>) {
         (obj.*M)(args[I].template as<std::tuple_element_t<I, Args>>()...);
@@ -94,10 +99,11 @@ std::unique_ptr<MetaMethod> make_method(std::string name) {
       } else {
         return Value((obj.*M)(args[I].template as<std::tuple_element_t<I, Args>>()...));
       }
-    }(std::make_index_sequence<std::tuple_size_v<Args>>{});
+    }
+    (std::make_index_sequence<std::tuple_size_v<Args>>{});
   };
-  return std::make_unique<MetaMethod>(std::move(name), result_type<typename Tr::Result>(), std::move(arg_types),
-                                      invoker);
+  return std::make_unique<MetaMethod>(std::move(name), result_type<typename Tr::Result>(),
+                                      std::move(arg_types), invoker);
 }
 
 }  // namespace detail

@@ -24,11 +24,14 @@ class MetaInstance;
 
 class MetaProperty {
  public:
-  MetaProperty(std::string name, const MetaType& type, PropertyFlags flags, std::size_t offset, Value default_value)
+  MetaProperty(std::string name, const MetaType& type, PropertyFlags flags, std::size_t offset,
+               Value default_value)
       : name_(std::move(name)),
         type_(&type),
         settable_(flags.has(ReadOnly) ? nullptr : &type),
-        flags_(flags), offset_(offset), default_(std::move(default_value)) {}
+        flags_(flags),
+        offset_(offset),
+        default_(std::move(default_value)) {}
   MetaProperty(const MetaProperty&) = delete;
   MetaProperty& operator=(const MetaProperty&) = delete;
 

@@ -33,7 +33,16 @@ class ByteReader;
 
 /// @brief What kind of value a MetaType describes.
 enum class TypeKind : std::uint8_t {
-  Bool, Int, UInt, Float, Double, String, Enum, Flags, Struct, Vector,
+  Bool,
+  Int,
+  UInt,
+  Float,
+  Double,
+  String,
+  Enum,
+  Flags,
+  Struct,
+  Vector,
   Ref,        ///< composite reference (counted)
   SharedRef,  ///< shared reference (not counted, nulled when the target dies)
   RefList,    ///< list of composite references
@@ -52,12 +61,12 @@ class RefResolver {
 
 /// @brief The operations of a MetaType. One table may serve several MetaTypes (e.g. all enums of a size).
 struct TypeOps {
-  void (*construct)(const MetaType&, void* dst);                   ///< default value into raw memory
+  void (*construct)(const MetaType&, void* dst);  ///< default value into raw memory
   void (*copy_construct)(const MetaType&, void* dst, const void* src);
   void (*move_construct)(const MetaType&, void* dst, void* src) noexcept;
   void (*destroy)(const MetaType&, void* obj) noexcept;
   void (*assign)(const MetaType&, void* dst, const void* src);
-  bool (*equal)(const MetaType&, const void* a, const void* b);   ///< references compare by id
+  bool (*equal)(const MetaType&, const void* a, const void* b);  ///< references compare by id
   std::size_t (*hash)(const MetaType&, const void* obj);
   void (*write_text)(const MetaType&, const void* obj, std::string& out);
   void (*read_text)(const MetaType&, void* obj, TextReader& in, const RefResolver* refs);
@@ -79,8 +88,8 @@ class MetaType {
   struct Field {
     std::string name;
     const MetaType* type;
-    std::size_t offset;                        ///< npos when get/set are used
-    void (*get)(const void* obj, void* out);   ///< copies the field out (assigns into a live value)
+    std::size_t offset;                       ///< npos when get/set are used
+    void (*get)(const void* obj, void* out);  ///< copies the field out (assigns into a live value)
     void (*set)(void* obj, const void* in);
   };
   static constexpr std::size_t npos = static_cast<std::size_t>(-1);
@@ -104,7 +113,9 @@ class MetaType {
   [[nodiscard]] bool is_composite() const noexcept {
     return kind_ == TypeKind::Ref || kind_ == TypeKind::RefList;
   }
-  [[nodiscard]] bool is_arithmetic() const noexcept { return kind_ <= TypeKind::Double && kind_ != TypeKind::Bool; }
+  [[nodiscard]] bool is_arithmetic() const noexcept {
+    return kind_ <= TypeKind::Double && kind_ != TypeKind::Bool;
+  }
   /// @brief True for unsigned integers and for enums and flags whose underlying type is unsigned.
   [[nodiscard]] bool is_unsigned() const noexcept { return unsigned_; }
   /// @brief True when @p v is representable by this integer, enum or flags type.
@@ -197,7 +208,9 @@ struct TypeTraits;  // specialised below for built-in types; user types use the 
 
 namespace detail {
 template <class T>
-concept HasTraits = requires { TypeTraits<T>::make(); };
+concept HasTraits = requires {
+  TypeTraits<T>::make();
+};
 template <class T>
 concept HasAdlType = requires(T* p) {
   { vsd_meta_type(p) } -> std::same_as<const MetaType&>;
@@ -221,7 +234,8 @@ using CanonicalInt = std::conditional_t<
 /// @brief The MetaType of C++ type T (built-in, or declared with VSD_ENUM / VSD_FLAGS / VSD_STRUCT).
 template <class T>
 const MetaType& meta_type() {
-  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool> && !std::is_same_v<T, detail::CanonicalInt<T>>) {
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool> &&
+                !std::is_same_v<T, detail::CanonicalInt<T>>) {
     return meta_type<detail::CanonicalInt<T>>();
   } else if constexpr (detail::HasTraits<T>) {
     static const MetaType type = TypeTraits<T>::make();
@@ -293,7 +307,9 @@ struct ValueOps {
   static bool equal(const MetaType&, const void* a, const void* b) {
     return equal_values(*static_cast<const T*>(a), *static_cast<const T*>(b));
   }
-  static std::size_t hash(const MetaType&, const void* obj) { return hash_value(*static_cast<const T*>(obj)); }
+  static std::size_t hash(const MetaType&, const void* obj) {
+    return hash_value(*static_cast<const T*>(obj));
+  }
   static void write_text(const MetaType& t, const void* obj, std::string& out) {
     text_out(t, *static_cast<const T*>(obj), out);
   }
@@ -306,9 +322,9 @@ struct ValueOps {
   static void read_bytes(const MetaType& t, void* obj, ByteReader& in, const RefResolver* refs) {
     bytes_in(t, *static_cast<T*>(obj), in, refs);
   }
-  static constexpr TypeOps table{&construct,  &copy_construct, &move_construct, &destroy,
-                                 &assign,     &equal,          &hash,           &write_text,
-                                 &read_text,  &write_bytes,    &read_bytes,     nullptr};
+  static constexpr TypeOps table{&construct, &copy_construct, &move_construct, &destroy,
+                                 &assign,    &equal,          &hash,           &write_text,
+                                 &read_text, &write_bytes,    &read_bytes,     nullptr};
 };
 
 /// Makes the MetaType of a C++ type with ValueOps<T>.
@@ -349,8 +365,7 @@ struct TypeTraits<std::string> {
   static MetaType make() { return detail::make_type<std::string>("string", TypeKind::String); }
 };
 template <class T>
-  requires(std::is_integral_v<T> && !std::is_same_v<T, bool>)
-struct TypeTraits<T> {
+requires(std::is_integral_v<T> && !std::is_same_v<T, bool>) struct TypeTraits<T> {
   static MetaType make() {
     std::string name = std::is_signed_v<T> ? "int" : "uint";
     name += std::to_string(sizeof(T) * 8);
@@ -358,7 +373,7 @@ struct TypeTraits<T> {
   }
 };
 template <class T>
-  requires is_meta_type_v<T>
+requires is_meta_type_v<T>
 struct TypeTraits<std::vector<T>> {
   static MetaType make() {
     MetaType t = detail::make_type<std::vector<T>>("vector<" + meta_type<T>().name() + ">", TypeKind::Vector);
@@ -375,42 +390,42 @@ struct TypeTraits<std::vector<T>> {
 
 /// @brief Declares enum (or enum class) @p E with its named values to the meta-information system.
 /// Write it in the namespace of E: `VSD_ENUM(Color, Red, Green, Blue)`.
-#define VSD_ENUM(E, ...)                                                                          \
-  [[maybe_unused]] inline const ::vsd::MetaType& vsd_meta_type(E*) {                              \
-    static const ::vsd::MetaType type = [] {                                                      \
-      auto t = ::vsd::detail::make_type<E>(#E, ::vsd::TypeKind::Enum);                            \
-      VSD_PP_FOR_EACH(VSD_DETAIL_ENUM_VALUE, E, __VA_ARGS__)                                      \
-      return t;                                                                                   \
-    }();                                                                                          \
-    return type;                                                                                  \
+#define VSD_ENUM(E, ...)                                               \
+  [[maybe_unused]] inline const ::vsd::MetaType& vsd_meta_type(E*) {   \
+    static const ::vsd::MetaType type = [] {                           \
+      auto t = ::vsd::detail::make_type<E>(#E, ::vsd::TypeKind::Enum); \
+      VSD_PP_FOR_EACH(VSD_DETAIL_ENUM_VALUE, E, __VA_ARGS__)           \
+      return t;                                                        \
+    }();                                                               \
+    return type;                                                       \
   }
 
 /// @brief Declares a flags enum @p E whose values are single bits: `VSD_FLAGS(Access, Read, Write)`.
 /// Its text form is `Read|Write`; combine values with the enum's own operators.
-#define VSD_FLAGS(E, ...)                                                                         \
-  [[maybe_unused]] inline const ::vsd::MetaType& vsd_meta_type(E*) {                              \
-    static const ::vsd::MetaType type = [] {                                                      \
-      auto t = ::vsd::detail::make_type<E>(#E, ::vsd::TypeKind::Flags);                           \
-      VSD_PP_FOR_EACH(VSD_DETAIL_ENUM_VALUE, E, __VA_ARGS__)                                      \
-      return t;                                                                                   \
-    }();                                                                                          \
-    return type;                                                                                  \
+#define VSD_FLAGS(E, ...)                                               \
+  [[maybe_unused]] inline const ::vsd::MetaType& vsd_meta_type(E*) {    \
+    static const ::vsd::MetaType type = [] {                            \
+      auto t = ::vsd::detail::make_type<E>(#E, ::vsd::TypeKind::Flags); \
+      VSD_PP_FOR_EACH(VSD_DETAIL_ENUM_VALUE, E, __VA_ARGS__)            \
+      return t;                                                         \
+    }();                                                                \
+    return type;                                                        \
   }
 
-#define VSD_DETAIL_STRUCT_FIELD(S, f)                                                          \
+#define VSD_DETAIL_STRUCT_FIELD(S, f) \
   t.add_field({#f, &::vsd::meta_type<decltype(S::f)>(), offsetof(S, f), nullptr, nullptr});
 
 /// @brief Declares a simple struct @p S (standard layout, default constructible, fields of known types)
 /// with the fields to describe: `VSD_STRUCT(Pose2d, x, y, theta)`. Write it in the namespace of S.
-#define VSD_STRUCT(S, ...)                                                                        \
-  [[maybe_unused]] inline const ::vsd::MetaType& vsd_meta_type(S*) {                              \
-    static_assert(std::is_standard_layout_v<S>, "VSD_STRUCT needs a standard-layout struct");     \
-    static const ::vsd::MetaType type = [] {                                                      \
-      auto t = ::vsd::detail::make_type<S>(#S, ::vsd::TypeKind::Struct);                          \
-      VSD_PP_FOR_EACH(VSD_DETAIL_STRUCT_FIELD, S, __VA_ARGS__)                                    \
-      return t;                                                                                   \
-    }();                                                                                          \
-    return type;                                                                                  \
+#define VSD_STRUCT(S, ...)                                                                    \
+  [[maybe_unused]] inline const ::vsd::MetaType& vsd_meta_type(S*) {                          \
+    static_assert(std::is_standard_layout_v<S>, "VSD_STRUCT needs a standard-layout struct"); \
+    static const ::vsd::MetaType type = [] {                                                  \
+      auto t = ::vsd::detail::make_type<S>(#S, ::vsd::TypeKind::Struct);                      \
+      VSD_PP_FOR_EACH(VSD_DETAIL_STRUCT_FIELD, S, __VA_ARGS__)                                \
+      return t;                                                                               \
+    }();                                                                                      \
+    return type;                                                                              \
   }
 
 #include "vsd/core/detail/value_ops.hpp"

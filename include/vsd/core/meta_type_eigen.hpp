@@ -52,7 +52,8 @@ template <>
 struct TypeTraits<Eigen::Vector2d> {
   static MetaType make() {
     auto t = detail::make_type<Eigen::Vector2d>("Vector2d", TypeKind::Struct);
-    t.add_field(detail::eigen_coeff<Eigen::Vector2d, 0>("x")).add_field(detail::eigen_coeff<Eigen::Vector2d, 1>("y"));
+    t.add_field(detail::eigen_coeff<Eigen::Vector2d, 0>("x"))
+        .add_field(detail::eigen_coeff<Eigen::Vector2d, 1>("y"));
     return t;
   }
 };
@@ -99,6 +100,5 @@ struct TypeTraits<Eigen::Isometry3d> {
     return t;
   }
 };
-
 
 }  // namespace vsd

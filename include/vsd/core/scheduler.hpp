@@ -16,9 +16,9 @@ namespace vsd {
 
 /// @brief What a task learns about the step it runs in.
 struct StepInfo {
-  double time;          ///< simulated time at the end of this step, in seconds
-  double dt;            ///< time since this task last ran
-  std::uint64_t step;   ///< number of the step (1 for the first)
+  double time;         ///< simulated time at the end of this step, in seconds
+  double dt;           ///< time since this task last ran
+  std::uint64_t step;  ///< number of the step (1 for the first)
 };
 
 class Scheduler {
@@ -64,8 +64,8 @@ class Scheduler {
     std::string name;
     Task task;
     int priority;
-    std::uint64_t every;       // base steps between runs; 0 for event-driven
-    std::uint64_t last_step;   // step it last ran in
+    std::uint64_t every;      // base steps between runs; 0 for event-driven
+    std::uint64_t last_step;  // step it last ran in
     bool pending = false;
     bool removed = false;
   };

@@ -29,7 +29,8 @@ namespace detail {
 /// that a connection can outlive its signal and a signal can die in the middle of its own emit.
 struct SignalCore {
   struct Slot {
-    void (*fn)() = nullptr;  // type-erased thunk (void(*)() is the generic function pointer); null once disconnected
+    void (*fn)() =
+        nullptr;  // type-erased thunk (void(*)() is the generic function pointer); null once disconnected
     void* ctx = nullptr;
     void (*drop)(void*) = nullptr;  // destroys a heap-held functor, if any
     std::uint32_t id = 0;

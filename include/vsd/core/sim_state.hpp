@@ -120,8 +120,8 @@ class SimState : public Instance {
   void enable_state_watch();
   bool state_watch_wanted() const noexcept;
   void property_changed(SimStateInstance& inst, const MetaProperty& p, const void* old_value);
-  void list_changed(SimStateInstance& holder, const MetaProperty& p, std::size_t index, SimStateInstance& target,
-                    bool inserted);
+  void list_changed(SimStateInstance& holder, const MetaProperty& p, std::size_t index,
+                    SimStateInstance& target, bool inserted);
   PropertySignal* type_signal(const MetaInstance& m, bool tree) const noexcept;
   void emit_property(SimStateInstance& inst, const MetaProperty& p);
   void free_graveyard() noexcept;

@@ -31,8 +31,8 @@ class Value {
   Value(const MetaType& type, const void* src) : type_(&type) { type.copy_construct(alloc(), src); }
   /// @brief Holds @p v with the MetaType of its C++ type (string literals become std::string).
   template <class T>
-    requires(!std::is_same_v<std::decay_t<T>, Value> && is_meta_type_v<std::decay_t<T>>)
-  Value(T&& v) : type_(&meta_type<std::decay_t<T>>()) {  // NOLINT(google-explicit-constructor)
+  requires(!std::is_same_v<std::decay_t<T>, Value> && is_meta_type_v<std::decay_t<T>>) Value(T&& v)
+      : type_(&meta_type<std::decay_t<T>>()) {  // NOLINT(google-explicit-constructor)
     ::new (alloc()) std::decay_t<T>(std::forward<T>(v));
   }
   Value(const char* s) : Value(std::string(s)) {}  // NOLINT(google-explicit-constructor)
@@ -69,7 +69,9 @@ class Value {
   /// @brief The MetaType held, or nullptr when empty.
   [[nodiscard]] const MetaType* type() const noexcept { return type_; }
   [[nodiscard]] bool empty() const noexcept { return type_ == nullptr; }
-  [[nodiscard]] const void* data() const noexcept { return type_ == nullptr ? nullptr : (on_heap() ? heap_ : buf_); }
+  [[nodiscard]] const void* data() const noexcept {
+    return type_ == nullptr ? nullptr : (on_heap() ? heap_ : buf_);
+  }
   [[nodiscard]] void* data() noexcept { return type_ == nullptr ? nullptr : (on_heap() ? heap_ : buf_); }
 
   /// @brief True when this holds a T.

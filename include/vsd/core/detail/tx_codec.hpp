@@ -34,7 +34,7 @@ struct TxOp {
   Id id = 0;               // instance (Create/Delete/Set) or holder (Insert/Erase)
   std::string_view name;   // class (Create/Delete) or property (Set/Insert/Erase)
   std::vector<std::pair<std::string_view, std::span<const std::uint8_t>>> values;  // Create/Delete
-  std::span<const std::uint8_t> old_value, new_value;                             // Set
+  std::span<const std::uint8_t> old_value, new_value;                              // Set
   std::size_t index = 0;                                                           // Insert/Erase
   Id target = 0;                                                                   // Insert/Erase
 };

@@ -97,7 +97,8 @@ void text_in(const MetaType& t, T& v, TextReader& in, const RefResolver* refs) {
       v = static_cast<T>(x);
     } else {
       const std::uint64_t x = in.unsigned_integer();
-      if (x > std::numeric_limits<T>::max()) in.fail_at(at, std::to_string(x) + " is out of range for " + t.name());
+      if (x > std::numeric_limits<T>::max())
+        in.fail_at(at, std::to_string(x) + " is out of range for " + t.name());
       v = static_cast<T>(x);
     }
   } else if constexpr (std::is_same_v<T, float>) {
