@@ -10,6 +10,8 @@
 #include <vector>
 #include <vsd/vsd.hpp>
 
+#include "test_util.hpp"
+
 namespace mi {
 
 class MiVehicle : public vsd::Node {
@@ -80,20 +82,9 @@ using mi::MiVehicle;
 using testing::ElementsAre;
 using testing::HasSubstr;
 
-std::string error_of(const std::function<void()>& fn) {
-  try {
-    fn();
-  } catch (const vsd::Error& e) {
-    return e.what();
-  }
-  return "<no error>";
-}
+using vsd_test::error_of;
 
-std::vector<std::string> names_of(std::span<const vsd::MetaProperty* const> props) {
-  std::vector<std::string> out;
-  for (const vsd::MetaProperty* p : props) out.push_back(p->name());
-  return out;
-}
+using vsd_test::names_of;
 
 std::vector<std::string> method_names(const vsd::MetaInstance& m) {
   std::vector<std::string> out;

@@ -9,6 +9,8 @@
 #include <vector>
 #include <vsd/vsd.hpp>
 
+#include "test_util.hpp"
+
 namespace rg {
 
 enum class RgMode { Idle, Busy };
@@ -49,14 +51,7 @@ namespace {
 
 using testing::HasSubstr;
 
-std::string error_of(const std::function<void()>& fn) {
-  try {
-    fn();
-  } catch (const vsd::Error& e) {
-    return e.what();
-  }
-  return "<no error>";
-}
+using vsd_test::error_of;
 
 vsd::Registry& global() { return vsd::Registry::global(); }
 

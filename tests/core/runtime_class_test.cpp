@@ -13,6 +13,8 @@
 #include <vector>
 #include <vsd/vsd.hpp>
 
+#include "test_util.hpp"
+
 namespace rc {
 
 // A C++ class that run-time classes derive from.
@@ -33,20 +35,9 @@ using rc::RcMotor;
 using testing::ElementsAre;
 using testing::HasSubstr;
 
-std::string error_of(const std::function<void()>& fn) {
-  try {
-    fn();
-  } catch (const vsd::Error& e) {
-    return e.what();
-  }
-  return "<no error>";
-}
+using vsd_test::error_of;
 
-std::vector<std::string> names_of(std::span<const vsd::MetaProperty* const> props) {
-  std::vector<std::string> out;
-  for (const vsd::MetaProperty* p : props) out.push_back(p->name());
-  return out;
-}
+using vsd_test::names_of;
 
 /// Undefines a run-time class when the test ends (also when it fails early). Declare guards before the
 /// Environment whose instances they outlive, and a subclass's guard after its base's.

@@ -12,6 +12,8 @@
 #include <vector>
 #include <vsd/vsd.hpp>
 
+#include "test_util.hpp"
+
 namespace vt {
 
 struct alignas(32) VtAligned {
@@ -44,14 +46,7 @@ bool stored_inline(const vsd::Value& v) {
   return p >= b && p < b + sizeof(vsd::Value);
 }
 
-std::string error_of(const std::function<void()>& fn) {
-  try {
-    fn();
-  } catch (const vsd::Error& e) {
-    return e.what();
-  }
-  return "<no error>";
-}
+using vsd_test::error_of;
 
 Eigen::Isometry3d sample_frame() {
   Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
