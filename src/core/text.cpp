@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <type_traits>
 
 #include "vsd/core/error.hpp"
 
@@ -149,65 +150,30 @@ std::string_view TextReader::number_token() {
   return text_.substr(start, pos_ - start);
 }
 
-std::int64_t TextReader::integer() {
-  const std::size_t at = (skip_ws(), pos_);
+// One number token converted to T with from_chars; the error names the token and points at its start.
+template <class T>
+T TextReader::number(const char* what) {
+  const std::size_t at = token_start();
   auto tok = number_token();
   if (!tok.empty() && tok[0] == '+') tok.remove_prefix(1);
-  std::int64_t v = 0;
-  auto [p, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
-  if (ec != std::errc() || p != tok.data() + tok.size()) {
-    pos_ = at;
-    fail("'" + std::string(tok) + "' is not an integer" +
-         (ec == std::errc::result_out_of_range ? " in range" : ""));
+  if constexpr (std::is_floating_point_v<T>) {
+    if (tok == "nan" || tok == "-nan") return std::numeric_limits<T>::quiet_NaN();
+    if (tok == "inf") return std::numeric_limits<T>::infinity();
+    if (tok == "-inf") return -std::numeric_limits<T>::infinity();
   }
-  return v;
-}
-
-std::uint64_t TextReader::unsigned_integer() {
-  const std::size_t at = (skip_ws(), pos_);
-  auto tok = number_token();
-  if (!tok.empty() && tok[0] == '+') tok.remove_prefix(1);
-  std::uint64_t v = 0;
-  auto [p, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
-  if (ec != std::errc() || p != tok.data() + tok.size()) {
-    pos_ = at;
-    fail("'" + std::string(tok) + "' is not an unsigned integer" +
-         (ec == std::errc::result_out_of_range ? " in range" : ""));
-  }
-  return v;
-}
-
-double TextReader::real() {
-  const std::size_t at = (skip_ws(), pos_);
-  auto tok = number_token();
-  if (!tok.empty() && tok[0] == '+') tok.remove_prefix(1);
-  if (tok == "nan" || tok == "-nan") return std::numeric_limits<double>::quiet_NaN();
-  if (tok == "inf") return std::numeric_limits<double>::infinity();
-  if (tok == "-inf") return -std::numeric_limits<double>::infinity();
-  double v = 0;
-  auto [p, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
-  if (ec != std::errc() || p != tok.data() + tok.size()) {
-    pos_ = at;
-    fail("'" + std::string(tok) + "' is not a number");
-  }
-  return v;
-}
-
-float TextReader::real_float() {
-  const std::size_t at = (skip_ws(), pos_);
-  auto tok = number_token();
-  if (!tok.empty() && tok[0] == '+') tok.remove_prefix(1);
-  if (tok == "nan" || tok == "-nan") return std::numeric_limits<float>::quiet_NaN();
-  if (tok == "inf") return std::numeric_limits<float>::infinity();
-  if (tok == "-inf") return -std::numeric_limits<float>::infinity();
-  float v = 0;
+  T v{};
   auto [p, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
   if (ec == std::errc::result_out_of_range)
-    fail_at(at, "'" + std::string(tok) + "' is out of range for float");
+    fail_at(at, "'" + std::string(tok) + "' is out of the range of " + what);
   if (ec != std::errc() || p != tok.data() + tok.size())
-    fail_at(at, "'" + std::string(tok) + "' is not a number");
+    fail_at(at, "'" + std::string(tok) + "' is not " + what);
   return v;
 }
+
+std::int64_t TextReader::integer() { return number<std::int64_t>("an integer"); }
+std::uint64_t TextReader::unsigned_integer() { return number<std::uint64_t>("an unsigned integer"); }
+double TextReader::real() { return number<double>("a number"); }
+float TextReader::real_float() { return number<float>("a float"); }
 
 void TextReader::expect_end() {
   if (!at_end()) fail(std::string("unexpected '") + text_[pos_] + "' after the value");

@@ -69,6 +69,9 @@ class TextReader {
   };
 
  private:
+  template <class T>
+  T number(const char* what);
+
   std::string_view text_;
   std::string_view origin_;
   std::size_t pos_ = 0;
