@@ -103,8 +103,12 @@ void SimStateInstance::list_erase(const MetaProperty& p, std::size_t index) {
 
 PropertySignal& SimStateInstance::on_changed() {
   auto& slot = state_->instance_signals_[this];
-  if (!slot) slot = std::make_unique<PropertySignal>();
-  watch_ |= own_watch;
+  if (!slot) {
+    slot = std::make_unique<PropertySignal>();
+    // Setters take the slow path from the moment the signal has a listener again.
+    slot->on_first_listener([](void* self) { static_cast<SimStateInstance*>(self)->watch_ |= own_watch; },
+                            this);
+  }
   return *slot;
 }
 

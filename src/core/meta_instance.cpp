@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <mutex>
 
@@ -15,15 +16,6 @@ namespace vsd {
 
 namespace detail {
 
-std::uint64_t fnv1a(std::string_view s) noexcept {
-  std::uint64_t h = 14695981039346656037ULL;
-  for (const char c : s) {
-    h ^= static_cast<unsigned char>(c);
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
-
 template <class T>
 void NameTable<T>::build(const std::vector<std::pair<std::string_view, const T*>>& entries) {
   std::size_t cap = 4;
@@ -31,29 +23,18 @@ void NameTable<T>::build(const std::vector<std::pair<std::string_view, const T*>
   entries_.assign(cap, Entry{});
   mask_ = cap - 1;
   for (const auto& [name, item] : entries) {
-    const std::uint64_t h = fnv1a(name);
-    for (std::uint64_t i = h & mask_;; i = (i + 1) & mask_) {
+    const NameKey k(name);
+    for (std::uint64_t i = k.hash & mask_;; i = (i + 1) & mask_) {
       Entry& e = entries_[i];
       if (e.item == nullptr) {
-        e = Entry{h, name, item};
+        e = Entry{k, name, item};
         break;
       }
-      if (e.hash == h && e.name == name) {  // a later entry (subclass, own name) wins
+      if (e.name == name) {  // a later entry (subclass, own name) wins
         e.item = item;
         break;
       }
     }
-  }
-}
-
-template <class T>
-const T* NameTable<T>::find(std::string_view name) const noexcept {
-  if (entries_.empty()) return nullptr;
-  const std::uint64_t h = fnv1a(name);
-  for (std::uint64_t i = h & mask_;; i = (i + 1) & mask_) {
-    const Entry& e = entries_[i];
-    if (e.item == nullptr) return nullptr;
-    if (e.hash == h && e.name == name) return e.item;
   }
 }
 
@@ -152,6 +133,8 @@ void MetaInstance::finish() {
     ancestors_ = base_->ancestors_;
   }
   ancestors_.push_back(this);
+  runtime_chain_.clear();
+  for (const MetaInstance* m = this; m != nullptr && m->runtime_; m = m->base_) runtime_chain_.push_back(m);
   for (std::size_t i = 0; i < own_props_.size(); ++i) {
     own_props_[i]->index_ = props_.size();
     props_.push_back(own_props_[i].get());
@@ -178,8 +161,7 @@ void MetaInstance::finish() {
   method_table_.build(mnames);
 }
 
-const MetaProperty& MetaInstance::property(std::string_view name) const {
-  if (const MetaProperty* p = find_property(name)) return *p;
+void MetaInstance::throw_no_property(std::string_view name) const {
   detail::throw_error("class '" + name_ + "' has no property '" + std::string(name) + "'");
 }
 
@@ -200,8 +182,7 @@ SimStateInstance* MetaInstance::construct(void* memory) const {
   SimStateInstance* obj = builtin_->construct_(memory);
   VSD_ASSERT(static_cast<void*>(obj) == memory, "the SimStateInstance part must start the object");
   // Run-time properties, root-most class first, each from its default value.
-  std::vector<const MetaInstance*> chain;
-  for (const MetaInstance* m = this; m != nullptr && m->runtime_; m = m->base_) chain.push_back(m);
+  const std::vector<const MetaInstance*>& chain = runtime_chain_;
   std::size_t built = 0;
   std::size_t built_class = 0;
   try {
@@ -308,7 +289,7 @@ bool MetaProperty::views_as(const MetaType& wanted) const noexcept {
 }
 
 bool MetaProperty::stores_from(const MetaType& given) const noexcept {
-  return settable_ != nullptr && type_->is_reference() && given.kind() == type_->kind() &&
+  return !flags_.has(ReadOnly) && type_->is_reference() && given.kind() == type_->kind() &&
          given.target() == type_->target();
 }
 

@@ -2,6 +2,7 @@
 #include "vsd/core/sim_state.hpp"
 
 #include <algorithm>
+#include <array>
 
 #include "vsd/core/detail/tx_codec.hpp"
 #include "vsd/core/environment.hpp"
@@ -14,7 +15,7 @@ namespace vsd {
 struct SimState::Dispatch {
   explicit Dispatch(SimState& s) noexcept : s_(s) { ++s_.dispatching_; }
   ~Dispatch() {
-    if (--s_.dispatching_ == 0) s_.free_graveyard();
+    if (--s_.dispatching_ == 0 && !s_.graveyard_.empty()) s_.free_graveyard();
   }
   Dispatch(const Dispatch&) = delete;
   Dispatch& operator=(const Dispatch&) = delete;
@@ -23,6 +24,7 @@ struct SimState::Dispatch {
 
 SimState::SimState(Environment& env, std::string name) : env_(&env), name_(std::move(name)) {
   set_meta(static_meta());
+  property_changed_.on_first_listener(&SimState::watch_hook, this);
   root_ = static_cast<Database*>(&make(Database::static_meta(), 1));
 }
 
@@ -133,7 +135,7 @@ void SimState::destroy(SimStateInstance& x) {
   }
   by_id_.erase(x.id_);
   index_.remove(x);
-  instance_signals_.erase(&x);
+  if (!instance_signals_.empty()) instance_signals_.erase(&x);
   graveyard_.push_back(&x);
 }
 
@@ -165,20 +167,27 @@ void SimState::clear_reference(SimStateInstance& inst, const MetaProperty& p) {
 
 // ---- signals ----------------------------------------------------------------------------------------------
 
+// Watching: an instance's watch_ byte sends its setters down the slow path. It is switched on for every
+// instance when the SimState starts recording or one of its signals gains a first listener (the signals'
+// on_first_listener hook), and switched off lazily, per instance, when a change finds nobody interested.
+
 void SimState::enable_state_watch() {
-  if (state_watch_) return;
   state_watch_ = true;
   for (auto& [id, x] : by_id_) x->watch_ |= SimStateInstance::state_watch;
 }
 
+void SimState::watch_hook(void* state) { static_cast<SimState*>(state)->enable_state_watch(); }
+
 bool SimState::state_watch_wanted() const noexcept {
-  return recording_ || property_changed_.has_listeners() || type_signals_ != 0;
+  if (recording_ || property_changed_.has_listeners()) return true;
+  if (type_signals_ == 0) return false;
+  for (const auto* table : {&type_exact_, &type_tree_})
+    for (const auto& s : *table)
+      if (s && s->has_listeners()) return true;
+  return false;
 }
 
-PropertySignal& SimState::on_property_changed() {
-  enable_state_watch();
-  return property_changed_;
-}
+PropertySignal& SimState::on_property_changed() { return property_changed_; }
 
 PropertySignal& SimState::on_property_changed(const MetaInstance& type, bool include_subtypes) {
   auto& table = include_subtypes ? type_tree_ : type_exact_;
@@ -186,9 +195,9 @@ PropertySignal& SimState::on_property_changed(const MetaInstance& type, bool inc
   auto& slot = table[type.index()];
   if (!slot) {
     slot = std::make_unique<PropertySignal>();
+    slot->on_first_listener(&SimState::watch_hook, this);
     ++type_signals_;
   }
-  enable_state_watch();
   return *slot;
 }
 
@@ -200,6 +209,7 @@ PropertySignal* SimState::type_signal(const MetaInstance& m, bool tree) const no
 }
 
 void SimState::emit_property(SimStateInstance& inst, const MetaProperty& p) {
+  // Collect first, emit after: a listener may delete the instance or disconnect anyone.
   PropertySignal* own = nullptr;
   if ((inst.watch_ & SimStateInstance::own_watch) != 0) {
     auto it = instance_signals_.find(&inst);
@@ -209,16 +219,38 @@ void SimState::emit_property(SimStateInstance& inst, const MetaProperty& p) {
       inst.watch_ &= static_cast<std::uint8_t>(~SimStateInstance::own_watch);
     }
   }
-  if (!state_watch_wanted()) state_watch_ = false;
-  if (!state_watch_) inst.watch_ &= static_cast<std::uint8_t>(~SimStateInstance::state_watch);
-  if (own != nullptr) own->emit(inst, p);
-  if (!state_watch_) return;
+  PropertySignal* exact = nullptr;
+  std::array<PropertySignal*, 8> tree{};  // subtree listeners of the first ancestors
+  std::size_t trees = 0;
+  bool deep = false;  // more ancestors with listeners than the array holds
   if (type_signals_ != 0) {
-    if (PropertySignal* s = type_signal(inst.meta(), false)) s->emit(inst, p);
-    for (const MetaInstance* m = &inst.meta(); m != nullptr; m = m->base())
-      if (PropertySignal* s = type_signal(*m, true)) s->emit(inst, p);
+    exact = type_signal(inst.meta(), false);
+    for (const MetaInstance* m = &inst.meta(); m != nullptr; m = m->base()) {
+      if (PropertySignal* s = type_signal(*m, true)) {
+        if (trees < tree.size()) {
+          tree[trees++] = s;
+        } else {
+          deep = true;
+        }
+      }
+    }
   }
-  property_changed_.emit(inst, p);
+  const bool state_wide = property_changed_.has_listeners();
+  if (own == nullptr && exact == nullptr && trees == 0 && !state_wide && !recording_) {
+    // Nobody is interested in this instance: back to the fast path until a signal gains a listener.
+    inst.watch_ &= static_cast<std::uint8_t>(~SimStateInstance::state_watch);
+    if (state_watch_ && !state_watch_wanted()) state_watch_ = false;
+    return;
+  }
+  if (own != nullptr) own->emit(inst, p);
+  if (exact != nullptr) exact->emit(inst, p);
+  for (std::size_t i = 0; i < trees; ++i) tree[i]->emit(inst, p);
+  if (deep) {
+    std::size_t seen = 0;
+    for (const MetaInstance* m = &inst.meta(); m != nullptr; m = m->base())
+      if (PropertySignal* s = type_signal(*m, true); s != nullptr && ++seen > tree.size()) s->emit(inst, p);
+  }
+  if (state_wide) property_changed_.emit(inst, p);
 }
 
 void SimState::property_changed(SimStateInstance& inst, const MetaProperty& p, const void* old_value) {

@@ -125,6 +125,33 @@ TEST_F(SimStateTest, DisconnectingStopsNotificationAndTheFastPathReturns) {
   EXPECT_EQ(n, 1);
 }
 
+// Setters leave the slow path lazily when nobody listens; a listener connected later through a signal
+// reference kept from before must switch it on again.
+TEST_F(SimStateTest, ListenersConnectedThroughAKeptSignalAreCalled) {
+  auto& r = state.create<TRobot>();
+  auto& other = state.create<TRobot>();
+  vsd::PropertySignal& own = r.on_changed();
+  vsd::PropertySignal& all = state.on_property_changed();
+  vsd::PropertySignal& robots = state.on_property_changed(TRobot::static_meta());
+  int first = 0;
+  {
+    auto c = own.connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++first; });
+    r.set_speed(2.0);
+  }
+  r.set_speed(3.0);  // nobody listens: the instance goes back to the fast path
+  other.set_speed(3.0);
+  int own_calls = 0, all_calls = 0, robot_calls = 0;
+  auto c1 = own.connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++own_calls; });
+  auto c2 = all.connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++all_calls; });
+  auto c3 = robots.connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++robot_calls; });
+  r.set_speed(4.0);
+  other.set_speed(4.0);
+  EXPECT_EQ(first, 1);
+  EXPECT_EQ(own_calls, 1);
+  EXPECT_EQ(all_calls, 2);
+  EXPECT_EQ(robot_calls, 2);
+}
+
 TEST_F(SimStateTest, AListenerMayDeleteTheInstanceItIsToldAbout) {
   auto& r = state.create<TRobot>();
   auto& other = state.create<TRobot>();

@@ -20,9 +20,11 @@ inline constexpr Id null_id = 0;
 #if defined(__GNUC__) || defined(__clang__)
 #define VSD_LIKELY(x) __builtin_expect(!!(x), 1)
 #define VSD_UNLIKELY(x) __builtin_expect(!!(x), 0)
+#define VSD_NOINLINE __attribute__((noinline, cold))
 #else
 #define VSD_LIKELY(x) (x)
 #define VSD_UNLIKELY(x) (x)
+#define VSD_NOINLINE
 #endif
 
 /// @brief Checks an invariant of vsd itself (a bug in vsd when it fires, never bad user input).

@@ -98,11 +98,17 @@ class SimStateInstance : public Instance {
   void set(std::string_view name, const Value& v);
   template <class T>
   [[nodiscard]] const T& get(std::string_view name) const {
-    return meta().property(name).template get<T>(*this);
+    const MetaProperty& p = meta().property(name);  // of this instance's class: no owner check needed
+    if (VSD_UNLIKELY(p.get_tag_ != detail::tag_of<T>()) && !p.views_as(meta_type<T>()))
+      p.throw_type(meta_type<T>());
+    return *static_cast<const T*>(p.address(*this));
   }
   template <class T>
   void set(std::string_view name, const T& v) {
-    meta().property(name).template set<T>(*this, v);
+    const MetaProperty& p = meta().property(name);
+    if (VSD_UNLIKELY(p.set_tag_ != detail::tag_of<T>()) && !p.stores_from(meta_type<T>()))
+      p.throw_set(meta_type<T>());
+    assign_at(*static_cast<T*>(const_cast<void*>(p.address(*this))), v, p);
   }
 
   // ---- reference lists ----
@@ -127,7 +133,7 @@ class SimStateInstance : public Instance {
     if (VSD_LIKELY(watch_ == 0)) {
       field = v;
     } else {
-      assign_watched(field, v, prop());
+      assign_slow<T>(field, v, prop);
     }
   }
 
@@ -146,8 +152,20 @@ class SimStateInstance : public Instance {
     if (VSD_LIKELY(watch_ == 0)) {
       field = v;
     } else {
-      assign_watched(field, v, p);
+      assign_slow<T>(field, v, p);
     }
+  }
+  // The observed store, kept out of the callers' loops: they pay a compare and a branch, nothing more.
+  // Small values travel in registers, so the fast path never spills them for the slow one's sake.
+  template <class T>
+  using SlowArg = std::conditional_t<std::is_trivially_copyable_v<T> && sizeof(T) <= 16, T, const T&>;
+  template <class T>
+  VSD_NOINLINE void assign_slow(T& field, SlowArg<T> v, const MetaProperty& (*prop)()) {
+    assign_watched(field, static_cast<const T&>(v), prop());
+  }
+  template <class T>
+  VSD_NOINLINE void assign_slow(T& field, SlowArg<T> v, const MetaProperty& p) {
+    assign_watched(field, static_cast<const T&>(v), p);
   }
   template <class T>
   void assign_watched(T& field, const T& v, const MetaProperty& p) {
@@ -176,8 +194,9 @@ class SimStateInstance : public Instance {
 // ---- MetaProperty templates that need SimStateInstance ----
 
 template <class T>
-void MetaProperty::set(SimStateInstance& obj, const T& v) const {
-  if (VSD_UNLIKELY(settable_ != &meta_type<T>()) && !stores_from(meta_type<T>())) throw_set(meta_type<T>());
+inline void MetaProperty::set(SimStateInstance& obj, const T& v) const {
+  if (VSD_UNLIKELY(set_tag_ != detail::tag_of<T>()) && !stores_from(meta_type<T>()))
+    throw_set(meta_type<T>());
   if (VSD_UNLIKELY(!instance_fits(obj))) throw_owner(obj);
   obj.assign_at(*static_cast<T*>(const_cast<void*>(address(obj))), v, *this);
 }

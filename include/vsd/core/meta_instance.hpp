@@ -13,6 +13,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <span>
 #include <string>
@@ -29,23 +30,63 @@ class SimStateInstance;
 class Registry;
 
 namespace detail {
-/// Open-addressing name table: a power-of-two array of (hash, pointer), hashed with FNV-1a.
+
+/// A name as two 64-bit words that together cover all its bytes (overlapping loads for short names):
+/// equal words and lengths mean equal names up to 16 bytes, without a call to memcmp.
+struct NameKey {
+  std::uint64_t first = 0;
+  std::uint64_t last = 0;
+  std::uint64_t hash = 0;
+
+  explicit NameKey(std::string_view s) noexcept {
+    const char* p = s.data();
+    const std::size_t n = s.size();
+    if (n >= 8) {
+      std::memcpy(&first, p, 8);
+      std::memcpy(&last, p + n - 8, 8);
+    } else if (n >= 4) {
+      std::uint32_t a, b;
+      std::memcpy(&a, p, 4);
+      std::memcpy(&b, p + n - 4, 4);
+      first = a;
+      last = b;
+    } else if (n > 0) {
+      first = static_cast<unsigned char>(p[0]) | (std::uint64_t{static_cast<unsigned char>(p[n / 2])} << 8) |
+              (std::uint64_t{static_cast<unsigned char>(p[n - 1])} << 16);
+    }
+    std::uint64_t h = (first ^ (n * 0x9E3779B97F4A7C15ULL)) * 0xBF58476D1CE4E5B9ULL;
+    h = (h ^ (h >> 31) ^ last) * 0x94D049BB133111EBULL;
+    hash = h ^ (h >> 29);
+  }
+};
+
+/// Open-addressing name table: a power-of-two array of (key, name, item). A lookup of a name of up to
+/// 16 bytes is a hash of two words and, usually, one probe.
 template <class T>
 class NameTable {
  public:
   void build(const std::vector<std::pair<std::string_view, const T*>>& entries);
-  [[nodiscard]] const T* find(std::string_view name) const noexcept;
+  [[nodiscard]] const T* find(std::string_view name) const noexcept {
+    if (mask_ == 0) return nullptr;
+    const NameKey k(name);
+    for (std::uint64_t i = k.hash & mask_;; i = (i + 1) & mask_) {
+      const Entry& e = entries_[i];
+      if (e.item == nullptr) return nullptr;
+      if (e.key.hash == k.hash && e.name.size() == name.size() && e.key.first == k.first &&
+          e.key.last == k.last && (name.size() <= 16 || e.name == name))
+        return e.item;
+    }
+  }
 
  private:
   struct Entry {
-    std::uint64_t hash = 0;
+    NameKey key{std::string_view{}};
     std::string_view name;
     const T* item = nullptr;
   };
   std::vector<Entry> entries_;
   std::uint64_t mask_ = 0;
 };
-std::uint64_t fnv1a(std::string_view s) noexcept;
 }  // namespace detail
 
 class MetaInstance {
@@ -100,7 +141,10 @@ class MetaInstance {
     return prop_table_.find(name);
   }
   /// @brief The property named @p name; throws vsd::Error naming the class when there is none.
-  [[nodiscard]] const MetaProperty& property(std::string_view name) const;
+  [[nodiscard]] const MetaProperty& property(std::string_view name) const {
+    if (const MetaProperty* p = find_property(name)) return *p;
+    throw_no_property(name);
+  }
   [[nodiscard]] const MetaMethod* find_method(std::string_view name) const noexcept {
     return method_table_.find(name);
   }
@@ -131,6 +175,7 @@ class MetaInstance {
   friend class Registry;
   MetaInstance(std::string name, const MetaInstance& base, bool abstract);  // run-time class
   void finish();
+  [[noreturn]] void throw_no_property(std::string_view name) const;
   void link_to_base();
   void unlink_from_base() noexcept;
 
@@ -151,6 +196,7 @@ class MetaInstance {
   std::vector<const MetaMethod*> methods_;
   std::vector<const MetaProperty*> slots_;
   std::vector<const MetaInstance*> ancestors_;
+  std::vector<const MetaInstance*> runtime_chain_;  // run-time classes from this one up, most derived first
   detail::NameTable<MetaProperty> prop_table_;
   detail::NameTable<MetaMethod> method_table_;
   std::vector<const MetaInstance*> derived_;

@@ -28,7 +28,8 @@ class MetaProperty {
                Value default_value)
       : name_(std::move(name)),
         type_(&type),
-        settable_(flags.has(ReadOnly) ? nullptr : &type),
+        get_tag_(type.cpp_tag()),
+        set_tag_(flags.has(ReadOnly) ? nullptr : type.cpp_tag()),
         flags_(flags),
         offset_(offset),
         default_(std::move(default_value)) {}
@@ -60,7 +61,8 @@ class MetaProperty {
   /// @brief The value as a T; throws vsd::Error when T is not the property's type.
   template <class T>
   [[nodiscard]] const T& get(const SimStateInstance& obj) const {
-    if (VSD_UNLIKELY(type_ != &meta_type<T>()) && !views_as(meta_type<T>())) throw_type(meta_type<T>());
+    if (VSD_UNLIKELY(get_tag_ != detail::tag_of<T>()) && !views_as(meta_type<T>()))
+      throw_type(meta_type<T>());
     if (VSD_UNLIKELY(!instance_fits(obj))) throw_owner(obj);
     return *static_cast<const T*>(address(obj));
   }
@@ -81,6 +83,7 @@ class MetaProperty {
 
  private:
   friend class MetaInstance;
+  friend class SimStateInstance;
   [[nodiscard]] bool instance_fits(const SimStateInstance& obj) const noexcept;
   // A reference type made at run time and the C++ one of the same kind and target (or, for reading, a
   // base of the target) are interchangeable: same layout, same ops.
@@ -93,7 +96,8 @@ class MetaProperty {
 
   std::string name_;
   const MetaType* type_;
-  const MetaType* settable_;  // type_, or nullptr when ReadOnly: one compare checks both
+  const void* get_tag_;  // type_->cpp_tag(): the check of a typed read is one compare with a constant
+  const void* set_tag_;  // the same, or null when ReadOnly: one compare checks both
   PropertyFlags flags_;
   std::size_t offset_;
   Value default_;

@@ -105,6 +105,11 @@ class MetaType {
   [[nodiscard]] std::size_t size() const noexcept { return size_; }
   [[nodiscard]] std::size_t alignment() const noexcept { return align_; }
   [[nodiscard]] const TypeOps& ops() const noexcept { return *ops_; }
+  /// @brief Identity of the C++ type behind this MetaType (null for types made at run time).
+  [[nodiscard]] const void* cpp_tag() const noexcept { return tag_; }
+  /// @brief True when this is the MetaType of C++ type T (cheap: no call).
+  template <class T>
+  [[nodiscard]] bool is() const noexcept;
 
   [[nodiscard]] bool is_reference() const noexcept { return kind_ >= TypeKind::Ref; }
   [[nodiscard]] bool is_ref_list() const noexcept {
@@ -171,6 +176,10 @@ class MetaType {
     fields_.push_back(std::move(f));
     return *this;
   }
+  MetaType& set_cpp_tag(const void* tag) noexcept {
+    tag_ = tag;
+    return *this;
+  }
   MetaType& set_unsigned(bool u) noexcept {
     unsigned_ = u;
     return *this;
@@ -196,12 +205,20 @@ class MetaType {
   std::size_t align_;
   TypeKind kind_;
   bool unsigned_ = false;
+  const void* tag_ = nullptr;
   std::vector<EnumValue> enum_values_;
   std::vector<Field> fields_;
   const MetaType* element_ = nullptr;
   const MetaInstance* target_ = nullptr;
   const MetaInstance& (*target_fn_)() = nullptr;
 };
+
+namespace detail {
+/// One object per C++ type whose address identifies the type at compile time: type checks on hot paths
+/// compare against a constant instead of calling meta_type<T>().
+template <class T>
+inline constexpr char type_tag{};
+}  // namespace detail
 
 template <class T>
 struct TypeTraits;  // specialised below for built-in types; user types use the ADL hook vsd_meta_type(T*)
@@ -229,7 +246,21 @@ using CanonicalInt = std::conditional_t<
     std::conditional_t<sizeof(T) == 1, std::uint8_t,
                        std::conditional_t<sizeof(T) == 2, std::uint16_t,
                                           std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>>>>;
+/// The tag a C++ type's MetaType carries (integers of one representation share one).
+template <class T>
+constexpr const void* tag_of() noexcept {
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+    return &type_tag<CanonicalInt<T>>;
+  } else {
+    return &type_tag<T>;
+  }
+}
 }  // namespace detail
+
+template <class T>
+bool MetaType::is() const noexcept {
+  return tag_ == detail::tag_of<T>();
+}
 
 /// @brief The MetaType of C++ type T (built-in, or declared with VSD_ENUM / VSD_FLAGS / VSD_STRUCT).
 template <class T>
@@ -331,6 +362,7 @@ struct ValueOps {
 template <class T>
 MetaType make_type(std::string name, TypeKind kind) {
   MetaType t(std::move(name), kind, sizeof(T), alignof(T), ValueOps<T>::table);
+  t.set_cpp_tag(tag_of<T>());
   if constexpr (std::is_enum_v<T>) {
     t.set_unsigned(std::is_unsigned_v<std::underlying_type_t<T>>);
   } else if constexpr (std::is_integral_v<T>) {

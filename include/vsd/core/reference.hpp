@@ -215,6 +215,7 @@ MetaType make_ref_type(std::string_view prefix, TypeKind kind) {
   MetaType t(std::string(prefix) + "<" + std::string(T::vsd_class_name) + ">", kind, sizeof(R), alignof(R),
              kind == TypeKind::Ref || kind == TypeKind::SharedRef ? ref_ops : ref_list_ops);
   t.set_target(+[]() -> const MetaInstance& { return T::static_meta(); });
+  t.set_cpp_tag(tag_of<R>());
   return t;
 }
 }  // namespace detail

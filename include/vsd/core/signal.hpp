@@ -4,8 +4,8 @@
  *  A signal keeps its listeners in one small array and calls them in a tight loop. Emitting with no
  *  listener costs one well-predicted branch, and emitting never allocates. Listeners may connect and
  *  disconnect any listener (themselves included) while the signal is being emitted: a disconnected slot
- *  is blanked at once and swept away when the outermost emit returns; a slot connected during an emit is
- *  first called by the next emit.
+ *  is blanked at once and swept away when the outermost emit returns; a slot connected during an emit
+ *  waits aside and is first called by the next emit.
  *
  *  Lifetime: a Connection may outlive its Signal (disconnecting then does nothing) and a Signal may be
  *  destroyed from inside one of its own listeners. Signals and connections belong to one thread at a
@@ -29,23 +29,28 @@ namespace detail {
 /// that a connection can outlive its signal and a signal can die in the middle of its own emit.
 struct SignalCore {
   struct Slot {
-    void (*fn)() =
-        nullptr;  // type-erased thunk (void(*)() is the generic function pointer); null once disconnected
+    void (*fn)() = nullptr;  // type-erased thunk (void(*)() is the generic function pointer)
     void* ctx = nullptr;
     void (*drop)(void*) = nullptr;  // destroys a heap-held functor, if any
     std::uint32_t id = 0;
+    bool dead = false;  // disconnected during an emit: fn is the signal's no-op until the sweep
   };
-  std::vector<Slot> slots;
-  void** live = nullptr;  // the owning signal's "live" pointer, null once the signal is gone
+  std::vector<Slot> slots;            // never reallocated while an emit walks it
+  std::vector<Slot> pending;          // connected during an emit; joins `slots` when the outermost emit ends
+  void** live = nullptr;              // the owning signal's "live" pointer, null once the signal is gone
+  void (*noop)() = nullptr;           // a thunk that does nothing, for slots blanked during an emit
+  void (*on_first)(void*) = nullptr;  // called when the signal gains a listener after having none
+  void* on_first_ctx = nullptr;
   std::uint32_t refs = 1;
   std::uint32_t depth = 0;  // nesting of emits in progress
   std::uint32_t next_id = 1;
-  bool dirty = false;
+  bool dirty = false;  // blanked or pending slots to tidy up after the emit
 
   void update_live() noexcept;
   void disconnect(std::uint32_t id) noexcept;
-  void sweep() noexcept;
+  void finish_dispatch() noexcept;  // after the outermost emit: tidy up, or free an orphaned core
   void release() noexcept;
+  [[nodiscard]] bool has(std::uint32_t id) const noexcept;
   ~SignalCore();
 };
 
@@ -119,8 +124,10 @@ class Signal<void(Args...)> {
   /// @brief Number of connected listeners.
   [[nodiscard]] std::size_t size() const noexcept {
     std::size_t n = 0;
-    if (core_ != nullptr)
-      for (const auto& s : core_->slots) n += s.fn != nullptr ? 1 : 0;
+    if (core_ != nullptr) {
+      for (const auto& s : core_->slots) n += s.dead ? 0 : 1;
+      for (const auto& s : core_->pending) n += s.dead ? 0 : 1;
+    }
     return n;
   }
 
@@ -134,6 +141,14 @@ class Signal<void(Args...)> {
     return add(thunk, held, [](void* p) { delete static_cast<Fn*>(p); });
   }
 
+  /// @brief Calls @p hook(@p ctx) whenever the signal gains a listener after having none. The owner of
+  /// the signal uses it to switch on work that is only worth doing while somebody listens.
+  void on_first_listener(void (*hook)(void*), void* ctx) {
+    core();
+    core_->on_first = hook;
+    core_->on_first_ctx = ctx;
+  }
+
   /// @brief Connects a member function of @p object without allocating: `sig.connect<&C::on_x>(obj)`.
   template <auto Member, class C>
   Connection connect(C& object) {
@@ -142,33 +157,46 @@ class Signal<void(Args...)> {
   }
 
  private:
+  static void noop(void*, Args...) {}
+
+  detail::SignalCore* core() {
+    if (core_ == nullptr) {
+      core_ = new detail::SignalCore;
+      core_->live = reinterpret_cast<void**>(&live_);
+      core_->noop = reinterpret_cast<void (*)()>(static_cast<Thunk>(&noop));
+    }
+    return core_;
+  }
+
   Connection add(Thunk thunk, void* ctx, void (*drop)(void*)) {
-    if (core_ == nullptr) core_ = new detail::SignalCore;
-    core_->live = reinterpret_cast<void**>(&live_);
-    const std::uint32_t id = core_->next_id++;
-    core_->slots.push_back({reinterpret_cast<void (*)()>(thunk), ctx, drop, id});
-    core_->update_live();
-    return Connection{core_, id};
+    detail::SignalCore* c = core();
+    const bool first = live_ == nullptr;
+    const std::uint32_t id = c->next_id++;
+    const detail::SignalCore::Slot slot{reinterpret_cast<void (*)()>(thunk), ctx, drop, id};
+    if (c->depth > 0) {  // an emit is walking `slots`: do not move it under its feet
+      c->pending.push_back(slot);
+      c->dirty = true;
+    } else {
+      c->slots.push_back(slot);
+    }
+    c->update_live();
+    if (first && c->on_first != nullptr) c->on_first(c->on_first_ctx);
+    return Connection{c, id};
   }
 
   void dispatch(Args... args) const {
     detail::SignalCore* core = core_;
-    struct Depth {
+    struct Depth {  // a core whose signal died during the emit is freed by the outermost one
       detail::SignalCore* c;
       ~Depth() {
-        if (--c->depth == 0) {
-          if (c->dirty) c->sweep();
-          c->release();
-        }
+        if (--c->depth == 0 && (c->dirty || c->refs == 0)) c->finish_dispatch();
       }
     };
-    if (core->depth++ == 0) ++core->refs;  // keep the core alive even if the signal dies meanwhile
+    ++core->depth;
     Depth guard{core};
-    const std::size_t n = core->slots.size();  // listeners connected during this emit wait for the next
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& slot = core->slots[i];
-      if (slot.fn != nullptr) reinterpret_cast<Thunk>(slot.fn)(slot.ctx, args...);
-    }
+    // No test per slot: a slot disconnected during an emit calls a no-op until it is swept.
+    for (const auto *s = core->slots.data(), *end = s + core->slots.size(); s != end; ++s)
+      reinterpret_cast<Thunk>(s->fn)(s->ctx, args...);
   }
 
   detail::SignalCore* core_ = nullptr;

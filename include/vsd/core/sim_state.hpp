@@ -118,6 +118,7 @@ class SimState : public Instance {
   void detach_link(detail::RefLink& link);
   void clear_reference(SimStateInstance& inst, const MetaProperty& p);
   void enable_state_watch();
+  static void watch_hook(void* state);
   bool state_watch_wanted() const noexcept;
   void property_changed(SimStateInstance& inst, const MetaProperty& p, const void* old_value);
   void list_changed(SimStateInstance& holder, const MetaProperty& p, std::size_t index,

@@ -77,7 +77,7 @@ class Value {
   /// @brief True when this holds a T.
   template <class T>
   [[nodiscard]] bool is() const noexcept {
-    return type_ == &meta_type<T>();
+    return type_ != nullptr && type_->template is<T>();
   }
   /// @brief The held T, or nullptr when this holds something else.
   template <class T>
