@@ -23,13 +23,19 @@ std::size_t ElementIndex::count(const MetaInstance& m, bool include_subtypes) co
 
 ElementIndex::InstanceSignal& ElementIndex::on_created(const MetaInstance& m, bool include_subtypes) {
   auto& slot = include_subtypes ? bucket(m).created_tree : bucket(m).created_exact;
-  if (!slot) slot = std::make_unique<InstanceSignal>();
+  if (!slot) {
+    slot = std::make_unique<InstanceSignal>();
+    ++signals_;
+  }
   return *slot;
 }
 
 ElementIndex::InstanceSignal& ElementIndex::on_deleted(const MetaInstance& m, bool include_subtypes) {
   auto& slot = include_subtypes ? bucket(m).deleted_tree : bucket(m).deleted_exact;
-  if (!slot) slot = std::make_unique<InstanceSignal>();
+  if (!slot) {
+    slot = std::make_unique<InstanceSignal>();
+    ++signals_;
+  }
   return *slot;
 }
 
@@ -64,10 +70,12 @@ std::vector<ElementIndex::InstanceSignal*> ElementIndex::listeners(const SimStat
 }
 
 void ElementIndex::emit_created(SimStateInstance& i) {
+  if (signals_ == 0) return;
   for (InstanceSignal* s : listeners(i, true)) s->emit(i);
 }
 
 void ElementIndex::emit_deleted(SimStateInstance& i) {
+  if (signals_ == 0) return;
   for (InstanceSignal* s : listeners(i, false)) s->emit(i);
 }
 

@@ -32,11 +32,11 @@ SimState::~SimState() {
   ++applying_;  // no cascades while tearing down
   // First cut every reference to every instance (free references outside become null), so that the
   // instances can then be freed in any order.
-  for (auto& [id, x] : by_id_) {
+  by_id_.for_each([](Id, SimStateInstance* x) {
     while (x->composite_head_ != nullptr) x->composite_head_->drop();
     while (x->shared_head_ != nullptr) x->shared_head_->drop();
-  }
-  for (auto& [id, x] : by_id_) x->meta().destroy(x);
+  });
+  by_id_.for_each([](Id, SimStateInstance* x) { x->meta().destroy(x); });
   by_id_.clear();
   free_graveyard();
 }
@@ -58,7 +58,7 @@ SimStateInstance& SimState::make(const MetaInstance& cls, Id id) {
     detail::throw_error("class '" + cls.name() + "' is abstract and cannot be instantiated");
   if (root_ != nullptr && cls.is_a(Database::static_meta()))
     detail::throw_error("SimState '" + name_ + "' already has its Database");
-  if (by_id_.count(id) != 0)
+  if (by_id_.contains(id))
     detail::throw_error("SimState '" + name_ + "' already has an instance #" + std::to_string(id));
   void* memory = ::operator new(cls.size(), std::align_val_t(cls.alignment()));
   SimStateInstance* obj = nullptr;
@@ -71,7 +71,7 @@ SimStateInstance& SimState::make(const MetaInstance& cls, Id id) {
   obj->state_ = this;
   obj->id_ = id;
   obj->watch_ = state_watch_ ? SimStateInstance::state_watch : 0;
-  by_id_.emplace(id, obj);
+  by_id_.insert(id, obj);
   index_.add(*obj);
   return *obj;
 }
@@ -95,14 +95,14 @@ SimStateInstance& SimState::create(const MetaInstance& cls) {
 SimStateInstance& SimState::create(std::string_view cls) { return create(env_->registry().get_class(cls)); }
 
 SimStateInstance* SimState::find(Id id) const noexcept {
-  auto it = by_id_.find(id);
-  return it == by_id_.end() || it->second->is_being_deleted() ? nullptr : it->second;
+  SimStateInstance* x = by_id_.find(id);
+  return x == nullptr || x->is_being_deleted() ? nullptr : x;
 }
 
 std::vector<SimStateInstance*> SimState::instances() const {
   std::vector<SimStateInstance*> out;
   out.reserve(by_id_.size());
-  for (const auto& [id, x] : by_id_) out.push_back(x);
+  by_id_.for_each([&](Id, SimStateInstance* x) { out.push_back(x); });
   std::sort(out.begin(), out.end(), [](auto* a, auto* b) { return a->id() < b->id(); });
   return out;
 }
@@ -173,7 +173,7 @@ void SimState::clear_reference(SimStateInstance& inst, const MetaProperty& p) {
 
 void SimState::enable_state_watch() {
   state_watch_ = true;
-  for (auto& [id, x] : by_id_) x->watch_ |= SimStateInstance::state_watch;
+  by_id_.for_each([](Id, SimStateInstance* x) { x->watch_ |= SimStateInstance::state_watch; });
 }
 
 void SimState::watch_hook(void* state) { static_cast<SimState*>(state)->enable_state_watch(); }

@@ -348,7 +348,7 @@ class Applier {
             cls->is_a(Database::static_meta()))
           fail(op, n, "class '" + cls->name() + "' cannot be instantiated here");
         if (op.id == null_id || class_of(op.id) != nullptr ||
-            (created_.count(op.id) == 0 && deleted_.count(op.id) == 0 && s_.by_id_.count(op.id) != 0))
+            (created_.count(op.id) == 0 && deleted_.count(op.id) == 0 && s_.by_id_.contains(op.id)))
           fail(op, n, "instance #" + std::to_string(op.id) + " already exists");
         for (const auto& [name, bytes] : op.values) {
           TxOp sub = op;

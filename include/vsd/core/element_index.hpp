@@ -63,6 +63,7 @@ class ElementIndex {
   void emit_deleted(SimStateInstance& i);
 
   std::vector<Bucket> buckets_;  // indexed by MetaInstance::index()
+  std::size_t signals_ = 0;      // per-type signals made so far
 };
 
 }  // namespace vsd

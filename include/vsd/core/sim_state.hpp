@@ -16,11 +16,12 @@
 #include <memory>
 #include <string>
 #include <string_view>
-#include <unordered_map>
+#include <unordered_map>  // instance_signals_
 #include <vector>
 
 #include "vsd/core/database.hpp"
 #include "vsd/core/declare.hpp"
+#include "vsd/core/detail/id_map.hpp"
 #include "vsd/core/element_index.hpp"
 #include "vsd/core/transaction.hpp"
 
@@ -131,7 +132,7 @@ class SimState : public Instance {
   Environment* env_;
   std::string name_;
   Database* root_ = nullptr;
-  std::unordered_map<Id, SimStateInstance*> by_id_;
+  detail::IdMap by_id_;
   ElementIndex index_;
   InstanceSignal created_;
   InstanceSignal deleted_;

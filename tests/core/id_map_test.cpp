@@ -1,0 +1,52 @@
+#include "vsd/core/detail/id_map.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <unordered_map>
+
+namespace {
+
+vsd::SimStateInstance* fake(std::uint64_t n) { return reinterpret_cast<vsd::SimStateInstance*>(n * 16 + 16); }
+
+TEST(IdMap, AgreesWithAStandardMapUnderRandomInsertsAndErases) {
+  vsd::detail::IdMap map;
+  std::unordered_map<vsd::Id, vsd::SimStateInstance*> model;
+  std::mt19937_64 rng(7);
+  for (int step = 0; step < 200000; ++step) {
+    // Dense ids (as an Environment hands out) plus some far apart ones (other sites).
+    const vsd::Id id = (rng() % 4 == 0) ? (rng() % 8 + 1) << 48 | rng() % 64 : rng() % 3000 + 1;
+    if (rng() % 3 == 0) {
+      map.erase(id);
+      model.erase(id);
+    } else {
+      const bool fresh = model.emplace(id, fake(id)).second;
+      EXPECT_EQ(map.insert(id, fake(id)), fresh);
+    }
+    if (step % 997 == 0) {
+      ASSERT_EQ(map.size(), model.size());
+      for (const auto& [k, v] : model) ASSERT_EQ(map.find(k), v) << "id " << k;
+    }
+  }
+  std::size_t seen = 0;
+  map.for_each([&](vsd::Id k, vsd::SimStateInstance* v) {
+    ++seen;
+    EXPECT_EQ(model.at(k), v);
+  });
+  EXPECT_EQ(seen, model.size());
+  EXPECT_EQ(map.find(999999999), nullptr);
+}
+
+TEST(IdMap, EraseOfAMissingIdChangesNothing) {
+  vsd::detail::IdMap map;
+  map.erase(5);
+  EXPECT_TRUE(map.insert(5, fake(5)));
+  EXPECT_FALSE(map.insert(5, fake(6)));
+  map.erase(6);
+  EXPECT_EQ(map.size(), 1u);
+  EXPECT_EQ(map.find(5), fake(5));
+  map.clear();
+  EXPECT_EQ(map.find(5), nullptr);
+}
+
+}  // namespace
