@@ -1,7 +1,8 @@
 /** @file
  *  @brief Value: an owning, type-erased value of any MetaType — the currency of generic access.
  *
- *  Small values (up to 32 bytes, alignment up to 16) live inside the Value; larger ones on the heap.
+ *  Small values (up to 48 bytes, alignment up to 16: strings, vectors, Eigen vectors and quaternions,
+ *  references) live inside the Value; larger ones (Isometry3d) on the heap.
  *  Generic property access, method calls (vsdMetaCall), scripting and persistence exchange Values.
  */
 #pragma once
@@ -20,7 +21,7 @@ namespace vsd {
 
 class Value {
  public:
-  static constexpr std::size_t inline_size = 32;
+  static constexpr std::size_t inline_size = 48;  // references (48 bytes) and lists of them fit
   static constexpr std::size_t inline_align = 16;
 
   /// @brief An empty value (no type).
