@@ -1,6 +1,7 @@
 // Transaction bundles: encoding, parsing, inversion, and applying with an all-or-nothing check first.
 #include "vsd/core/transaction.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <map>
 #include <unordered_map>
@@ -237,6 +238,8 @@ namespace detail {
 
 /// Applies a bundle to a SimState: a full dry run over a model of the state first, then the real run.
 class Applier {
+  using RefLink = vsd::detail::RefLink;
+
  public:
   Applier(SimState& s, const Transaction& t) : s_(s), t_(t) {}
 
@@ -327,7 +330,9 @@ class Applier {
           check_target(op, n, ids.back(), t);
         }
       } else if (t.is_reference()) {
-        check_target(op, n, r.varint(), t);
+        ids.push_back(r.varint());
+        check_target(op, n, ids.back(), t);
+        if (ids.back() == null_id) ids.clear();
       } else {
         Value v(t);
         t.read_bytes(v.data(), r, nullptr);
@@ -367,6 +372,7 @@ class Applier {
         created_.erase(op.id);
         deleted_.insert(op.id);
         for (auto& [key, ids] : lists_) std::erase(ids, op.id);
+        forget_edges(op.id);
         break;
       }
       case Transaction::Op::Set: {
@@ -376,7 +382,19 @@ class Applier {
         if (p.has(Transient)) fail(op, n, "property '" + p.name() + "' is transient");
         check_value(op, n, p, op.old_value);
         auto ids = check_value(op, n, p, op.new_value);
-        if (p.type().is_ref_list()) list_model(op.id, p) = std::move(ids);
+        if (p.type().is_ref_list()) {
+          auto& list = list_model(op.id, p);
+          if (p.type().is_composite()) {
+            for (Id old : list) remove_edge(op.id, old);
+            for (Id now : ids) add_edge(op, n, op.id, now);
+          }
+          list = std::move(ids);
+        } else if (p.type().is_composite()) {
+          Id& held = single_model(op.id, p);
+          if (held != null_id) remove_edge(op.id, held);
+          held = ids.empty() ? null_id : ids.front();
+          if (held != null_id) add_edge(op, n, op.id, held);
+        }
         break;
       }
       case Transaction::Op::Insert:
@@ -393,15 +411,78 @@ class Applier {
             fail(op, n,
                  "index " + std::to_string(op.index) + " is past the end (size " +
                      std::to_string(ids.size()) + ")");
+          if (p.type().is_composite()) add_edge(op, n, op.id, op.target);
           ids.insert(ids.begin() + static_cast<std::ptrdiff_t>(op.index), op.target);
         } else {
           if (op.index >= ids.size() || ids[op.index] != op.target)
             fail(op, n, "#" + std::to_string(op.target) + " is not at index " + std::to_string(op.index));
           ids.erase(ids.begin() + static_cast<std::ptrdiff_t>(op.index));
+          if (p.type().is_composite()) remove_edge(op.id, op.target);
         }
         break;
       }
     }
+  }
+
+  // ---- composite edges: the dry run rejects a bundle that would make an instance its own ancestor ----
+
+  Id& single_model(Id holder, const MetaProperty& p) {
+    auto key = std::make_pair(holder, &p);
+    if (auto it = singles_.find(key); it != singles_.end()) return it->second;
+    Id now = null_id;
+    if (created_.count(holder) == 0)
+      if (const SimStateInstance* x = s_.find(holder)) now = static_cast<const RefBase*>(p.address(*x))->id();
+    if (deleted_.count(now) != 0) now = null_id;
+    return singles_.emplace(key, now).first->second;
+  }
+  // The instances holding @p child compositely, one entry per reference, as the bundle has left them.
+  std::vector<Id> holders_of(Id child) const {
+    std::vector<Id> out;
+    if (deleted_.count(child) != 0) return out;
+    if (created_.count(child) == 0)
+      if (const SimStateInstance* x = s_.find(child))
+        for (const RefLink* l = x->composite_head_; l != nullptr; l = l->next)
+          if (l->holder != nullptr) out.push_back(l->holder->id());
+    if (auto it = removed_up_.find(child); it != removed_up_.end())
+      for (Id h : it->second)
+        if (auto at = std::find(out.begin(), out.end(), h); at != out.end()) out.erase(at);
+    if (auto it = added_up_.find(child); it != added_up_.end())
+      out.insert(out.end(), it->second.begin(), it->second.end());
+    std::erase_if(out, [&](Id h) { return deleted_.count(h) != 0; });
+    return out;
+  }
+  bool holds_up(Id from, Id goal) const {  // is goal a composite ancestor of from (or from itself)?
+    std::vector<Id> todo{from};
+    std::unordered_set<Id> seen;
+    while (!todo.empty()) {
+      const Id x = todo.back();
+      todo.pop_back();
+      if (x == goal) return true;
+      if (!seen.insert(x).second) continue;
+      for (Id h : holders_of(x)) todo.push_back(h);
+    }
+    return false;
+  }
+  void add_edge(const TxOp& op, std::size_t n, Id holder, Id child) {
+    if (holds_up(holder, child))
+      fail(op, n,
+           "a composite reference from #" + std::to_string(holder) + " to #" + std::to_string(child) +
+               " would make an instance its own ancestor");
+    added_up_[child].push_back(holder);
+  }
+  void remove_edge(Id holder, Id child) {
+    auto& added = added_up_[child];
+    if (auto at = std::find(added.begin(), added.end(), holder); at != added.end()) {
+      added.erase(at);
+    } else {
+      removed_up_[child].push_back(holder);
+    }
+  }
+  void forget_edges(Id gone) {  // a deleted instance neither holds nor is held any more
+    added_up_.erase(gone);
+    removed_up_.erase(gone);
+    for (auto& [child, holders] : added_up_) std::erase(holders, gone);
+    std::erase_if(singles_, [&](const auto& e) { return e.first.first == gone; });
   }
 
   Value decode(const MetaProperty& p, std::span<const std::uint8_t> bytes) const {
@@ -454,6 +535,9 @@ class Applier {
   std::unordered_map<Id, const MetaInstance*> created_;
   std::unordered_set<Id> deleted_;
   std::map<std::pair<Id, const MetaProperty*>, std::vector<Id>> lists_;
+  std::map<std::pair<Id, const MetaProperty*>, Id> singles_;
+  std::unordered_map<Id, std::vector<Id>> added_up_;    // child -> composite holders gained so far
+  std::unordered_map<Id, std::vector<Id>> removed_up_;  // child -> real composite holders lost so far
 };
 
 }  // namespace detail

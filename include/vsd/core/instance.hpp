@@ -27,6 +27,9 @@
 namespace vsd {
 
 class SimState;
+namespace detail {
+class Applier;
+}  // namespace detail
 
 class Instance {
  public:
@@ -143,6 +146,7 @@ class SimStateInstance : public Instance {
   friend class MetaInstance;
   friend class ElementIndex;
   friend struct detail::RefAccess;
+  friend class detail::Applier;
   static constexpr std::uint8_t dying_bit = 1;
   static constexpr std::uint8_t own_watch = 1;    // this instance has listeners
   static constexpr std::uint8_t state_watch = 2;  // its SimState records or has listeners
