@@ -41,6 +41,13 @@ std::vector<SimState*> Environment::states() const {
 
 Id Environment::next_id() noexcept { return next_id_.fetch_add(1, std::memory_order_relaxed); }
 
+void Environment::reserve_ids_through(Id id) noexcept {
+  if ((id >> 48) != site_) return;  // another site's ids never meet ours
+  Id current = next_id_.load(std::memory_order_relaxed);
+  while (current <= id && !next_id_.compare_exchange_weak(current, id + 1, std::memory_order_relaxed)) {
+  }
+}
+
 Module* Environment::find_module(std::type_index t) const noexcept {
   for (const auto& [type, m] : modules_)
     if (type == t) return m.get();

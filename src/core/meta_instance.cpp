@@ -256,6 +256,12 @@ ClassBuilder& ClassBuilder::method(std::string name, std::vector<const MetaType*
   return *this;
 }
 
+ClassBuilder& ClassBuilder::alias(std::string old_name) {
+  if (meta_->own_props_.empty()) detail::throw_error("alias '" + old_name + "' given before any property");
+  meta_->own_props_.back()->add_alias(std::move(old_name));
+  return *this;
+}
+
 ClassBuilder& ClassBuilder::set_abstract(bool abstract) {
   meta_->abstract_ = abstract;
   return *this;

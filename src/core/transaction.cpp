@@ -74,12 +74,55 @@ void write_set(std::vector<std::uint8_t>& out, const SimStateInstance& inst, con
 
 void write_list(std::vector<std::uint8_t>& out, Transaction::Op op, Id holder, const MetaProperty& p,
                 std::size_t index, Id target) {
+  write_list(out, op, holder, p.name(), index, target);
+}
+
+void write_list(std::vector<std::uint8_t>& out, Transaction::Op op, Id holder, std::string_view prop,
+                std::size_t index, Id target) {
   ByteWriter w(out);
   w.u8(static_cast<std::uint8_t>(op));
   w.varint(holder);
-  w.string(p.name());
+  w.string(prop);
   w.varint(index);
   w.varint(target);
+}
+
+namespace {
+void write_span_framed(std::vector<std::uint8_t>& out, std::span<const std::uint8_t> s) {
+  ByteWriter w(out);
+  w.fixed(static_cast<std::uint32_t>(s.size()));
+  w.raw(s.data(), s.size());
+}
+}  // namespace
+
+void write_create(std::vector<std::uint8_t>& out, Id id, std::string_view cls,
+                  std::span<const TxValue> values) {
+  ByteWriter w(out);
+  w.u8(static_cast<std::uint8_t>(Transaction::Op::Create));
+  w.varint(id);
+  w.string(cls);
+  w.varint(values.size());
+  for (const auto& [name, bytes] : values) {
+    w.string(name);
+    write_span_framed(out, bytes);
+  }
+}
+
+void write_set(std::vector<std::uint8_t>& out, Id id, std::string_view prop,
+               std::span<const std::uint8_t> old_value, std::span<const std::uint8_t> new_value) {
+  ByteWriter w(out);
+  w.u8(static_cast<std::uint8_t>(Transaction::Op::Set));
+  w.varint(id);
+  w.string(prop);
+  write_span_framed(out, old_value);
+  write_span_framed(out, new_value);
+}
+
+Transaction make_transaction(std::vector<std::uint8_t> bytes, std::size_t ops) {
+  Transaction t;
+  t.bytes_ = std::move(bytes);
+  t.ops_ = ops;
+  return t;
 }
 
 }  // namespace detail

@@ -42,6 +42,9 @@ class Environment : public Instance {
   [[nodiscard]] std::vector<SimState*> states() const;
   /// @brief A fresh id, unique in this environment. Thread-safe.
   [[nodiscard]] Id next_id() noexcept;
+  /// @brief Makes sure next_id() never hands out @p id or a smaller id of this site (instances that
+  /// arrive with their ids, e.g. from a file, keep them). Thread-safe.
+  void reserve_ids_through(Id id) noexcept;
 
   /// @brief Uses module M: on first use registers its types and attaches it. Returns the module.
   template <class M, class... A>

@@ -221,6 +221,9 @@ class ClassBuilder {
   ClassBuilder& method(std::string name, std::vector<const MetaType*> arguments, const MetaType* result,
                        MetaMethod::Invoker fn);
   ClassBuilder& set_abstract(bool abstract = true);
+  /// @brief Lets the last added property also be found as @p old_name (a property that was renamed:
+  /// files and bundles that use the old name still load).
+  ClassBuilder& alias(std::string old_name);
   /// @brief Builds the class and registers it.
   /// @throws vsd::Error on a duplicate class or property name, or a property whose default has the
   /// wrong type.

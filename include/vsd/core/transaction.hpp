@@ -20,6 +20,11 @@
 
 namespace vsd {
 
+class Transaction;
+namespace detail {
+Transaction make_transaction(std::vector<std::uint8_t> bytes, std::size_t ops);
+}  // namespace detail
+
 class Transaction {
  public:
   enum class Op : std::uint8_t { Create = 1, Delete = 2, Set = 3, Insert = 4, Erase = 5 };
@@ -44,7 +49,7 @@ class Transaction {
 
  private:
   friend class SimState;
-  friend class TransactionWriter;
+  friend Transaction detail::make_transaction(std::vector<std::uint8_t> bytes, std::size_t ops);
   std::vector<std::uint8_t> bytes_;
   std::size_t ops_ = 0;
 };

@@ -24,6 +24,16 @@ void write_set(std::vector<std::uint8_t>& out, const SimStateInstance& inst, con
                const void* old_value, const void* new_value);
 void write_list(std::vector<std::uint8_t>& out, Transaction::Op op, Id holder, const MetaProperty& p,
                 std::size_t index, Id target);
+/// A bundle made from raw parts (loaders): values are the binary form of each property's type.
+using TxValue = std::pair<std::string_view, std::span<const std::uint8_t>>;
+void write_create(std::vector<std::uint8_t>& out, Id id, std::string_view cls, std::span<const TxValue> values);
+void write_set(std::vector<std::uint8_t>& out, Id id, std::string_view prop, std::span<const std::uint8_t> old_value,
+               std::span<const std::uint8_t> new_value);
+void write_list(std::vector<std::uint8_t>& out, Transaction::Op op, Id holder, std::string_view prop,
+                std::size_t index, Id target);
+/// A Transaction holding @p bytes (header included) with @p ops operations, unchecked (apply checks).
+Transaction make_transaction(std::vector<std::uint8_t> bytes, std::size_t ops);
+
 /// True for the properties a transaction carries in Create/Delete payloads and compares.
 bool carried_in_payload(const MetaProperty& p) noexcept;
 

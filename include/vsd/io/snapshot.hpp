@@ -1,0 +1,73 @@
+/** @file
+ *  @brief Binary snapshots: save a SimState (or one subtree) and load it into an empty state or under
+ *  a node of an existing one.
+ *
+ *  What is written is decided by the meta-information: every Savable, non-Transient property of every
+ *  instance, references by id, and the definitions of the run-time classes the instances use (so a
+ *  program that never defined them can load the file, inspect it and save it again).
+ *
+ *  Format "VSDS", version 1: a class table (name, run-time definition if any, the saved properties by
+ *  name and type name), then the instances (id, class, one length-framed value per saved property in
+ *  each property type's binary form), then the top-level node ids.
+ *
+ *  Loading is all or nothing: the file is read and checked into a Transaction bundle, which the target
+ *  SimState checks again (ids, classes, values, reference targets, list positions, composite cycles)
+ *  before it changes anything. A malformed, truncated or hostile file gets a vsd::Error with the byte
+ *  offset and what was wrong; the target state is exactly as before. Schema evolution: a property the
+ *  class no longer has is reported (LoadReport::warnings) and dropped; one the file lacks keeps its
+ *  default; a renamed one is found through the class's aliases (MetaProperty::add_alias); a value whose
+ *  type changed converts when the number fits, and is reported otherwise.
+ */
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vsd/core.hpp"
+
+namespace vsd::io {
+
+/// @brief What a save wrote.
+struct SaveReport {
+  std::size_t instances = 0;
+  /// References to instances outside a saved subtree; they are written as null.
+  std::size_t cut_references = 0;
+};
+
+/// @brief What a load did.
+struct LoadReport {
+  std::size_t instances = 0;
+  /// The nodes that were top level in the file (the subtree root, or the Database's children), now
+  /// attached to the target.
+  std::vector<Node*> roots;
+  /// Run-time classes the file defined that this program did not know.
+  std::vector<std::string> defined_classes;
+  /// Schema differences found and handled: unknown properties, changed types.
+  std::vector<std::string> warnings;
+};
+
+/// @brief The whole state as a snapshot.
+std::vector<std::uint8_t> save_bytes(const SimState& state, SaveReport* report = nullptr);
+/// @brief @p root and everything it holds compositely (children, extensions, composite references).
+std::vector<std::uint8_t> save_bytes(const Node& root, SaveReport* report = nullptr);
+
+/// @brief Loads a whole-state snapshot into @p state, which must be empty; ids are kept.
+LoadReport load_bytes(SimState& state, std::span<const std::uint8_t> bytes,
+                      std::string_view origin = "snapshot");
+/// @brief Loads a snapshot under @p parent; instances get fresh ids of @p parent's Environment.
+LoadReport load_bytes(Node& parent, std::span<const std::uint8_t> bytes,
+                      std::string_view origin = "snapshot");
+
+/// @brief save_bytes() written with write_file_atomically().
+SaveReport save(const SimState& state, const std::filesystem::path& path);
+SaveReport save(const Node& root, const std::filesystem::path& path);
+/// @brief load_bytes() of a file; errors name the file.
+LoadReport load(SimState& state, const std::filesystem::path& path);
+LoadReport load(Node& parent, const std::filesystem::path& path);
+
+}  // namespace vsd::io

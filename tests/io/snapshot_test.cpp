@@ -1,0 +1,299 @@
+#include "vsd/io/snapshot.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "../core/test_classes.hpp"
+#include "vsd/io/file.hpp"
+
+using testing::HasSubstr;
+using vsd_test::TRobot;
+using vsd_test::TSensor;
+using vsd_test::TTool;
+
+namespace {
+
+class IoPlain : public vsd::Node {
+  VSD_INSTANCE(IoPlain, vsd::Node)
+  VSD_PROPERTY(double, saved, 1.0, vsd::Savable)
+  VSD_PROPERTY(double, not_saved, 2.0, vsd::Editable)
+};
+
+// A model with every kind of value and reference.
+void build_model(vsd::SimState& s) {
+  auto& cell = s.create<vsd::Node>();
+  cell.set_name("cell");
+  s.database().add_child(cell);
+  auto& r = s.create<TRobot>();
+  r.set_name("arm");
+  r.set_speed(2.5);
+  r.set_joints({0.1, -0.2, 0.3});
+  Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
+  f.translate(Eigen::Vector3d(1, 2, 3));
+  r.set_frame(f);
+  cell.add_child(r);
+  auto& tool = s.create<TTool>();
+  tool.set_length(0.25);
+  r.set_tool(&tool);  // composite, not a child
+  auto& goal = s.create<vsd::Node>();
+  goal.set_name("goal");
+  cell.add_child(goal);
+  r.set_target(&goal);  // shared, pointing forward in id order from nothing
+  auto& sensor = s.create<TSensor>();
+  sensor.set_range(9);
+  r.add_extension(sensor);
+  const vsd::MetaProperty& watched = TRobot::vsd_prop_watched();
+  r.list_insert(watched, 0, goal);
+  r.list_insert(watched, 1, cell);
+  s.database().set_name("world");
+}
+
+std::string diff_of(const vsd::SimState& a, const vsd::SimState& b) {
+  std::string d;
+  return a.equals(b, &d) ? std::string() : d;
+}
+
+TEST(Snapshot, WholeStateRoundTripKeepsIdsAndEverything) {
+  vsd::Environment env;
+  build_model(env.main_state());
+  const auto bytes = vsd::io::save_bytes(env.main_state());
+  auto& copy = env.create_state("copy");
+  const vsd::io::LoadReport report = vsd::io::load_bytes(copy, bytes);
+  EXPECT_EQ(diff_of(env.main_state(), copy), "");
+  EXPECT_EQ(report.instances, env.main_state().size() - 1);
+  ASSERT_EQ(report.roots.size(), 1u);
+  EXPECT_EQ(report.roots[0]->name(), "cell");
+  EXPECT_TRUE(report.warnings.empty());
+  EXPECT_EQ(vsd_test::check_reference_counts(copy), "");
+  EXPECT_EQ(vsd::io::save_bytes(copy), bytes) << "saving what was loaded gives the same bytes";
+}
+
+TEST(Snapshot, LoadedIdsAreNeverHandedOutAgain) {
+  vsd::Environment source;
+  build_model(source.main_state());
+  for (int i = 0; i < 50; ++i) source.main_state().create<vsd::Node>();
+  const auto bytes = vsd::io::save_bytes(source.main_state());
+  vsd::Environment target;  // a fresh environment whose counter starts low
+  vsd::io::load_bytes(target.main_state(), bytes);
+  for (int i = 0; i < 100; ++i) target.main_state().create<vsd::Node>();  // must not clash
+  EXPECT_EQ(target.main_state().size(), source.main_state().size() + 100);
+}
+
+TEST(Snapshot, LoadingUnderANodeGivesFreshIds) {
+  vsd::Environment env;
+  build_model(env.main_state());
+  const auto bytes = vsd::io::save_bytes(env.main_state());
+  vsd::SimState& s = env.main_state();
+  auto& holder = s.create<vsd::Node>();
+  holder.set_name("imports");
+  s.database().add_child(holder);
+  const auto first = vsd::io::load_bytes(holder, bytes);
+  const auto second = vsd::io::load_bytes(holder, bytes);
+  ASSERT_EQ(holder.children().size(), 2u);
+  EXPECT_NE(first.roots[0]->id(), second.roots[0]->id());
+  auto* arm = static_cast<TRobot*>(second.roots[0]->find_child("arm"));
+  ASSERT_NE(arm, nullptr);
+  EXPECT_EQ(arm->target().get(), second.roots[0]->find_child("goal")) << "references follow the new ids";
+  EXPECT_EQ(arm->tool()->length(), 0.25);
+  EXPECT_EQ(s.database().name(), "world") << "a load under a node leaves the Database's values alone";
+  EXPECT_EQ(vsd_test::check_reference_counts(s), "");
+}
+
+TEST(Snapshot, SubtreesCutOutsideReferences) {
+  vsd::Environment env;
+  build_model(env.main_state());
+  vsd::SimState& s = env.main_state();
+  auto* arm = static_cast<TRobot*>(s.database().find_child("cell")->find_child("arm"));
+  vsd::io::SaveReport saved;
+  const auto bytes = vsd::io::save_bytes(*arm, &saved);
+  EXPECT_EQ(saved.instances, 3u);       // arm, its tool, its sensor
+  EXPECT_EQ(saved.cut_references, 3u);  // target and two watched nodes lie outside
+  auto& other = env.create_state("other");
+  const auto report = vsd::io::load_bytes(other, bytes);
+  ASSERT_EQ(report.roots.size(), 1u);
+  auto& loaded = static_cast<TRobot&>(*report.roots[0]);
+  EXPECT_EQ(loaded.parent(), &other.database());
+  EXPECT_EQ(loaded.target().get(), nullptr);
+  EXPECT_TRUE(loaded.watched().empty());
+  ASSERT_NE(loaded.tool().get(), nullptr);
+  EXPECT_NE(loaded.find_extension<TSensor>(), nullptr);
+}
+
+TEST(Snapshot, OnlySavablePropertiesAreWritten) {
+  vsd::Environment env;
+  auto& p = env.main_state().create<IoPlain>();
+  p.set_saved(5);
+  p.set_not_saved(6);
+  env.main_state().database().add_child(p);
+  auto& copy = env.create_state("copy");
+  vsd::io::load_bytes(copy, vsd::io::save_bytes(env.main_state()));
+  auto* q = copy.find<IoPlain>(p.id());
+  ASSERT_NE(q, nullptr);
+  EXPECT_EQ(q->saved(), 5);
+  EXPECT_EQ(q->not_saved(), 2) << "not Savable: the default";
+}
+
+TEST(Snapshot, RunTimeClassesTravelWithTheFile) {
+  std::vector<std::uint8_t> bytes;
+  {
+    const vsd::MetaInstance& belt = vsd::ClassBuilder("IoBelt", vsd::Node::static_meta())
+                                        .property<double>("speed", 0.5)
+                                        .property<std::string>("label", std::string("none"))
+                                        .define();
+    const vsd::MetaInstance& fast = vsd::ClassBuilder("IoFastBelt", belt).property<int>("lanes", 2).define();
+    vsd::Environment env;
+    auto& b = static_cast<vsd::Node&>(env.main_state().create(fast));
+    b.set("speed", vsd::Value(3.0));
+    b.set("label", vsd::Value("express"));
+    env.main_state().database().add_child(b);
+    bytes = vsd::io::save_bytes(env.main_state());
+  }
+  vsd::Registry::global().undefine(vsd::Registry::global().get_class("IoFastBelt"));
+  vsd::Registry::global().undefine(vsd::Registry::global().get_class("IoBelt"));
+  // This "program" does not know IoBelt: the file defines it.
+  vsd::Environment env;
+  const auto report = vsd::io::load_bytes(env.main_state(), bytes);
+  EXPECT_THAT(report.defined_classes, testing::ElementsAre("IoBelt", "IoFastBelt"));
+  ASSERT_EQ(report.roots.size(), 1u);
+  EXPECT_EQ(report.roots[0]->get<double>("speed"), 3.0);
+  EXPECT_EQ(report.roots[0]->get<std::string>("label"), "express");
+  EXPECT_EQ(report.roots[0]->get<int>("lanes"), 2);
+  EXPECT_EQ(vsd::io::save_bytes(env.main_state()), bytes) << "loaded and saved again: unchanged";
+  env.main_state().destroy(*report.roots[0]);
+  vsd::Registry::global().undefine(vsd::Registry::global().get_class("IoFastBelt"));
+  vsd::Registry::global().undefine(vsd::Registry::global().get_class("IoBelt"));
+}
+
+TEST(Snapshot, SchemaEvolution) {
+  std::vector<std::uint8_t> bytes;
+  {
+    const vsd::MetaInstance& v1 = vsd::ClassBuilder("IoEvolving", vsd::Node::static_meta())
+                                      .property<int>("speed", 0)
+                                      .property<double>("gone", 0.0)
+                                      .property<std::string>("colour", std::string())
+                                      .define();
+    vsd::Environment env;
+    auto& x = env.main_state().create(v1);
+    x.set("speed", vsd::Value(4));
+    x.set("gone", vsd::Value(1.5));
+    x.set("colour", vsd::Value("red"));
+    env.main_state().database().add_child(static_cast<vsd::Node&>(x));
+    bytes = vsd::io::save_bytes(env.main_state());
+    env.main_state().destroy(x);
+    vsd::Registry::global().undefine(v1);
+  }
+  // Version 2: speed renamed to velocity and now a double, gone removed, colour became a number, added new.
+  const vsd::MetaInstance& v2 = vsd::ClassBuilder("IoEvolving", vsd::Node::static_meta())
+                                    .property<double>("velocity", 0.0)
+                                    .alias("speed")
+                                    .property<double>("colour", 0.0)
+                                    .property<double>("added", 7.0)
+                                    .define();
+  {
+    vsd::Environment env;
+    const auto report = vsd::io::load_bytes(env.main_state(), bytes);
+    ASSERT_EQ(report.roots.size(), 1u);
+    vsd::Node& x = *report.roots[0];
+    EXPECT_EQ(x.get<double>("velocity"), 4.0);
+    EXPECT_EQ(x.get<double>("added"), 7.0);
+    EXPECT_EQ(x.get<double>("colour"), 0.0);
+    EXPECT_THAT(report.warnings, testing::UnorderedElementsAre(
+                                     HasSubstr("changed from int32 to double: values are converted"),
+                                     HasSubstr("no property 'gone'"),
+                                     HasSubstr("changed from string to double: saved values are dropped")));
+    env.main_state().destroy(x);
+  }
+  vsd::Registry::global().undefine(v2);
+}
+
+class HostileSnapshot : public testing::Test {
+ protected:
+  void SetUp() override {
+    build_model(source.main_state());
+    bytes = vsd::io::save_bytes(source.main_state());
+  }
+  // Loads @p bad into a fresh state; returns the error, checking that the state was left untouched.
+  std::string load_error(const std::vector<std::uint8_t>& bad) {
+    vsd::Environment env;
+    try {
+      vsd::io::load_bytes(env.main_state(), bad, "model.vsds");
+    } catch (const vsd::Error& e) {
+      EXPECT_EQ(env.main_state().size(), 1u) << "a rejected file must change nothing";
+      return e.what();
+    }
+    return "<loaded>";
+  }
+  vsd::Environment source;
+  std::vector<std::uint8_t> bytes;
+};
+
+TEST_F(HostileSnapshot, EveryTruncationIsRejectedWithAPosition) {
+  for (std::size_t n = 0; n < bytes.size(); ++n) {
+    const std::string e =
+        load_error(std::vector<std::uint8_t>(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n)));
+    EXPECT_THAT(e, HasSubstr("model.vsds: ")) << n;
+    EXPECT_THAT(e, HasSubstr("byte ")) << n;
+  }
+}
+
+TEST_F(HostileSnapshot, CorruptionNeverCrashesOrHalfLoads) {
+  std::mt19937 rng(99);
+  int loaded = 0;
+  for (int round = 0; round < 3000; ++round) {
+    auto bad = bytes;
+    const int flips = 1 + static_cast<int>(rng() % 4);
+    for (int k = 0; k < flips; ++k) bad[rng() % bad.size()] = static_cast<std::uint8_t>(rng());
+    if (load_error(bad) == "<loaded>") ++loaded;  // a flip inside a number may still be a valid file
+  }
+  EXPECT_LT(loaded, 3000);
+}
+
+TEST_F(HostileSnapshot, HeaderAndVersion) {
+  auto bad = bytes;
+  bad[0] = 'X';
+  EXPECT_THAT(load_error(bad), HasSubstr("byte 0: not a vsd snapshot"));
+  bad = bytes;
+  bad[4] = 9;
+  EXPECT_THAT(load_error(bad), HasSubstr("byte 4: snapshot format version 9"));
+}
+
+TEST_F(HostileSnapshot, AbsurdSizesDoNotAllocate) {
+  std::vector<std::uint8_t> bad(bytes.begin(), bytes.begin() + 6);  // header, then a huge class count
+  for (int i = 0; i < 9; ++i) bad.push_back(0xFF);
+  bad.push_back(0x01);
+  EXPECT_THAT(load_error(bad), HasSubstr("exceeds"));
+}
+
+TEST_F(HostileSnapshot, UnknownClassesAndDanglingReferences) {
+  auto bad = bytes;
+  auto at = std::search(bad.begin(), bad.end(), std::begin("TRobot"), std::end("TRobot") - 1);
+  ASSERT_NE(at, bad.end());
+  *at = 'Q';
+  EXPECT_THAT(load_error(bad), HasSubstr("unknown class 'QRobot'"));
+}
+
+TEST(SnapshotState, WholeStateLoadNeedsAnEmptyState) {
+  vsd::Environment env;
+  build_model(env.main_state());
+  const auto bytes = vsd::io::save_bytes(env.main_state());
+  EXPECT_THAT([&] { vsd::io::load_bytes(env.main_state(), bytes); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("needs an empty SimState")));
+}
+
+TEST(SnapshotFiles, SaveAndLoadThroughFiles) {
+  vsd::Environment env;
+  build_model(env.main_state());
+  const auto path =
+      std::filesystem::temp_directory_path() / ("vsd_snapshot_test_" + std::to_string(::getpid()));
+  vsd::io::save(env.main_state(), path);
+  auto& copy = env.create_state("copy");
+  vsd::io::load(copy, path);
+  EXPECT_EQ(diff_of(env.main_state(), copy), "");
+  std::filesystem::remove(path);
+  EXPECT_THAT([&] { vsd::io::load(copy, path); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("cannot open")));
+}
+
+}  // namespace
