@@ -131,47 +131,48 @@ Transaction make_transaction(std::vector<std::uint8_t> bytes, std::size_t ops) {
 namespace vsd {
 namespace detail {
 
-std::vector<TxOp> parse_tx(const Transaction& t) {
-  const auto& b = t.bytes();
+TxParser::TxParser(const Transaction& t) : bytes_(&t.bytes()), pos_(t.bytes().empty() ? 0 : header_size) {}
+
+bool TxParser::next(TxOp& op) {
+  const auto& b = *bytes_;
+  if (pos_ >= b.size()) return false;
   ByteReader r(b.data(), b.size());
-  std::vector<TxOp> ops;
-  if (b.empty()) return ops;
-  r.skip(header_size);
-  while (!r.at_end()) {
-    TxOp op;
-    op.offset = r.position();
-    const std::uint8_t code = r.u8();
-    if (code < 1 || code > 5) {
-      ByteReader at(b.data(), b.size());
-      at.skip(op.offset);
-      at.fail("unknown operation code " + std::to_string(code));
-    }
-    op.op = static_cast<Transaction::Op>(code);
-    op.id = r.varint();
-    op.name = r.string_view();
-    switch (op.op) {
-      case Transaction::Op::Create:
-      case Transaction::Op::Delete: {
-        const std::size_t n = r.size_prefix(6);  // a name and a frame take at least 6 bytes
-        op.values.reserve(n);
-        for (std::size_t i = 0; i < n; ++i) {
-          const auto name = r.string_view();
-          op.values.emplace_back(name, read_framed(r));
-        }
-        break;
+  r.skip(pos_);
+  op.offset = r.position();
+  op.values.clear();
+  const std::uint8_t code = r.u8();
+  if (code < 1 || code > 5) r.fail_at(op.offset, "unknown operation code " + std::to_string(code));
+  op.op = static_cast<Transaction::Op>(code);
+  op.id = r.varint();
+  op.name = r.string_view();
+  switch (op.op) {
+    case Transaction::Op::Create:
+    case Transaction::Op::Delete: {
+      const std::size_t n = r.size_prefix(6);  // a name and a frame take at least 6 bytes
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto name = r.string_view();
+        op.values.emplace_back(name, read_framed(r));
       }
-      case Transaction::Op::Set:
-        op.old_value = read_framed(r);
-        op.new_value = read_framed(r);
-        break;
-      case Transaction::Op::Insert:
-      case Transaction::Op::Erase:
-        op.index = r.varint();
-        op.target = r.varint();
-        break;
+      break;
     }
-    ops.push_back(std::move(op));
+    case Transaction::Op::Set:
+      op.old_value = read_framed(r);
+      op.new_value = read_framed(r);
+      break;
+    case Transaction::Op::Insert:
+    case Transaction::Op::Erase:
+      op.index = r.varint();
+      op.target = r.varint();
+      break;
   }
+  pos_ = r.position();
+  return true;
+}
+
+std::vector<TxOp> parse_tx(const Transaction& t) {
+  std::vector<TxOp> ops;
+  TxParser parser(t);
+  for (TxOp op; parser.next(op);) ops.push_back(op);
   return ops;
 }
 
@@ -284,17 +285,24 @@ class Applier {
   using RefLink = vsd::detail::RefLink;
 
  public:
-  Applier(SimState& s, const Transaction& t) : s_(s), t_(t) {}
+  /// @param values_checked the bundle's plain values were checked by its maker (a loader): the dry run
+  /// then checks structure, references and cycles, not every value again.
+  Applier(SimState& s, const Transaction& t, bool values_checked = false)
+      : s_(s), t_(t), values_checked_(values_checked) {}
 
   void run() {
-    const auto ops = parse_tx(t_);
-    for (std::size_t i = 0; i < ops.size(); ++i) check(ops[i], i);
+    TxOp op;  // reused: its storage serves every operation
+    {
+      TxParser parser(t_);
+      for (std::size_t i = 0; parser.next(op); ++i) check(op, i);
+    }
     ++s_.applying_;
     struct Done {
       SimState& s;
       ~Done() { --s.applying_; }
     } done{s_};
-    for (const auto& op : ops) apply(op);
+    TxParser parser(t_);
+    while (parser.next(op)) apply(op);
   }
 
  private:
@@ -323,10 +331,18 @@ class Applier {
     return "?";
   }
 
+  // Bundles create many instances of few classes: remember the last lookup (no lock, no string).
+  const MetaInstance* class_named(std::string_view name) {
+    if (last_class_ != nullptr && name == last_class_->name()) return last_class_;
+    const MetaInstance* c = s_.environment().registry().find_class(name);
+    if (c != nullptr) last_class_ = c;
+    return c;
+  }
+
   // ---- the model used by the dry run ----
   const MetaInstance* class_of(Id id) const {
-    if (deleted_.count(id) != 0) return nullptr;
-    if (auto it = created_.find(id); it != created_.end()) return it->second;
+    if (id == null_id || deleted_.contains(id)) return nullptr;
+    if (const MetaInstance* c = created_.find(id)) return c;
     const SimStateInstance* x = s_.find(id);
     return x != nullptr ? &x->meta() : nullptr;
   }
@@ -335,11 +351,11 @@ class Applier {
     auto it = lists_.find(key);
     if (it != lists_.end()) return it->second;
     std::vector<Id> ids;
-    if (created_.count(holder) == 0) {
+    if (!created_.contains(holder)) {
       if (const SimStateInstance* x = s_.find(holder)) {
         const auto& list = *static_cast<const RefListBase*>(p.address(*x));
         for (std::size_t i = 0; i < list.size(); ++i)
-          if (deleted_.count(list.at(i)->id()) == 0) ids.push_back(list.at(i)->id());
+          if (!deleted_.contains(list.at(i)->id())) ids.push_back(list.at(i)->id());
       }
     }
     return lists_.emplace(key, std::move(ids)).first->second;
@@ -376,6 +392,8 @@ class Applier {
         ids.push_back(r.varint());
         check_target(op, n, ids.back(), t);
         if (ids.back() == null_id) ids.clear();
+      } else if (values_checked_) {
+        return ids;
       } else {
         Value v(t);
         t.read_bytes(v.data(), r, nullptr);
@@ -390,13 +408,13 @@ class Applier {
   void check(const TxOp& op, std::size_t n) {
     switch (op.op) {
       case Transaction::Op::Create: {
-        const MetaInstance* cls = s_.environment().registry().find_class(op.name);
+        const MetaInstance* cls = class_named(op.name);
         if (cls == nullptr) fail(op, n, "unknown class '" + std::string(op.name) + "'");
         if (cls->is_abstract() || !cls->is_a(SimStateInstance::static_meta()) ||
             cls->is_a(Database::static_meta()))
           fail(op, n, "class '" + cls->name() + "' cannot be instantiated here");
         if (op.id == null_id || class_of(op.id) != nullptr ||
-            (created_.count(op.id) == 0 && deleted_.count(op.id) == 0 && s_.by_id_.contains(op.id)))
+            (!created_.contains(op.id) && !deleted_.contains(op.id) && s_.by_id_.contains(op.id)))
           fail(op, n, "instance #" + std::to_string(op.id) + " already exists");
         for (const auto& [name, bytes] : op.values) {
           TxOp sub = op;
@@ -406,14 +424,14 @@ class Applier {
           check_value(op, n, p, bytes);
         }
         deleted_.erase(op.id);
-        created_[op.id] = cls;
+        created_.assign(op.id, cls);
         break;
       }
       case Transaction::Op::Delete: {
         if (op.id == 1) fail(op, n, "the Database cannot be deleted");
         if (class_of(op.id) == nullptr) fail(op, n, "no instance #" + std::to_string(op.id));
         created_.erase(op.id);
-        deleted_.insert(op.id);
+        deleted_.insert(op.id, true);
         for (auto& [key, ids] : lists_) std::erase(ids, op.id);
         forget_edges(op.id);
         break;
@@ -473,61 +491,77 @@ class Applier {
     auto key = std::make_pair(holder, &p);
     if (auto it = singles_.find(key); it != singles_.end()) return it->second;
     Id now = null_id;
-    if (created_.count(holder) == 0)
+    if (!created_.contains(holder))
       if (const SimStateInstance* x = s_.find(holder)) now = static_cast<const RefBase*>(p.address(*x))->id();
-    if (deleted_.count(now) != 0) now = null_id;
+    if (now != null_id && deleted_.contains(now)) now = null_id;
     return singles_.emplace(key, now).first->second;
   }
   // The instances holding @p child compositely, one entry per reference, as the bundle has left them.
-  std::vector<Id> holders_of(Id child) const {
-    std::vector<Id> out;
-    if (deleted_.count(child) != 0) return out;
-    if (created_.count(child) == 0)
+  void holders_of(Id child, std::vector<Id>& out) const {
+    out.clear();
+    if (deleted_.contains(child)) return;
+    if (!created_.contains(child))
       if (const SimStateInstance* x = s_.find(child))
         for (const RefLink* l = x->composite_head_; l != nullptr; l = l->next)
           if (l->holder != nullptr) out.push_back(l->holder->id());
     if (auto it = removed_up_.find(child); it != removed_up_.end())
       for (Id h : it->second)
         if (auto at = std::find(out.begin(), out.end(), h); at != out.end()) out.erase(at);
-    if (auto it = added_up_.find(child); it != added_up_.end())
+    if (const Id first = added_first_.find(child); first != null_id) out.push_back(first);
+    if (auto it = added_more_.find(child); it != added_more_.end())
       out.insert(out.end(), it->second.begin(), it->second.end());
-    std::erase_if(out, [&](Id h) { return deleted_.count(h) != 0; });
-    return out;
+    std::erase_if(out, [&](Id h) { return deleted_.contains(h); });
   }
   bool holds_up(Id from, Id goal) const {  // is goal a composite ancestor of from (or from itself)?
-    std::vector<Id> todo{from};
+    std::vector<Id> todo{from}, up;
     std::unordered_set<Id> seen;
     while (!todo.empty()) {
       const Id x = todo.back();
       todo.pop_back();
       if (x == goal) return true;
       if (!seen.insert(x).second) continue;
-      for (Id h : holders_of(x)) todo.push_back(h);
+      holders_of(x, up);
+      todo.insert(todo.end(), up.begin(), up.end());
     }
     return false;
   }
+  // True when @p id was created by the bundle and has gained no composite reference of its own: then
+  // it cannot be anybody's ancestor.
+  bool holds_nothing(Id id) const { return created_.contains(id) && !holders_.contains(id); }
   void add_edge(const TxOp& op, std::size_t n, Id holder, Id child) {
-    if (holds_up(holder, child))
+    // Most edges of a big bundle point at instances it has just created and that hold nothing yet
+    // (a load builds top down): no walk is needed for them.
+    if (child == holder || (!holds_nothing(child) && holds_up(holder, child)))
       fail(op, n,
            "a composite reference from #" + std::to_string(holder) + " to #" + std::to_string(child) +
                " would make an instance its own ancestor");
-    added_up_[child].push_back(holder);
-  }
-  void remove_edge(Id holder, Id child) {
-    auto& added = added_up_[child];
-    if (auto at = std::find(added.begin(), added.end(), holder); at != added.end()) {
-      added.erase(at);
+    holders_.assign(holder, true);
+    if (Id* first = added_first_.get(child); first == nullptr || *first == null_id) {
+      added_first_.assign(child, holder);
     } else {
-      removed_up_[child].push_back(holder);
+      added_more_[child].push_back(holder);
     }
   }
-  void forget_edges(Id gone) {  // a deleted instance neither holds nor is held any more
-    added_up_.erase(gone);
-    removed_up_.erase(gone);
-    for (auto& [child, holders] : added_up_) std::erase(holders, gone);
-    std::erase_if(singles_, [&](const auto& e) { return e.first.first == gone; });
+  void remove_edge(Id holder, Id child) {
+    if (Id* first = added_first_.get(child); first != nullptr && *first == holder) {
+      *first = null_id;
+      return;
+    }
+    if (auto it = added_more_.find(child); it != added_more_.end())
+      if (auto at = std::find(it->second.begin(), it->second.end(), holder); at != it->second.end()) {
+        it->second.erase(at);
+        return;
+      }
+    removed_up_[child].push_back(holder);
   }
-
+  void forget_edges(Id gone) {  // a deleted instance neither holds nor is held any more
+    added_first_.erase(gone);
+    added_more_.erase(gone);
+    removed_up_.erase(gone);
+    std::erase_if(singles_, [&](const auto& e) { return e.first.first == gone; });
+    // Edges where `gone` is the holder are skipped by holders_of() while it stays deleted; should its
+    // id come back (an undo), such a stale edge can only make the check stricter.
+  }
   Value decode(const MetaProperty& p, std::span<const std::uint8_t> bytes) const {
     StateResolver refs;
     refs.s = &s_;
@@ -540,7 +574,7 @@ class Applier {
   void apply(const TxOp& op) {
     switch (op.op) {
       case Transaction::Op::Create: {
-        const MetaInstance& cls = s_.environment().registry().get_class(op.name);
+        const MetaInstance& cls = *class_named(op.name);  // found by the dry run
         SimStateInstance& x = s_.make(cls, op.id);
         for (const auto& [name, bytes] : op.values) {
           const MetaProperty& p = *cls.find_property(name);
@@ -575,12 +609,16 @@ class Applier {
 
   SimState& s_;
   const Transaction& t_;
-  std::unordered_map<Id, const MetaInstance*> created_;
-  std::unordered_set<Id> deleted_;
+  bool values_checked_;
+  const MetaInstance* last_class_ = nullptr;
+  FlatIdMap<const MetaInstance*> created_;
+  FlatIdMap<bool> deleted_;
   std::map<std::pair<Id, const MetaProperty*>, std::vector<Id>> lists_;
   std::map<std::pair<Id, const MetaProperty*>, Id> singles_;
-  std::unordered_map<Id, std::vector<Id>> added_up_;    // child -> composite holders gained so far
-  std::unordered_map<Id, std::vector<Id>> removed_up_;  // child -> real composite holders lost so far
+  FlatIdMap<Id> added_first_;                           // child -> first composite holder gained
+  std::unordered_map<Id, std::vector<Id>> added_more_;  // child -> further composite holders gained
+  std::unordered_map<Id, std::vector<Id>> removed_up_;  // child -> real composite holders lost
+  FlatIdMap<bool> holders_;                             // instances that gained composite references
 };
 
 }  // namespace detail
@@ -589,5 +627,12 @@ void SimState::apply(const Transaction& t) {
   if (t.empty()) return;
   detail::Applier(*this, t).run();
 }
+
+namespace detail {
+void apply_checked_values(SimState& state, const Transaction& t) {
+  if (t.empty()) return;
+  Applier(state, t, true).run();
+}
+}  // namespace detail
 
 }  // namespace vsd

@@ -3,6 +3,7 @@
 #include "vsd/io/snapshot.hpp"
 
 #include <algorithm>
+#include <deque>
 #include <optional>
 #include <unordered_map>
 #include <unordered_set>
@@ -40,7 +41,8 @@ class SnapshotWriter {
     for (const SimStateInstance* x : members_) class_index(x->meta());
     std::vector<std::uint8_t> out;
     ByteWriter w(out);
-    for (const std::uint8_t b : magic) w.u8(b);  // (w.raw into the empty vector trips a GCC 12 false positive)
+    for (const std::uint8_t b : magic)
+      w.u8(b);  // (w.raw into the empty vector trips a GCC 12 false positive)
     w.u8(format_version);
     w.u8(kind);
     w.varint(classes_.size());
@@ -147,16 +149,18 @@ struct ClassEntry {
 
 struct SavedValue {
   const Slot* slot;
-  std::size_t offset;               // of the frame in the file, for messages
-  std::vector<std::uint8_t> bytes;  // in the property's type (converted where needed); refs: ids as written
-  std::vector<Id> ids;              // reference targets (file ids)
+  std::size_t offset;                   // of the frame in the file, for messages
+  std::span<const std::uint8_t> bytes;  // the value in the property's type: in the file, or converted
+  std::uint32_t ids_first = 0;          // reference targets (file ids): ids_[ids_first, + ids_count)
+  std::uint32_t ids_count = 0;
 };
 
 struct SavedInstance {
   Id id;
   const ClassEntry* entry;
   std::size_t offset;
-  std::vector<SavedValue> values;
+  std::size_t first;  // its values are values_[first, first + count)
+  std::size_t count;
 };
 
 class SnapshotReader {
@@ -216,8 +220,8 @@ class SnapshotReader {
     if (!in_.at_end())
       fail_at(in_.position(), std::to_string(in_.remaining()) + " unexpected bytes after the snapshot");
     for (const SavedInstance& x : instances_)
-      for (const SavedValue& v : x.values)
-        for (Id id : v.ids)
+      for (const SavedValue& v : values_of(x))
+        for (Id id : ids_of(v))
           if (id != null_id && by_id_.count(id) == 0)
             fail_at(v.offset, "dangling reference: #" + std::to_string(x.id) + "." + v.slot->prop->name() +
                                   " names #" + std::to_string(id) + ", which is not in the snapshot");
@@ -259,14 +263,14 @@ class SnapshotReader {
     for (const SavedInstance& x : instances_) {
       if (&x == saved_root) continue;
       std::vector<detail::TxValue> values;
-      for (const SavedValue& v : x.values)
+      for (const SavedValue& v : values_of(x))
         if (v.slot->prop != nullptr && detail::carried_in_payload(*v.slot->prop))
           values.emplace_back(v.slot->prop->name(), v.bytes);
       detail::write_create(bundle, mapped(x.id), x.entry->cls->name(), values);
       ++ops;
     }
     if (saved_root != nullptr && whole) {  // the Database's own values
-      for (const SavedValue& v : saved_root->values) {
+      for (const SavedValue& v : values_of(*saved_root)) {
         if (v.slot->prop == nullptr || !detail::carried_in_payload(*v.slot->prop)) continue;
         std::vector<std::uint8_t> now;
         ByteWriter w(now);
@@ -278,24 +282,25 @@ class SnapshotReader {
     std::vector<Id> tops;
     for (const SavedInstance& x : instances_) {
       if (&x == saved_root && !whole) {  // under a node: the Database's children become top level
-        for (const SavedValue& v : x.values)
+        for (const SavedValue& v : values_of(x))
           if (v.slot->prop == &Node::vsd_prop_children())
-            for (Id id : v.ids) tops.push_back(id);
+            for (Id id : ids_of(v)) tops.push_back(id);
         continue;
       }
-      for (const SavedValue& v : x.values) {
+      for (const SavedValue& v : values_of(x)) {
         if (v.slot->prop == nullptr || !v.slot->prop->type().is_reference() || v.slot->prop->has(Transient))
           continue;
         const MetaProperty& p = *v.slot->prop;
         if (p.type().is_ref_list()) {
-          for (std::size_t i = 0; i < v.ids.size(); ++i) {
-            detail::write_list(bundle, Transaction::Op::Insert, mapped(x.id), p.name(), i, mapped(v.ids[i]));
+          const auto ids = ids_of(v);
+          for (std::size_t i = 0; i < ids.size(); ++i) {
+            detail::write_list(bundle, Transaction::Op::Insert, mapped(x.id), p.name(), i, mapped(ids[i]));
             ++ops;
           }
-        } else if (!v.ids.empty() && v.ids.front() != null_id) {
+        } else if (v.ids_count != 0 && ids_of(v).front() != null_id) {
           std::vector<std::uint8_t> null_bytes, target;
           ByteWriter(null_bytes).varint(null_id);
-          ByteWriter(target).varint(mapped(v.ids.front()));
+          ByteWriter(target).varint(mapped(ids_of(v).front()));
           detail::write_set(bundle, mapped(x.id), p.name(), null_bytes, target);
           ++ops;
         }
@@ -314,7 +319,7 @@ class SnapshotReader {
       tops = top_;
     }
     try {
-      state.apply(detail::make_transaction(std::move(bundle), ops));
+      detail::apply_checked_values(state, detail::make_transaction(std::move(bundle), ops));
     } catch (const Error& e) {
       throw Error(std::string(origin_) + ": the snapshot does not fit SimState '" + state.name() +
                   "': " + e.what());
@@ -430,6 +435,30 @@ class SnapshotReader {
     return {in_.skip(n), n};
   }
 
+  // Checks that a frame holds exactly one value of @p type. Plain numbers need no decoding beyond their size.
+  void check_value(std::size_t frame_at, const MetaType& type, std::span<const std::uint8_t> frame) {
+    const TypeKind k = type.kind();
+    if (k == TypeKind::Int || k == TypeKind::UInt || k == TypeKind::Float || k == TypeKind::Double ||
+        k == TypeKind::Enum || k == TypeKind::Flags) {
+      if (frame.size() != type.size())
+        fail_at(frame_at, "a value of type " + type.name() + " takes " + std::to_string(type.size()) +
+                              " bytes, not " + std::to_string(frame.size()));
+      return;
+    }
+    if (k == TypeKind::String) {  // checked in place: no string is built
+      ByteReader r(frame.data(), frame.size());
+      try {
+        (void)r.string_view();
+        if (!r.at_end()) r.fail(std::to_string(r.remaining()) + " unexpected bytes after the value");
+      } catch (const Error& e) {
+        fail_at(frame_at + 4 + r.position(), std::string("value of type string: ") + e.what());
+      }
+      return;
+    }
+    Value scratch(type);
+    decode_into(frame_at, type, frame, scratch);
+  }
+
   // Decodes one framed value of @p type (no references) into @p out, checking it is exactly one value.
   void decode_into(std::size_t frame_at, const MetaType& type, std::span<const std::uint8_t> frame,
                    Value& out) {
@@ -443,9 +472,18 @@ class SnapshotReader {
     }
   }
 
+  std::span<const Id> ids_of(const SavedValue& v) const {
+    return std::span<const Id>(ids_).subspan(v.ids_first, v.ids_count);
+  }
+
+  std::span<const SavedValue> values_of(const SavedInstance& x) const {
+    return std::span<const SavedValue>(values_).subspan(x.first, x.count);
+  }
+
   SavedInstance read_instance() {
     return guarded([&] {
       SavedInstance x;
+      x.first = values_.size();
       x.offset = in_.position();
       x.id = in_.varint();
       if (x.id == null_id) fail_at(x.offset, "instance id 0 is not valid");
@@ -458,7 +496,7 @@ class SnapshotReader {
         const std::size_t frame_at = in_.position();
         const auto frame = read_frame();
         if (s.prop == nullptr) continue;  // reported once per class
-        SavedValue v{&s, frame_at, {}, {}};
+        SavedValue v{&s, frame_at, {}, static_cast<std::uint32_t>(ids_.size()), 0};
         const MetaType& type = s.prop->type();
         if (type.is_reference()) {
           ByteReader r(frame.data(), frame.size());
@@ -466,11 +504,11 @@ class SnapshotReader {
             if (type.is_ref_list()) {
               const std::size_t n = r.size_prefix(1);
               for (std::size_t i = 0; i < n; ++i) {
-                v.ids.push_back(r.varint());
-                if (v.ids.back() == null_id) r.fail("a reference list cannot hold null");
+                ids_.push_back(r.varint());
+                if (ids_.back() == null_id) r.fail("a reference list cannot hold null");
               }
             } else {
-              v.ids.push_back(r.varint());
+              ids_.push_back(r.varint());
             }
             if (!r.at_end()) r.fail(std::to_string(r.remaining()) + " unexpected bytes after the value");
           } catch (const Error& e) {
@@ -485,15 +523,18 @@ class SnapshotReader {
           } catch (const Error& e) {
             fail_at(frame_at, std::string("value of ") + s.prop->name() + ": " + e.what());
           }
-          ByteWriter w(v.bytes);
+          auto& owned = converted_.emplace_back();  // a deque: earlier values never move
+          ByteWriter w(owned);
           type.write_bytes(converted.data(), w);
+          v.bytes = owned;
         } else {
-          Value check(type);
-          decode_into(frame_at, type, frame, check);
-          v.bytes.assign(frame.begin(), frame.end());
+          check_value(frame_at, type, frame);
+          v.bytes = frame;
         }
-        x.values.push_back(std::move(v));
+        v.ids_count = static_cast<std::uint32_t>(ids_.size() - v.ids_first);
+        values_.push_back(v);
       }
+      x.count = values_.size() - x.first;
       return x;
     });
   }
@@ -510,6 +551,9 @@ class SnapshotReader {
   std::uint8_t kind_ = kind_state;
   std::vector<ClassEntry> classes_;
   std::vector<SavedInstance> instances_;
+  std::vector<SavedValue> values_;  // of all instances, in file order
+  std::vector<Id> ids_;             // reference targets of all values
+  std::deque<std::vector<std::uint8_t>> converted_;
   std::unordered_map<Id, const SavedInstance*> by_id_;
   std::vector<Id> top_;
   std::vector<const MetaInstance*> defined_;

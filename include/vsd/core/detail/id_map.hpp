@@ -1,5 +1,6 @@
 /** @file
- *  @brief Internal: IdMap, a flat open-addressing map from instance id to instance pointer.
+ *  @brief Internal: FlatIdMap, a flat open-addressing map from instance id to a small value (IdMap: to
+ *  the instance pointer).
  *
  *  Linear probing in a power-of-two table kept at most half full, deletion by backward shift (no
  *  tombstones): a lookup is a hash and, almost always, one or two probes; inserting and erasing never
@@ -19,26 +20,30 @@ class SimStateInstance;
 
 namespace vsd::detail {
 
-class IdMap {
+/// Id 0 (null_id) is never a key: it marks empty slots.
+template <class V>
+class FlatIdMap {
  public:
   [[nodiscard]] std::size_t size() const noexcept { return size_; }
 
-  [[nodiscard]] SimStateInstance* find(Id id) const noexcept {
-    if (size_ == 0) return nullptr;
-    for (std::size_t i = slot(id);; i = (i + 1) & mask_) {
-      const Entry& e = table_[i];
-      if (e.value == nullptr) return nullptr;
-      if (e.id == id) return e.value;
-    }
+  /// The value of @p id, or a pointer-like "nothing" (V{}) when absent.
+  [[nodiscard]] V find(Id id) const noexcept {
+    const Entry* e = entry(id);
+    return e != nullptr ? e->value : V{};
   }
-  [[nodiscard]] bool contains(Id id) const noexcept { return find(id) != nullptr; }
+  [[nodiscard]] bool contains(Id id) const noexcept { return entry(id) != nullptr; }
+  /// The stored value of @p id, or nullptr.
+  [[nodiscard]] V* get(Id id) noexcept {
+    return entry(id) != nullptr ? &const_cast<Entry*>(entry(id))->value : nullptr;
+  }
 
   /// Inserts; returns false (and changes nothing) when @p id is present.
-  bool insert(Id id, SimStateInstance* value) {
+  bool insert(Id id, V value) {
+    VSD_ASSERT(id != null_id, "id 0 cannot be a key");
     if ((size_ + 1) * 2 > table_.size()) grow();
     for (std::size_t i = slot(id);; i = (i + 1) & mask_) {
       Entry& e = table_[i];
-      if (e.value == nullptr) {
+      if (e.id == null_id) {
         e = Entry{id, value};
         ++size_;
         return true;
@@ -46,15 +51,23 @@ class IdMap {
       if (e.id == id) return false;
     }
   }
+  /// Inserts or overwrites.
+  void assign(Id id, V value) {
+    if (V* v = get(id)) {
+      *v = value;
+    } else {
+      insert(id, value);
+    }
+  }
 
   /// Removes @p id if present.
   void erase(Id id) noexcept {
     if (size_ == 0) return;
     std::size_t i = slot(id);
-    while (table_[i].value != nullptr && table_[i].id != id) i = (i + 1) & mask_;
-    if (table_[i].value == nullptr) return;
+    while (table_[i].id != null_id && table_[i].id != id) i = (i + 1) & mask_;
+    if (table_[i].id == null_id) return;
     // Backward-shift deletion: pull later entries of the probe run into the hole.
-    for (std::size_t j = (i + 1) & mask_; table_[j].value != nullptr; j = (j + 1) & mask_) {
+    for (std::size_t j = (i + 1) & mask_; table_[j].id != null_id; j = (j + 1) & mask_) {
       const std::size_t home = slot(table_[j].id);
       const bool movable = i <= j ? (home <= i || home > j) : (home <= i && home > j);
       if (movable) {
@@ -76,17 +89,28 @@ class IdMap {
   template <class F>
   void for_each(F&& fn) const {
     for (const Entry& e : table_)
-      if (e.value != nullptr) fn(e.id, e.value);
+      if (e.id != null_id) fn(e.id, e.value);
   }
 
  private:
   struct Entry {
-    Id id = 0;
-    SimStateInstance* value = nullptr;
+    Id id = null_id;
+    V value{};
   };
+  [[nodiscard]] const Entry* entry(Id id) const noexcept {
+    if (size_ == 0) return nullptr;
+    for (std::size_t i = slot(id);; i = (i + 1) & mask_) {
+      const Entry& e = table_[i];
+      if (e.id == null_id) return nullptr;
+      if (e.id == id) return &e;
+    }
+  }
   [[nodiscard]] std::size_t slot(Id id) const noexcept {
-    std::uint64_t h = id * 0x9E3779B97F4A7C15ULL;  // Fibonacci hashing: ids are dense, spread them
-    return static_cast<std::size_t>(h >> 32) & mask_;
+    // Ids of one site are dense and handed out in order: their low bits are already a perfect hash,
+    // and neighbouring ids land in neighbouring slots (instances made together are looked up
+    // together). Only the site (top 16 bits) is mixed in, so that sites do not pile onto one run.
+    const std::uint64_t site = id >> 48;
+    return static_cast<std::size_t>(id ^ (site * 0x9E3779B97F4A7C15ULL)) & mask_;
   }
   void grow() {
     std::vector<Entry> old;
@@ -95,12 +119,15 @@ class IdMap {
     mask_ = table_.size() - 1;
     size_ = 0;
     for (const Entry& e : old)
-      if (e.value != nullptr) insert(e.id, e.value);
+      if (e.id != null_id) insert(e.id, e.value);
   }
 
   std::vector<Entry> table_;
   std::size_t mask_ = 0;
   std::size_t size_ = 0;
 };
+
+/// Instances of a SimState by id.
+using IdMap = FlatIdMap<SimStateInstance*>;
 
 }  // namespace vsd::detail

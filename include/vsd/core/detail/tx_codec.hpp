@@ -11,6 +11,7 @@
 #include "vsd/core/transaction.hpp"
 
 namespace vsd {
+class SimState;
 class SimStateInstance;
 class MetaProperty;
 }  // namespace vsd
@@ -26,13 +27,18 @@ void write_list(std::vector<std::uint8_t>& out, Transaction::Op op, Id holder, c
                 std::size_t index, Id target);
 /// A bundle made from raw parts (loaders): values are the binary form of each property's type.
 using TxValue = std::pair<std::string_view, std::span<const std::uint8_t>>;
-void write_create(std::vector<std::uint8_t>& out, Id id, std::string_view cls, std::span<const TxValue> values);
-void write_set(std::vector<std::uint8_t>& out, Id id, std::string_view prop, std::span<const std::uint8_t> old_value,
-               std::span<const std::uint8_t> new_value);
+void write_create(std::vector<std::uint8_t>& out, Id id, std::string_view cls,
+                  std::span<const TxValue> values);
+void write_set(std::vector<std::uint8_t>& out, Id id, std::string_view prop,
+               std::span<const std::uint8_t> old_value, std::span<const std::uint8_t> new_value);
 void write_list(std::vector<std::uint8_t>& out, Transaction::Op op, Id holder, std::string_view prop,
                 std::size_t index, Id target);
 /// A Transaction holding @p bytes (header included) with @p ops operations, unchecked (apply checks).
 Transaction make_transaction(std::vector<std::uint8_t> bytes, std::size_t ops);
+
+/// SimState::apply for a bundle whose plain values its maker has already checked (loaders): the dry run
+/// still checks ids, classes, properties, references, list positions and cycles.
+void apply_checked_values(SimState& state, const Transaction& t);
 
 /// True for the properties a transaction carries in Create/Delete payloads and compares.
 bool carried_in_payload(const MetaProperty& p) noexcept;
@@ -47,6 +53,19 @@ struct TxOp {
   std::span<const std::uint8_t> old_value, new_value;                              // Set
   std::size_t index = 0;                                                           // Insert/Erase
   Id target = 0;                                                                   // Insert/Erase
+};
+
+/// Reads a bundle's operations one at a time (no list of all of them is built).
+class TxParser {
+ public:
+  explicit TxParser(const Transaction& t);
+  /// Reads the next operation into @p op (reusing its storage); false at the end.
+  /// @throws vsd::Error with the byte offset of malformed data.
+  bool next(TxOp& op);
+
+ private:
+  const std::vector<std::uint8_t>* bytes_;
+  std::size_t pos_ = 0;
 };
 
 /// Parses every operation of a bundle. @throws vsd::Error with the byte offset of malformed data.
