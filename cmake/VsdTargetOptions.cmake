@@ -13,7 +13,12 @@ function(vsd_target_options target)
     if(VSD_WERROR)
       target_compile_options(${target} PRIVATE -Werror)
     endif()
-    if(VSD_SANITIZE)
+    if(VSD_BUILD_FUZZERS)
+      # Coverage for libFuzzer in every vsd target; the fuzzers themselves link the fuzzer runtime.
+      target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer
+                                               -fno-sanitize-recover=all)
+      target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+    elseif(VSD_SANITIZE)
       target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
                                                -fno-sanitize-recover=all)
       target_link_options(${target} PRIVATE -fsanitize=address,undefined)

@@ -21,6 +21,9 @@ PACKAGES=(
   qtbase5-dev
   libboost-dev
   libsigc++-3.0-dev
+  # fuzzing (libFuzzer comes with clang's runtime)
+  clang
+  libclang-rt-14-dev
 )
 
 if [[ "${VSD_SKIP_DEPS:-0}" == "1" ]]; then

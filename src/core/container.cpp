@@ -7,7 +7,7 @@
 namespace vsd {
 
 View::View(SimState& state, Filter filter, Order order)
-    : state_(&state), filter_(std::move(filter)), order_(std::move(order)) {
+    : filter_(std::move(filter)), order_(std::move(order)) {
   state.index().for_each(Node::static_meta(), true, [&](SimStateInstance& i) {
     auto& n = static_cast<Node&>(i);
     if (!filter_ || filter_(n)) nodes_.push_back(&n);

@@ -70,6 +70,20 @@ TEST(Snapshot, WholeStateRoundTripKeepsIdsAndEverything) {
   EXPECT_EQ(vsd::io::save_bytes(copy), bytes) << "saving what was loaded gives the same bytes";
 }
 
+// A frame's rotation is stored as its exact matrix: an arbitrary rotation comes back bit for bit.
+TEST(Snapshot, FramesRoundTripExactly) {
+  vsd::Environment env;
+  auto& r = env.main_state().create<TRobot>();
+  Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
+  f.rotate(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
+  f.translation() << 0.1, -0.2, 1e-300;
+  r.set_frame(f);
+  auto& copy = env.create_state("copy");
+  vsd::io::load_bytes(copy, vsd::io::save_bytes(env.main_state()));
+  const Eigen::Isometry3d& g = copy.find<TRobot>(r.id())->frame();
+  for (int i = 0; i < 16; ++i) EXPECT_EQ(f.matrix().data()[i], g.matrix().data()[i]) << i;
+}
+
 TEST(Snapshot, LoadedIdsAreNeverHandedOutAgain) {
   vsd::Environment source;
   build_model(source.main_state());

@@ -69,7 +69,6 @@ class View : public Container {
   void drop(SimStateInstance& inst);
   void place(Node& n);
 
-  SimState* state_;
   Filter filter_;
   Order order_;
   std::vector<Node*> nodes_;

@@ -92,6 +92,41 @@ struct TypeTraits<Eigen::Quaterniond> {
     return t;
   }
 };
+namespace detail {
+// A frame's bytes and its equality use the exact matrix (translation and the 3x3 linear part): going
+// through a quaternion rounds ordinary rotations in their last bits and cannot carry a damaged matrix.
+// The text form stays {translation, rotation} for people.
+template <>
+inline bool equal_values<Eigen::Isometry3d>(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  for (int i = 0; i < 16; ++i)
+    if (!equal_values(a.matrix().data()[i], b.matrix().data()[i])) return false;
+  return true;
+}
+template <>
+inline std::size_t hash_value<Eigen::Isometry3d>(const Eigen::Isometry3d& v) {
+  std::size_t h = 16;
+  for (int i = 0; i < 16; ++i) h = hash_combine(h, hash_value(v.matrix().data()[i]));
+  return h;
+}
+template <>
+inline void bytes_out<Eigen::Isometry3d>(const MetaType&, const Eigen::Isometry3d& v, ByteWriter& out) {
+  out.raw(v.translation().data(), 3 * sizeof(double));
+  const Eigen::Matrix3d linear = v.linear();
+  out.raw(linear.data(), 9 * sizeof(double));
+}
+template <>
+inline void bytes_in<Eigen::Isometry3d>(const MetaType&, Eigen::Isometry3d& v, ByteReader& in,
+                                        const RefResolver*) {
+  Eigen::Vector3d t;
+  Eigen::Matrix3d linear;
+  in.raw(t.data(), 3 * sizeof(double));
+  in.raw(linear.data(), 9 * sizeof(double));
+  v.setIdentity();
+  v.translation() = t;
+  v.linear() = linear;
+}
+}  // namespace detail
+
 template <>
 struct TypeTraits<Eigen::Isometry3d> {
   static MetaType make() {
