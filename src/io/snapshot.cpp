@@ -243,7 +243,9 @@ class SnapshotReader {
     for (const SavedInstance& x : instances_) {
       if (kind_ == kind_state && x.entry->cls->is_a(Database::static_meta())) {
         saved_root = &x;
-        map[x.id] = whole ? state.database().id() : null_id;
+        // Loaded under a node, the file's Database *is* that node: its children become the node's, and
+        // references to it point at the node.
+        map[x.id] = whole ? state.database().id() : parent->id();
         continue;
       }
       if (whole) {

@@ -59,7 +59,9 @@ std::vector<std::uint8_t> save_bytes(const Node& root, SaveReport* report = null
 /// @brief Loads a whole-state snapshot into @p state, which must be empty; ids are kept.
 LoadReport load_bytes(SimState& state, std::span<const std::uint8_t> bytes,
                       std::string_view origin = "snapshot");
-/// @brief Loads a snapshot under @p parent; instances get fresh ids of @p parent's Environment.
+/// @brief Loads a snapshot under @p parent; instances get fresh ids of @p parent's Environment. The
+/// file's Database stands for @p parent: its children become @p parent's, references to it point at
+/// @p parent, and its own values are not copied.
 LoadReport load_bytes(Node& parent, std::span<const std::uint8_t> bytes,
                       std::string_view origin = "snapshot");
 
