@@ -1,6 +1,7 @@
 #include "vsd/core/meta_type.hpp"
 
 #include <cstring>
+#include <limits>
 #include <string>
 
 #include "vsd/core/bytes.hpp"
@@ -170,7 +171,7 @@ void struct_write_text(const MetaType& t, const void* obj, std::string& out) {
     if (!first) out += ", ";
     first = false;
     if (!positional) {
-      out += f.name;
+      write_quoted(out, f.name);  // JSON keys are strings
       out += ": ";
     }
     FieldValue fv(f, obj);
@@ -198,7 +199,7 @@ void struct_read_text(const MetaType& t, void* obj, TextReader& in, const RefRes
   if (in.accept('}')) return;
   do {
     const std::size_t at = in.token_start();
-    const auto name = in.identifier();
+    const std::string name = in.key();  // "x" or, in the older form, x
     const MetaType::Field* field = nullptr;
     for (const auto& f : fields)
       if (f.name == name) field = &f;
@@ -226,50 +227,84 @@ void struct_read_bytes(const MetaType& t, void* obj, ByteReader& in, const RefRe
   }
 }
 
+namespace {
+
+std::string enum_number_text(const MetaType& t, std::int64_t v) {
+  return t.is_unsigned() ? std::to_string(static_cast<std::uint64_t>(v)) : std::to_string(v);
+}
+
+// One number of an enum or flags text; unsigned 64-bit types take their whole range.
+std::int64_t enum_number(const MetaType& t, TextReader& in) {
+  const std::size_t at = in.token_start();
+  if (in.peek() == '-') {
+    const std::int64_t v = in.integer();
+    if (!t.integer_fits(v)) in.fail_at(at, std::to_string(v) + " is out of range for " + t.name());
+    return v;
+  }
+  const std::uint64_t u = in.unsigned_integer();
+  const auto v = static_cast<std::int64_t>(u);
+  const bool fits = u <= static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())
+                        ? t.integer_fits(v)
+                        : t.size() >= 8 && (t.is_unsigned() || t.kind() == TypeKind::Flags);
+  if (!fits) in.fail_at(at, std::to_string(u) + " is out of range for " + t.name());
+  return v;
+}
+
+// One name or number of an enum or flags text.
+std::int64_t enum_part(const MetaType& t, TextReader& in) {
+  const std::size_t at = in.token_start();
+  const char c = in.peek();
+  if (c == '-' || c == '+' || (c >= '0' && c <= '9')) return enum_number(t, in);
+  const auto name = in.identifier();
+  std::int64_t v = 0;
+  if (!t.enum_value(name, v)) in.fail_at(at, "'" + std::string(name) + "' is not a value of " + t.name());
+  return v;
+}
+
+}  // namespace
+
 void enum_write_text(const MetaType& t, const void* obj, std::string& out) {
   const std::int64_t v = t.load_integer(obj);
   if (t.kind() == TypeKind::Enum) {
     const auto name = t.enum_name(v);
     if (!name.empty()) {
-      out += name;
+      write_quoted(out, name);
     } else {
-      out += std::to_string(v);  // a value without a name still round-trips
+      out += enum_number_text(t, v);  // a value without a name still round-trips
     }
     return;
   }
-  // Flags: names of the set bits joined by '|', unnamed bits as a number, nothing set as 0.
+  // Flags: names of the set bits joined by '|' in one string, unnamed bits as a number at its end; no
+  // named bit set (nothing set, or only unnamed bits) is a plain number.
   auto rest = static_cast<std::uint64_t>(v);
-  bool first = true;
+  std::string names;
   for (const auto& e : t.enum_values()) {
     const auto bit = static_cast<std::uint64_t>(e.value);
     if (bit != 0 && (rest & bit) == bit) {
-      if (!first) out.push_back('|');
-      out += e.name;
+      if (!names.empty()) names.push_back('|');
+      names += e.name;
       rest &= ~bit;
-      first = false;
     }
   }
-  if (rest != 0 || first) {
-    if (!first) out.push_back('|');
+  if (names.empty()) {
     out += std::to_string(rest);
+    return;
   }
+  if (rest != 0) names += "|" + std::to_string(rest);
+  write_quoted(out, names);
 }
 
 void enum_read_text(const MetaType& t, void* obj, TextReader& in) {
+  // Written "Red" or "Read|Write" (or a number); the older bare forms Red and Read|Write read too. A
+  // quoted text is scanned in place rather than unquoted first, so an error points at the offending name.
+  const bool quoted = in.accept('"');
+  const bool flags = t.kind() == TypeKind::Flags;
   std::int64_t total = 0;
   do {
-    std::int64_t v = 0;
-    const std::size_t at = in.token_start();
-    const char c = in.peek();
-    if (c == '-' || (c >= '0' && c <= '9')) {
-      v = in.integer();
-      if (!t.integer_fits(v)) in.fail_at(at, std::to_string(v) + " is out of range for " + t.name());
-    } else {
-      const auto name = in.identifier();
-      if (!t.enum_value(name, v)) in.fail_at(at, "'" + std::string(name) + "' is not a value of " + t.name());
-    }
-    total = t.kind() == TypeKind::Flags ? (total | v) : v;
-  } while (t.kind() == TypeKind::Flags && in.accept('|'));
+    const std::int64_t v = enum_part(t, in);
+    total = flags ? (total | v) : v;
+  } while (flags && in.accept('|'));
+  if (quoted) in.expect('"');
   t.store_integer(obj, total);
 }
 
@@ -323,6 +358,99 @@ void make_isometry_fields(MetaType& t) {
                  static_cast<I*>(o)->linear() =
                      static_cast<const Eigen::Quaterniond*>(in)->normalized().toRotationMatrix();
                }});
+}
+
+namespace {
+
+// A frame's rotation: 3 rows of 3 numbers, taken exactly as the linear part, or a quaternion ([w, x, y, z]
+// or {"w": ...}; the older form) normalised into a rotation matrix as the rotation field does.
+void read_rotation(Eigen::Matrix3d& linear, TextReader& in) {
+  const std::size_t start = in.token_start();
+  if (in.accept('[') && in.peek() == '[') {
+    TextReader::Nest nest(in);
+    const auto next = [&](int i) {  // the ',' before element i, or an error when the list ends early
+      if (i == 0) return;
+      if (in.peek() == ']') in.fail("a rotation matrix is 3 rows of 3 numbers");
+      in.expect(',');
+    };
+    const auto close = [&] {
+      if (in.peek() != ']') in.fail("a rotation matrix is 3 rows of 3 numbers");
+      in.expect(']');
+    };
+    for (int r = 0; r < 3; ++r) {
+      next(r);
+      TextReader::Nest row(in);
+      in.expect('[');
+      for (int c = 0; c < 3; ++c) {
+        next(c);
+        linear(r, c) = in.real();
+      }
+      close();
+    }
+    close();
+    return;
+  }
+  in.seek(start);
+  Eigen::Quaterniond q(linear);
+  meta_type<Eigen::Quaterniond>().read_text(&q, in);
+  linear = q.normalized().toRotationMatrix();
+}
+
+}  // namespace
+
+void isometry_write_text(const Eigen::Isometry3d& v, std::string& out) {
+  out += "{\"translation\": [";
+  for (int i = 0; i < 3; ++i) {
+    if (i != 0) out += ", ";
+    write_real(out, v.translation()[i]);
+  }
+  out += "], \"rotation\": [";
+  for (int r = 0; r < 3; ++r) {
+    if (r != 0) out += ", ";
+    out.push_back('[');
+    for (int c = 0; c < 3; ++c) {
+      if (c != 0) out += ", ";
+      write_real(out, v.linear()(r, c));
+    }
+    out.push_back(']');
+  }
+  out += "]}";
+}
+
+void isometry_read_text(Eigen::Isometry3d& v, TextReader& in) {
+  TextReader::Nest nest(in);
+  // Fields not given keep their value, as in any struct; v changes only once the whole text is read.
+  Eigen::Vector3d translation = v.translation();
+  Eigen::Matrix3d linear = v.linear();
+  const MetaType& vector = meta_type<Eigen::Vector3d>();
+  if (in.accept('[')) {  // positional [translation, rotation], as the generic struct form took it
+    vector.read_text(&translation, in);
+    in.expect(',');
+    read_rotation(linear, in);
+    if (in.peek() != ']') in.fail("Isometry3d has 2 fields");
+    in.expect(']');
+  } else {
+    if (in.peek() != '{') in.fail("expected '{' or '[' to start a Isometry3d");
+    in.expect('{');
+    if (!in.accept('}')) {
+      do {
+        const std::size_t at = in.token_start();
+        const std::string name = in.key();
+        const bool is_translation = name == "translation";
+        if (!is_translation && name != "rotation") in.fail_at(at, "Isometry3d has no field '" + name + "'");
+        in.expect(':');
+        if (is_translation) {
+          vector.read_text(&translation, in);
+        } else {
+          read_rotation(linear, in);
+        }
+      } while (in.accept(','));
+      in.expect('}');
+    }
+  }
+  v.setIdentity();
+  v.translation() = translation;
+  v.linear() = linear;
 }
 
 }  // namespace detail

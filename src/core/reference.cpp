@@ -2,6 +2,7 @@
 #include "vsd/core/reference.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <string>
 
 #include "vsd/core/bytes.hpp"
@@ -248,25 +249,37 @@ bool ref_equal(const MetaType&, const void* a, const void* b) {
 std::size_t ref_hash(const MetaType&, const void* p) {
   return std::hash<Id>{}(static_cast<const RefBase*>(p)->id());
 }
+// A reference is the JSON string "@42" or null; the older bare @42 reads too.
 void write_id(std::string& out, Id id) {
   if (id == null_id) {
     out += "null";
   } else {
-    out += "@" + std::to_string(id);
+    out += "\"@" + std::to_string(id) + "\"";
   }
 }
 Id read_id(TextReader& in) {
-  if (in.accept('@')) return in.unsigned_integer();
+  const std::size_t at = in.token_start();
+  const bool quoted = in.accept('"');
+  if (quoted || in.peek() == '@') {
+    if (!in.accept('@')) in.fail_at(at, "expected a reference (\"@id\" or null)");
+    const Id id = in.unsigned_integer();
+    if (quoted) in.expect('"');
+    return id;
+  }
+  if (std::isalpha(static_cast<unsigned char>(in.peek())) == 0)
+    in.fail_at(at, "expected a reference (\"@id\" or null)");
   const auto word = in.identifier();
-  if (word != "null") in.fail("expected a reference (@id or null), found '" + std::string(word) + "'");
+  if (word != "null")
+    in.fail_at(at, "expected a reference (\"@id\" or null), found '" + std::string(word) + "'");
   return null_id;
 }
 void ref_write_text(const MetaType&, const void* p, std::string& out) {
   write_id(out, static_cast<const RefBase*>(p)->id());
 }
 void ref_read_text(const MetaType& t, void* p, TextReader& in, const RefResolver* refs) {
+  const std::size_t at = in.token_start();
   const Id id = read_id(in);
-  SimStateInstance* target = resolve(t, id, refs, [&](const std::string& m) { in.fail(m); });
+  SimStateInstance* target = resolve(t, id, refs, [&](const std::string& m) { in.fail_at(at, m); });
   static_cast<RefCore*>(p)->reset_target(target);
 }
 void ref_write_bytes(const MetaType&, const void* p, ByteWriter& out) {
@@ -318,9 +331,10 @@ void list_write_text(const MetaType&, const void* p, std::string& out) {
 void list_read_text(const MetaType& t, void* p, TextReader& in, const RefResolver* refs) {
   ListCore fresh(is_composite_kind(t));
   for (bool first = true; vector_read_text_next(in, first); first = false) {
+    const std::size_t at = in.token_start();
     const Id id = read_id(in);
-    if (id == null_id) in.fail("a reference list cannot hold null");
-    fresh.insert_at(fresh.size(), resolve(t, id, refs, [&](const std::string& m) { in.fail(m); }));
+    if (id == null_id) in.fail_at(at, "a reference list cannot hold null");
+    fresh.insert_at(fresh.size(), resolve(t, id, refs, [&](const std::string& m) { in.fail_at(at, m); }));
   }
   *static_cast<RefListBase*>(p) = fresh;
 }

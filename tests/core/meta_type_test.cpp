@@ -6,6 +6,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -25,6 +27,9 @@ VSD_FLAGS(MtAccess, Read, Write, Exec)
 constexpr MtAccess operator|(MtAccess a, MtAccess b) {
   return static_cast<MtAccess>(static_cast<std::uint32_t>(a) | static_cast<std::uint32_t>(b));
 }
+
+enum class MtWide : std::uint64_t { Low = 1 };  // flags of 64 bits
+VSD_FLAGS(MtWide, Low)
 
 struct MtPose {
   double x = 0;
@@ -52,6 +57,7 @@ using mt::MtColor;
 using mt::MtLevel;
 using mt::MtPart;
 using mt::MtPose;
+using mt::MtWide;
 using testing::HasSubstr;
 using testing::MatchesRegex;
 using testing::StartsWith;
@@ -270,9 +276,15 @@ TEST(MetaTypeText, DoublesUseTheShortestRoundTrip) {
 }
 
 TEST(MetaTypeText, DoubleSpecialValues) {
-  EXPECT_EQ(text_of(nan), "nan");
-  EXPECT_EQ(text_of(inf), "inf");
-  EXPECT_EQ(text_of(-inf), "-inf");
+  // JSON has no NaN or infinity: they are written as strings.
+  EXPECT_EQ(text_of(nan), R"("nan")");
+  EXPECT_EQ(text_of(inf), R"("inf")");
+  EXPECT_EQ(text_of(-inf), R"("-inf")");
+  EXPECT_EQ(text_of(-nan), R"("nan")");
+  EXPECT_TRUE(std::isnan(parse<double>(R"("nan")")));
+  EXPECT_EQ(parse<double>(R"("inf")"), inf);
+  EXPECT_EQ(parse<double>(R"("-inf")"), -inf);
+  // The older bare forms.
   EXPECT_TRUE(std::isnan(parse<double>("nan")));
   EXPECT_EQ(parse<double>("inf"), inf);
   EXPECT_EQ(parse<double>("+inf"), inf);
@@ -289,6 +301,33 @@ TEST(MetaTypeText, FloatRoundTrip) {
     SCOPED_TRACE(v);
     EXPECT_EQ(parse<float>(text_of(v)), v);
   }
+}
+
+TEST(MetaTypeText, SpecialValuesRoundTrip) {
+  constexpr float finf = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(text_of(std::numeric_limits<float>::quiet_NaN()), R"("nan")");
+  EXPECT_EQ(text_of(-finf), R"("-inf")");
+  for (const float v : {finf, -finf}) EXPECT_EQ(parse<float>(text_of(v)), v);
+  EXPECT_TRUE(std::isnan(parse<float>(text_of(std::numeric_limits<float>::quiet_NaN()))));
+  EXPECT_TRUE(std::isnan(parse<float>("nan")));
+  for (const double v : {inf, -inf}) EXPECT_EQ(parse<double>(text_of(v)), v);
+  EXPECT_TRUE(std::isnan(parse<double>(text_of(nan))));
+
+  // In containers and structs too: the text stays JSON and reads back.
+  const std::vector<double> specials{nan, inf, -inf, 1.5};
+  EXPECT_EQ(text_of(specials), R"(["nan", "inf", "-inf", 1.5])");
+  EXPECT_TRUE(equal(parse<std::vector<double>>(text_of(specials)), specials));
+  EXPECT_TRUE(equal(parse<std::vector<double>>("[nan, inf, -inf, 1.5]"), specials));
+  const MtPose pose{nan, -inf, 0};
+  EXPECT_EQ(text_of(pose), R"(["nan", "-inf", 0])");
+  EXPECT_TRUE(equal(parse<MtPose>(text_of(pose)), pose));
+
+  // A string that is not one of the specials is no number; the error points at the string.
+  EXPECT_THAT(text_error(vsd::meta_type<double>(), R"("infinite")"), StartsWith("1:1: "));
+  const std::string e = text_error(vsd::meta_type<std::vector<double>>(), R"([1, "infinite"])");
+  EXPECT_THAT(e, StartsWith("1:5: expected a number"));
+  EXPECT_THAT(e, HasSubstr("\"infinite\""));
+  EXPECT_THAT(text_error(vsd::meta_type<std::int32_t>(), R"("inf")"), StartsWith("1:1: expected a number"));
 }
 
 TEST(MetaTypeText, FloatTextIsShortestForTheFloat) {
@@ -324,6 +363,42 @@ TEST(MetaTypeText, StringsWithQuotesEscapesAndNewlines) {
 TEST(MetaTypeText, StringEscapesOnInput) {
   EXPECT_EQ(parse<std::string>(R"("\"\\\/\n\t\r\b\f")"), "\"\\/\n\t\r\b\f");
   EXPECT_EQ(parse<std::string>(R"("\u0041\u00e4\u20ac")"), "A\xc3\xa4\xe2\x82\xac");
+  EXPECT_EQ(parse<std::string>(R"("\u0000")"), std::string(1, '\0'));
+  EXPECT_EQ(parse<std::string>(R"("\uFFFF\uD7FF\uE000")"), "\xef\xbf\xbf\xed\x9f\xbf\xee\x80\x80");
+}
+
+TEST(MetaTypeText, SurrogatePairsAreOneCharacter) {
+  // U+1F600 is the pair D83D DE00 in JSON; in UTF-8 it is the four bytes F0 9F 98 80.
+  EXPECT_EQ(parse<std::string>(R"("\uD83D\uDE00")"), "\xf0\x9f\x98\x80");
+  EXPECT_EQ(parse<std::string>(R"("a\ud83d\ude00b")"), std::string("a\xf0\x9f\x98\x80") + "b");
+  EXPECT_EQ(parse<std::string>(R"("\uD800\uDC00")"), "\xf0\x90\x80\x80");  // U+10000, the first
+  EXPECT_EQ(parse<std::string>(R"("\uDBFF\uDFFF")"), "\xf4\x8f\xbf\xbf");  // U+10FFFF, the last
+  // Characters beyond the BMP are written as their UTF-8 bytes and read back unchanged.
+  const std::string smile = "\xf0\x9f\x98\x80";
+  EXPECT_EQ(text_of(smile), "\"" + smile + "\"");
+  EXPECT_EQ(parse<std::string>(text_of(smile)), smile);
+}
+
+TEST(MetaTypeTextErrors, LoneSurrogates) {
+  // Each error names the line and column of the backslash of the offending escape.
+  const std::string high = text_error(vsd::meta_type<std::string>(), R"("ab\uD83Dcd")");
+  EXPECT_THAT(high, StartsWith("1:4: "));
+  EXPECT_THAT(high, HasSubstr("surrogate"));
+  const std::string low = text_error(vsd::meta_type<std::string>(), R"("\uDE00")");
+  EXPECT_THAT(low, StartsWith("1:2: "));
+  EXPECT_THAT(low, HasSubstr("surrogate"));
+  const std::string at_end = text_error(vsd::meta_type<std::string>(), R"("\uD83D")");
+  EXPECT_THAT(at_end, StartsWith("1:2: "));
+  EXPECT_THAT(at_end, HasSubstr("surrogate"));
+  const std::string two_high = text_error(vsd::meta_type<std::string>(), R"("\uD83D\uD83D")");
+  EXPECT_THAT(two_high, StartsWith("1:2: "));
+  EXPECT_THAT(two_high, HasSubstr("surrogate"));
+  const std::string later_line =
+      text_error(vsd::meta_type<std::vector<std::string>>(), "[\"ok\",\n  \"x\\uDC00\"]");
+  EXPECT_THAT(later_line, StartsWith("2:5: "));
+  EXPECT_THAT(later_line, HasSubstr("surrogate"));
+  EXPECT_THAT(text_error(vsd::meta_type<std::string>(), R"("\uD83D\u12")"), HasSubstr("\\u"));
+  EXPECT_THAT(text_error(vsd::meta_type<std::string>(), R"("\uD83D\uZZZZ")"), HasSubstr("\\u"));
 }
 
 TEST(MetaTypeText, EigenVectorsAndQuaternions) {
@@ -344,26 +419,121 @@ TEST(MetaTypeText, EigenVectorsAndQuaternions) {
 }
 
 TEST(MetaTypeText, EigenFrames) {
+  // A frame's text is its exact matrix: the translation and the rotation's rows.
   EXPECT_EQ(text_of(Eigen::Isometry3d(Eigen::Isometry3d::Identity())),
-            "{translation: [0, 0, 0], rotation: [1, 0, 0, 0]}");
+            R"({"translation": [0, 0, 0], "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]})");
 
-  const std::string exact = "{translation: [0.1, -2.5, 1e-300], rotation: [1, 0, 0, 0]}";
+  const std::string exact =
+      R"({"translation": [0.1, -2.5, 1e-300], "rotation": [[0, -1, 0], [1, 0, 0], [0, 0, 1]]})";
   EXPECT_EQ(text_of(parse<Eigen::Isometry3d>(exact)), exact);
 
   const Eigen::Isometry3d f = make_frame({1, 2, 3}, 0.7, {1, -2, 0.5});
   const Eigen::Isometry3d back = parse<Eigen::Isometry3d>(text_of(f));
-  EXPECT_TRUE(back.isApprox(f, 1e-14)) << text_of(f) << " read back as " << text_of(back);
-  EXPECT_EQ(back.translation(), f.translation());
+  EXPECT_TRUE(equal(back, f)) << text_of(f) << " read back as " << text_of(back);
+  EXPECT_EQ(back.matrix(), f.matrix());
 
   // Only the translation given: the rotation keeps its default (identity).
-  const Eigen::Isometry3d t = parse<Eigen::Isometry3d>("{translation: [4, 5, 6]}");
+  const Eigen::Isometry3d t = parse<Eigen::Isometry3d>(R"({"translation": [4, 5, 6]})");
   EXPECT_EQ(t.translation(), Eigen::Vector3d(4, 5, 6));
   EXPECT_TRUE(t.linear().isIdentity(0));
-  // A rotation given as a non-unit quaternion is normalised.
+  EXPECT_EQ(t.matrix().row(3), Eigen::RowVector4d(0, 0, 0, 1));
+  // Rows are taken exactly, without normalising, so even a damaged matrix round-trips.
+  const Eigen::Isometry3d scaled =
+      parse<Eigen::Isometry3d>(R"({"rotation": [[2, 0, 0], [0, 2, 0], [0, 0, 2]]})");
+  EXPECT_EQ(scaled.linear(), (2 * Eigen::Matrix3d::Identity()).eval());
+  EXPECT_EQ(text_of(scaled), R"({"translation": [0, 0, 0], "rotation": [[2, 0, 0], [0, 2, 0], [0, 0, 2]]})");
+}
+
+TEST(MetaTypeText, EigenFrameRotationAsQuaternion) {
+  // The older text gave the rotation as a quaternion [w, x, y, z]; it is read and normalised.
   const Eigen::Isometry3d n = parse<Eigen::Isometry3d>("{translation: [0, 0, 0], rotation: [2, 0, 0, 0]}");
   EXPECT_TRUE(n.linear().isIdentity(1e-15));
   const Eigen::Isometry3d z90 = parse<Eigen::Isometry3d>("{rotation: [1, 0, 0, 1]}");
   EXPECT_TRUE((z90.linear() * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY(), 1e-15));
+  const Eigen::Isometry3d quoted =
+      parse<Eigen::Isometry3d>(R"({"translation": [1, 2, 3], "rotation": [1, 0, 0, 1]})");
+  EXPECT_EQ(quoted.translation(), Eigen::Vector3d(1, 2, 3));
+  EXPECT_TRUE(quoted.linear().isApprox(z90.linear(), 0));
+  // As an object of w, x, y, z, quoted or bare keys; missing parts keep the current rotation's.
+  const Eigen::Isometry3d named =
+      parse<Eigen::Isometry3d>(R"({"rotation": {"w": 1, "x": 0, "y": 0, "z": 1}})");
+  EXPECT_TRUE(named.linear().isApprox(z90.linear(), 0));
+  const Eigen::Isometry3d bare = parse<Eigen::Isometry3d>("{rotation: {w: 1, z: 1}}");
+  EXPECT_TRUE(bare.linear().isApprox(z90.linear(), 0));
+  // The quaternion form of a rotation reads back close to the matrix.
+  const Eigen::Isometry3d f = make_frame({1, 2, 3}, 0.7, {1, -2, 0.5});
+  const Eigen::Quaterniond q(f.linear());
+  const std::string old_text =
+      "{translation: " + text_of(Eigen::Vector3d(f.translation())) + ", rotation: " + text_of(q) + "}";
+  const Eigen::Isometry3d back = parse<Eigen::Isometry3d>(old_text);
+  EXPECT_TRUE(back.isApprox(f, 1e-14)) << old_text;
+  // The positional struct form [translation, rotation] still reads.
+  const Eigen::Isometry3d positional = parse<Eigen::Isometry3d>("[[1, 2, 3], [1, 0, 0, 1]]");
+  EXPECT_EQ(positional.translation(), Eigen::Vector3d(1, 2, 3));
+  EXPECT_TRUE(positional.linear().isApprox(z90.linear(), 0));
+  // The generic field API still sees the rotation as a quaternion.
+  const auto& type = vsd::meta_type<Eigen::Isometry3d>();
+  ASSERT_EQ(type.fields().size(), 2u);
+  EXPECT_EQ(type.fields()[1].type, &vsd::meta_type<Eigen::Quaterniond>());
+}
+
+TEST(MetaTypeText, EigenFramesRoundTripExactly) {
+  // Text carries the exact matrix: random rotations and translations come back bit for bit.
+  std::srand(12345);
+  for (int i = 0; i < 1000; ++i) {
+    const Eigen::Vector3d axis = Eigen::Vector3d::Random();
+    const double angle = Eigen::Vector2d::Random()[0] * 3.5;
+    Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
+    f.translation() = Eigen::Vector3d::Random() * std::pow(10.0, i % 13 - 6);
+    f.linear() = Eigen::AngleAxisd(angle, axis.norm() > 0 ? axis.normalized() : Eigen::Vector3d::UnitZ())
+                     .toRotationMatrix();
+    const std::string text = text_of(f);
+    const Eigen::Isometry3d back = parse<Eigen::Isometry3d>(text);
+    ASSERT_EQ(std::memcmp(back.matrix().data(), f.matrix().data(), sizeof(double) * 16), 0) << text;
+    ASSERT_TRUE(equal(back, f)) << text;
+    ASSERT_EQ(text_of(back), text);
+  }
+  // Negative zeros and the specials keep their bits too.
+  Eigen::Isometry3d odd = Eigen::Isometry3d::Identity();
+  odd.translation() = Eigen::Vector3d(-0.0, inf, -inf);
+  odd.linear()(0, 1) = -0.0;
+  odd.linear()(2, 2) = nan;
+  const Eigen::Isometry3d back = parse<Eigen::Isometry3d>(text_of(odd));
+  EXPECT_TRUE(equal(back, odd)) << text_of(odd);
+  EXPECT_TRUE(std::signbit(back.translation().x()));
+  EXPECT_TRUE(std::signbit(back.linear()(0, 1)));
+  EXPECT_EQ(text_of(back), text_of(odd));
+}
+
+TEST(MetaTypeTextErrors, BadFrames) {
+  const auto& t = vsd::meta_type<Eigen::Isometry3d>();
+  const std::string two_rows = text_error(t, R"({"rotation": [[1, 0, 0], [0, 1, 0]]})");
+  EXPECT_THAT(two_rows, StartsWith("1:35: "));
+  EXPECT_THAT(two_rows, HasSubstr("3 rows of 3 numbers"));
+  const std::string short_row = text_error(t, R"({"rotation": [[1, 0], [0, 1, 0], [0, 0, 1]]})");
+  EXPECT_THAT(short_row, StartsWith("1:20: "));
+  EXPECT_THAT(short_row, HasSubstr("3 rows of 3 numbers"));
+  const std::string long_row = text_error(t, R"({"rotation": [[1, 0, 0, 0], [0, 1, 0], [0, 0, 1]]})");
+  EXPECT_THAT(long_row, StartsWith("1:23: "));
+  const std::string four_rows =
+      text_error(t, "{\"rotation\": [[1, 0, 0], [0, 1, 0], [0, 0, 1],\n [0, 0, 0]]}");
+  EXPECT_THAT(four_rows, StartsWith("1:46: "));
+  const std::string not_a_number = text_error(t, R"({"rotation": [[1, 0, 0], [0, x, 0], [0, 0, 1]]})");
+  EXPECT_THAT(not_a_number, StartsWith("1:30: "));
+  const std::string unknown = text_error(t, R"({"translation": [0, 0, 0], "scale": 2})");
+  EXPECT_THAT(unknown, StartsWith("1:28: "));
+  EXPECT_THAT(unknown, HasSubstr("Isometry3d has no field 'scale'"));
+  const std::string quaternion = text_error(t, R"({"rotation": [1, 0, 0]})");
+  EXPECT_THAT(quaternion, StartsWith("1:22: "));
+  EXPECT_THAT(quaternion, HasSubstr("expected ','"));
+  EXPECT_THAT(text_error(t, "5"), StartsWith("1:1: "));
+  EXPECT_THAT(text_error(t, R"({"rotation": )"), StartsWith("1:14: "));
+  EXPECT_THAT(text_error(t, "{\"rotation\": " + std::string(10000, '[')), MatchesRegex("1:[0-9]+: .*"));
+  // A failed read leaves the frame as it was.
+  Eigen::Isometry3d f = make_frame({1, 2, 3}, 0.5, {0, 0, 1});
+  const Eigen::Isometry3d before = f;
+  EXPECT_THROW(t.from_text(&f, R"({"translation": [7, 8, 9], "rotation": [[1, 0, 0]]})"), vsd::Error);
+  EXPECT_TRUE(equal(f, before));
 }
 
 TEST(MetaTypeText, Vectors) {
@@ -381,7 +551,7 @@ TEST(MetaTypeText, Vectors) {
   EXPECT_EQ(parse<std::vector<bool>>("[true,false,true]"), (std::vector<bool>{true, false, true}));
   EXPECT_EQ(parse<std::vector<std::vector<std::int32_t>>>("[[1, 2], [], [3]]"),
             (std::vector<std::vector<std::int32_t>>{{1, 2}, {}, {3}}));
-  const auto pts = parse<std::vector<Eigen::Vector3d>>("[[1, 2, 3], {x: 4, y: 5, z: 6}]");
+  const auto pts = parse<std::vector<Eigen::Vector3d>>(R"([[1, 2, 3], {"x": 4, "y": 5, "z": 6}])");
   ASSERT_EQ(pts.size(), 2u);
   EXPECT_EQ(pts[1], Eigen::Vector3d(4, 5, 6));
   const std::vector<std::uint64_t> big{0, std::numeric_limits<std::uint64_t>::max()};
@@ -415,12 +585,22 @@ TEST(MetaTypeEnum, NamesAndValues) {
 }
 
 TEST(MetaTypeEnum, TextRoundTrip) {
-  EXPECT_EQ(text_of(MtColor::Red), "Red");
-  EXPECT_EQ(text_of(MtColor::Green), "Green");
-  EXPECT_EQ(text_of(MtColor::Blue), "Blue");
+  EXPECT_EQ(text_of(MtColor::Red), R"("Red")");
+  EXPECT_EQ(text_of(MtColor::Green), R"("Green")");
+  EXPECT_EQ(text_of(MtColor::Blue), R"("Blue")");
+  EXPECT_EQ(parse<MtColor>(R"("Green")"), MtColor::Green);
+  EXPECT_EQ(parse<MtColor>(R"( "Blue" )"), MtColor::Blue);
+  EXPECT_EQ(parse<MtColor>("5"), MtColor::Green) << "a number names a value too";
+  for (const MtColor c : {MtColor::Red, MtColor::Green, MtColor::Blue})
+    EXPECT_EQ(parse<MtColor>(text_of(c)), c);
+  EXPECT_EQ(text_of(std::vector<MtColor>{MtColor::Red, MtColor::Blue}), R"(["Red", "Blue"])");
+}
+
+TEST(MetaTypeEnum, OlderBareNamesStillRead) {
   EXPECT_EQ(parse<MtColor>("Green"), MtColor::Green);
   EXPECT_EQ(parse<MtColor>(" Blue "), MtColor::Blue);
-  EXPECT_EQ(parse<MtColor>("5"), MtColor::Green) << "a number names a value too";
+  EXPECT_EQ(parse<std::vector<MtColor>>("[Red, \"Blue\", 5]"),
+            (std::vector<MtColor>{MtColor::Red, MtColor::Blue, MtColor::Green}));
 }
 
 TEST(MetaTypeEnum, UnknownNumericValueRoundTrips) {
@@ -435,9 +615,9 @@ TEST(MetaTypeEnum, UnknownNumericValueRoundTrips) {
 
 TEST(MetaTypeEnum, UnsignedUnderlyingTypeAboveTheSignedRange) {
   // MtLevel is an enum : uint8_t whose value High is 200 (above int8's range).
-  EXPECT_EQ(text_of(MtLevel::Low), "Low");
-  EXPECT_EQ(text_of(MtLevel::High), "High");
-  EXPECT_EQ(parse<MtLevel>("High"), MtLevel::High);
+  EXPECT_EQ(text_of(MtLevel::Low), R"("Low")");
+  EXPECT_EQ(text_of(MtLevel::High), R"("High")");
+  EXPECT_EQ(parse<MtLevel>(R"("High")"), MtLevel::High);
   EXPECT_EQ(text_of(static_cast<MtLevel>(250)), "250");
   EXPECT_EQ(parse<MtLevel>("250"), static_cast<MtLevel>(250));
   EXPECT_EQ(binary_round_trip(MtLevel::High), MtLevel::High);
@@ -455,18 +635,29 @@ TEST(MetaTypeFlags, TextForms) {
   const auto& t = vsd::meta_type<MtAccess>();
   EXPECT_EQ(t.kind(), vsd::TypeKind::Flags);
   EXPECT_EQ(t.name(), "MtAccess");
-  EXPECT_EQ(text_of(MtAccess::Read), "Read");
-  EXPECT_EQ(text_of(MtAccess::Read | MtAccess::Write), "Read|Write");
-  EXPECT_EQ(text_of(MtAccess::Read | MtAccess::Write | MtAccess::Exec), "Read|Write|Exec");
+  // Names joined by '|' in one string; unnamed bits as a number in the same string; nothing set is 0.
+  EXPECT_EQ(text_of(MtAccess::Read), R"("Read")");
+  EXPECT_EQ(text_of(MtAccess::Read | MtAccess::Write), R"("Read|Write")");
+  EXPECT_EQ(text_of(MtAccess::Read | MtAccess::Write | MtAccess::Exec), R"("Read|Write|Exec")");
   EXPECT_EQ(text_of(static_cast<MtAccess>(0)), "0");
-  EXPECT_EQ(text_of(static_cast<MtAccess>(1 | 8)), "Read|8");  // an unnamed bit stays a number
+  EXPECT_EQ(text_of(static_cast<MtAccess>(1 | 8)), R"("Read|8")");  // an unnamed bit stays a number
+  EXPECT_EQ(text_of(static_cast<MtAccess>(8 | 16)), "24");          // only unnamed bits: a number
 }
 
 TEST(MetaTypeFlags, ParseAndRoundTrip) {
+  EXPECT_EQ(parse<MtAccess>(R"("Read|Write")"), MtAccess::Read | MtAccess::Write);
+  EXPECT_EQ(parse<MtAccess>(R"(" Write | Exec ")"), MtAccess::Write | MtAccess::Exec);
+  EXPECT_EQ(parse<MtAccess>("0"), static_cast<MtAccess>(0));
+  EXPECT_EQ(parse<MtAccess>("6"), MtAccess::Write | MtAccess::Exec);
+  EXPECT_EQ(parse<MtAccess>(R"("Read|8")"), static_cast<MtAccess>(9));
+  EXPECT_EQ(parse<MtAccess>(R"("8|Read")"), static_cast<MtAccess>(9));
+  EXPECT_EQ(parse<MtAccess>(R"("Read")"), MtAccess::Read);
+  EXPECT_EQ(parse<MtAccess>(R"("0")"), static_cast<MtAccess>(0));
+  // The older bare forms.
   EXPECT_EQ(parse<MtAccess>("Read|Write"), MtAccess::Read | MtAccess::Write);
   EXPECT_EQ(parse<MtAccess>(" Write | Exec "), MtAccess::Write | MtAccess::Exec);
-  EXPECT_EQ(parse<MtAccess>("0"), static_cast<MtAccess>(0));
   EXPECT_EQ(parse<MtAccess>("Read|8"), static_cast<MtAccess>(9));
+  EXPECT_EQ(parse<MtAccess>("Exec"), MtAccess::Exec);
   for (std::uint32_t bits = 0; bits < 16; ++bits) {
     const auto v = static_cast<MtAccess>(bits);
     EXPECT_EQ(parse<MtAccess>(text_of(v)), v) << text_of(v);
@@ -489,6 +680,18 @@ TEST(MetaTypeStruct, DescribesItsFields) {
   EXPECT_EQ(t.fields()[3].type, &vsd::meta_type<MtColor>());
 }
 
+TEST(MetaTypeFlags, SixtyFourBits) {
+  // A flags type of 64 bits: an unnamed top bit is written, and read back, as an unsigned number.
+  const auto top = static_cast<MtWide>(std::uint64_t{1} << 63);
+  EXPECT_EQ(text_of(top), "9223372036854775808");
+  EXPECT_EQ(parse<MtWide>(text_of(top)), top);
+  const auto both = static_cast<MtWide>((std::uint64_t{1} << 63) | 1);
+  EXPECT_EQ(text_of(both), R"("Low|9223372036854775808")");
+  EXPECT_EQ(parse<MtWide>(text_of(both)), both);
+  EXPECT_EQ(parse<MtWide>("18446744073709551615"), static_cast<MtWide>(~std::uint64_t{0}));
+  EXPECT_THAT(text_error(vsd::meta_type<MtWide>(), "18446744073709551616"), StartsWith("1:1: "));
+}
+
 TEST(MetaTypeStruct, NumericStructIsWrittenAsAList) {
   EXPECT_EQ(text_of(MtPose{1, 2, 0.5}), "[1, 2, 0.5]");
   const MtPose p = parse<MtPose>("[1, 2, 0.5]");
@@ -498,15 +701,32 @@ TEST(MetaTypeStruct, NumericStructIsWrittenAsAList) {
 }
 
 TEST(MetaTypeStruct, NamedFormInAnyOrderAndPartial) {
-  const MtPose p = parse<MtPose>("{theta: 0.5, x: 1, y: 2}");
+  const MtPose p = parse<MtPose>(R"({"theta": 0.5, "x": 1, "y": 2})");
   EXPECT_EQ(p.x, 1);
   EXPECT_EQ(p.y, 2);
   EXPECT_EQ(p.theta, 0.5);
-  const MtPose q = parse<MtPose>("{y: -4}");
+  const MtPose q = parse<MtPose>(R"({"y": -4})");
   EXPECT_EQ(q.x, 0);
   EXPECT_EQ(q.y, -4);
   const MtPose e = parse<MtPose>("{}");
   EXPECT_EQ(e.theta, 0);
+}
+
+TEST(MetaTypeStruct, OlderBareKeysStillRead) {
+  const MtPose p = parse<MtPose>("{theta: 0.5, x: 1, \"y\": 2}");  // and mixed with quoted keys
+  EXPECT_EQ(p.x, 1);
+  EXPECT_EQ(p.y, 2);
+  EXPECT_EQ(p.theta, 0.5);
+  const MtPart part =
+      parse<MtPart>("{name: \"n\", color: Blue, pose: {theta: 2}, points: [{x: 1, y: 2, z: 3}]}");
+  EXPECT_EQ(part.name, "n");
+  EXPECT_EQ(part.color, MtColor::Blue);
+  EXPECT_EQ(part.pose.theta, 2);
+  ASSERT_EQ(part.points.size(), 1u);
+  EXPECT_EQ(part.points[0], Eigen::Vector3d(1, 2, 3));
+  // A key that is no identifier is only possible quoted; it is then simply an unknown field.
+  EXPECT_THAT(text_error(vsd::meta_type<MtPose>(), R"({"x y": 1})"), HasSubstr("MtPose has no field 'x y'"));
+  EXPECT_THAT(text_error(vsd::meta_type<MtPose>(), "{1: 1}"), StartsWith("1:2: expected a key"));
 }
 
 TEST(MetaTypeStruct, NestedStructAndVectorFields) {
@@ -518,9 +738,8 @@ TEST(MetaTypeStruct, NestedStructAndVectorFields) {
   part.active = true;
   part.waypoints = {{0, 0, 0}, {3, 4, 1}};
   const std::string text = text_of(part);
-  EXPECT_EQ(text,
-            "{name: \"gear \\\"A\\\"\", pose: [1, 2, 0.5], points: [[1, 2, 3], [-1, 0.25, 1e+10]], "
-            "color: Green, active: true, waypoints: [[0, 0, 0], [3, 4, 1]]}");
+  EXPECT_EQ(text, R"({"name": "gear \"A\"", "pose": [1, 2, 0.5], "points": [[1, 2, 3], [-1, 0.25, 1e+10]], )"
+                  R"("color": "Green", "active": true, "waypoints": [[0, 0, 0], [3, 4, 1]]})");
   const MtPart back = parse<MtPart>(text);
   EXPECT_TRUE(equal(back, part));
   EXPECT_EQ(back.name, part.name);
@@ -528,7 +747,7 @@ TEST(MetaTypeStruct, NestedStructAndVectorFields) {
   EXPECT_EQ(back.waypoints.size(), 2u);
   EXPECT_EQ(back.waypoints[1].y, 4);
 
-  const MtPart partial = parse<MtPart>("{ color: Blue,\n  pose: {theta: 2} }");
+  const MtPart partial = parse<MtPart>("{ \"color\": \"Blue\",\n  \"pose\": {\"theta\": 2} }");
   EXPECT_EQ(partial.color, MtColor::Blue);
   EXPECT_EQ(partial.pose.theta, 2);
   EXPECT_EQ(partial.name, "");
@@ -740,12 +959,34 @@ TEST(MetaTypeTextErrors, UnknownEnumName) {
   const std::string v = text_error(vsd::meta_type<std::vector<MtColor>>(), "[Red, Purple]");
   EXPECT_THAT(v, StartsWith("1:7: "));
   EXPECT_THAT(v, HasSubstr("Purple"));
+  // Quoted: the column of the name inside the quotes.
+  const std::string q = text_error(vsd::meta_type<std::vector<MtColor>>(), R"(["Red", "Purple"])");
+  EXPECT_THAT(q, StartsWith("1:10: "));
+  EXPECT_THAT(q, HasSubstr("'Purple' is not a value of MtColor"));
+  EXPECT_THAT(text_error(vsd::meta_type<MtColor>(), R"("Red|Blue")"), StartsWith("1:5: expected '\"'"));
+  EXPECT_THAT(text_error(vsd::meta_type<MtColor>(), R"("Red)"), HasSubstr("ended"));
+  EXPECT_THAT(text_error(vsd::meta_type<MtColor>(), R"("")"), StartsWith("1:2: "));
 }
 
 TEST(MetaTypeTextErrors, UnknownFlagName) {
   const std::string e = text_error(vsd::meta_type<MtAccess>(), "Read|Bogus");
   EXPECT_THAT(e, StartsWith("1:6: "));
   EXPECT_THAT(e, HasSubstr("'Bogus' is not a value of MtAccess"));
+  // Inside the quotes: still the line and column of the offending name.
+  const std::string q = text_error(vsd::meta_type<MtAccess>(), R"("Read|Bogus")");
+  EXPECT_THAT(q, StartsWith("1:7: "));
+  EXPECT_THAT(q, HasSubstr("'Bogus' is not a value of MtAccess"));
+  const std::string nested =
+      text_error(vsd::meta_type<std::vector<MtAccess>>(), "[\"Read\",\n  \"Write|Exec|Nope\"]");
+  EXPECT_THAT(nested, StartsWith("2:15: "));
+  EXPECT_THAT(nested, HasSubstr("'Nope'"));
+  const std::string number = text_error(vsd::meta_type<MtAccess>(), R"("Read|1x")");
+  EXPECT_THAT(number, StartsWith("1:7: "));
+  const std::string unclosed = text_error(vsd::meta_type<MtAccess>(), R"("Read|Write)");
+  EXPECT_THAT(unclosed, StartsWith("1:12: "));
+  EXPECT_THAT(unclosed, HasSubstr("ended"));
+  EXPECT_THAT(text_error(vsd::meta_type<MtAccess>(), R"("Read||Write")"), StartsWith("1:7: "));
+  EXPECT_THAT(text_error(vsd::meta_type<MtAccess>(), R"("Read|")"), StartsWith("1:7: "));
 }
 
 TEST(MetaTypeTextErrors, IntegerOutOfRange) {
@@ -851,6 +1092,9 @@ TEST(MetaTypeTextErrors, UnknownStructField) {
   const std::string e = text_error(vsd::meta_type<MtPose>(), "{x: 1, q: 2}");
   EXPECT_THAT(e, StartsWith("1:8: "));
   EXPECT_THAT(e, HasSubstr("MtPose has no field 'q'"));
+  const std::string quoted = text_error(vsd::meta_type<MtPose>(), R"({"x": 1, "q": 2})");
+  EXPECT_THAT(quoted, StartsWith("1:10: "));
+  EXPECT_THAT(quoted, HasSubstr("MtPose has no field 'q'"));
   const std::string nested = text_error(vsd::meta_type<MtPart>(), "{name: \"a\",\n pose: {rho: 1}}");
   EXPECT_THAT(nested, StartsWith("2:9: "));
   EXPECT_THAT(nested, HasSubstr("MtPose has no field 'rho'"));
@@ -910,6 +1154,152 @@ TEST(MetaTypeTextErrors, NestingGuardThrowsBeyondItsDepth) {
   }
   EXPECT_TRUE(threw);
   EXPECT_GE(levels.size(), 64u) << "reasonable nesting is allowed";
+}
+
+// ---- TextReader: skipping values and moving back --------------------------------------------------------
+
+// The texts skip_value() skips one after another in @p text.
+std::vector<std::string> skipped_values(std::string_view text) {
+  vsd::TextReader in(text);
+  std::vector<std::string> out;
+  while (!in.at_end()) {
+    const std::size_t start = in.token_start();
+    in.skip_value();
+    out.emplace_back(text.substr(start, in.position() - start));
+  }
+  return out;
+}
+
+std::string repeated(std::string_view part, int n) {
+  std::string s;
+  for (int i = 0; i < n; ++i) s += part;
+  return s;
+}
+
+std::string skip_error(std::string_view text) {
+  try {
+    vsd::TextReader in(text);
+    in.skip_value();
+  } catch (const vsd::Error& e) {
+    return e.what();
+  }
+  return "<no error>";
+}
+
+TEST(TextReader, SkipValueSkipsExactlyOneJsonValue) {
+  EXPECT_THAT(skipped_values(R"({"a": [1, {"b": "x\"}y"}, [], {}], "c": null} [true, false, -1.5e3, "nan"])"
+                             R"( "s]" 12 -0 1E+2 {} [] "" null)"),
+              testing::ElementsAre(R"({"a": [1, {"b": "x\"}y"}, [], {}], "c": null})",
+                                   R"([true, false, -1.5e3, "nan"])", R"("s]")", "12", "-0", "1E+2", "{}",
+                                   "[]", R"("")", "null"));
+  // Every value written by vsd is one value to skip.
+  MtPart part;
+  part.name = "a\n\"]}";
+  part.points = {{1, nan, -inf}};
+  part.waypoints = {{1, 2, 3}};
+  const std::string text = text_of(part) + " " + text_of(make_frame({1, 2, 3}, 0.3, {0, 1, 0})) + " " +
+                           text_of(MtAccess::Read | MtAccess::Exec) + " " + text_of(MtColor::Blue);
+  EXPECT_EQ(skipped_values(text).size(), 4u) << text;
+}
+
+TEST(TextReader, SkipValueTakesTheOlderForms) {
+  EXPECT_THAT(skipped_values("{x: 1, name: \"a\", color: Red, access: Read | Write|8, ref: @42} Read|Write "
+                             "8|Exec @7 \"@7\" nan -inf +inf Green vsd::Node [@1, @2] [nan, inf]"),
+              testing::ElementsAre("{x: 1, name: \"a\", color: Red, access: Read | Write|8, ref: @42}",
+                                   "Read|Write", "8|Exec", "@7", "\"@7\"", "nan", "-inf", "+inf", "Green",
+                                   "vsd::Node", "[@1, @2]", "[nan, inf]"));
+}
+
+TEST(TextReader, SkipValueRejectsBadInputWithThePosition) {
+  EXPECT_THAT(skip_error(""), StartsWith("1:1: expected a value but the text ended"));
+  EXPECT_THAT(skip_error("  ]"), StartsWith("1:3: expected a value, found ']'"));
+  EXPECT_THAT(skip_error("[1, ]"), StartsWith("1:5: expected a value, found ']'"));
+  EXPECT_THAT(skip_error("[1 2]"), StartsWith("1:4: expected ']' but found '2'"));
+  EXPECT_THAT(skip_error("[1, 2"), StartsWith("1:6: "));
+  EXPECT_THAT(skip_error(R"({"a" 1})"), StartsWith("1:6: expected ':'"));
+  EXPECT_THAT(skip_error(R"({"a": })"), StartsWith("1:7: expected a value"));
+  EXPECT_THAT(skip_error(R"({"a": 1,})"), StartsWith("1:9: expected a key"));
+  EXPECT_THAT(skip_error("{1: 2}"), StartsWith("1:2: expected a key"));
+  EXPECT_THAT(skip_error("{\"a\": [1,\n  1.2.3]}"), StartsWith("2:3: '1.2.3' is not a number"));
+  EXPECT_THAT(skip_error("-"), StartsWith("1:1: '-' is not a number"));
+  EXPECT_THAT(skip_error("\"abc"), HasSubstr("unterminated string"));
+  EXPECT_THAT(skip_error(R"("\uD83D")"), StartsWith("1:2: "));
+  EXPECT_THAT(skip_error("@"), StartsWith("1:2: expected a number"));
+  EXPECT_THAT(skip_error("@x"), StartsWith("1:2: "));
+  EXPECT_THAT(skip_error("Read|"), StartsWith("1:6: expected a value but the text ended"));
+  EXPECT_THAT(skip_error("#"), StartsWith("1:1: expected a value, found '#'"));
+  // A number beyond double's range is still one well-formed value.
+  EXPECT_EQ(skip_error("1e999"), "<no error>");
+}
+
+TEST(TextReader, SkipValueGuardsItsNesting) {
+  // Too deep a value throws (no stack overflow), whether arrays, objects or both.
+  for (const std::string& deep :
+       {std::string(100000, '['), repeated("{\"a\": ", 50000), repeated("{a: [", 50000)}) {
+    const std::string e = skip_error(deep);
+    EXPECT_THAT(e, MatchesRegex("1:[0-9]+: .*"));
+    EXPECT_THAT(e, HasSubstr("nested deeper than"));
+  }
+  // Reasonable nesting is fine, and the guard is released afterwards.
+  const std::string nested = std::string(64, '[') + std::string(64, ']');
+  const std::string two = nested + " " + nested;
+  vsd::TextReader in(two);
+  in.skip_value();
+  in.skip_value();
+  EXPECT_TRUE(in.at_end());
+  // Closed deep values one after another do not add up.
+  std::string many;
+  for (int i = 0; i < 1000; ++i) many += "[[[[1]]]] ";
+  EXPECT_EQ(skipped_values(many).size(), 1000u);
+}
+
+TEST(TextReader, SeekReadsAValueAgain) {
+  // A reader that sees a key before it can use the value skips it, then comes back to it.
+  const std::string text = R"({"later": [1, 2], "first": 3})";
+  vsd::TextReader in(text, "file.json");
+  EXPECT_EQ(in.text(), text);
+  in.expect('{');
+  EXPECT_EQ(in.key(), "later");
+  in.expect(':');
+  const std::size_t later = in.token_start();
+  in.skip_value();
+  in.expect(',');
+  EXPECT_EQ(in.key(), "first");
+  in.expect(':');
+  EXPECT_EQ(in.integer(), 3);
+  in.expect('}');
+  in.expect_end();
+  const std::size_t end = in.position();
+
+  in.seek(later);
+  EXPECT_EQ(in.position(), later);
+  EXPECT_EQ(in.column(), 11u);
+  std::vector<std::int32_t> v;
+  vsd::meta_type<std::vector<std::int32_t>>().read_text(&v, in);
+  EXPECT_EQ(v, (std::vector<std::int32_t>{1, 2}));
+  in.seek(end);
+  EXPECT_TRUE(in.at_end());
+  in.seek(text.size() + 100);  // past the end: clamped
+  EXPECT_EQ(in.position(), text.size());
+  EXPECT_TRUE(in.at_end());
+  in.seek(0);
+  EXPECT_EQ(in.peek(), '{');
+  // Errors after a seek name the position sought.
+  in.seek(later + 1);
+  try {
+    in.fail("here");
+    FAIL() << "fail() must throw";
+  } catch (const vsd::Error& e) {
+    EXPECT_STREQ(e.what(), "file.json:1:12: here");
+  }
+}
+
+TEST(TextReader, KeysQuotedOrBare) {
+  vsd::TextReader in(R"("a b" c "d\"e" ::)");
+  EXPECT_EQ(in.key(), "a b");
+  EXPECT_EQ(in.key(), "c");
+  EXPECT_EQ(in.key(), "d\"e");
+  EXPECT_THROW((void)in.key(), vsd::Error);
 }
 
 TEST(MetaTypeTextErrors, ErrorsLeaveTheTargetUsable) {

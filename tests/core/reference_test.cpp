@@ -3,9 +3,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <string>
+#include <string_view>
+
 #include "test_classes.hpp"
 
 using testing::HasSubstr;
+using testing::StartsWith;
 using vsd_test::TRobot;
 using vsd_test::TTool;
 
@@ -175,7 +179,7 @@ TEST_F(ReferenceTest, ValuesHoldingReferencesCount) {
     EXPECT_EQ(n.composite_count(), 2u);
     vsd::Value copy = v;
     EXPECT_EQ(n.composite_count(), 3u);
-    EXPECT_EQ(copy.to_text(), "@" + std::to_string(n.id()));
+    EXPECT_EQ(copy.to_text(), "\"@" + std::to_string(n.id()) + "\"");
   }
   EXPECT_EQ(n.composite_count(), 1u);
 }
@@ -188,6 +192,68 @@ TEST_F(ReferenceTest, ReferenceTextNeedsAResolver) {
   EXPECT_EQ(static_cast<const vsd::RefBase*>(null.data())->get(), nullptr);
   EXPECT_THAT([&] { (void)vsd::Value::from_text(t, "@12"); },
               testing::ThrowsMessage<vsd::Error>(HasSubstr("1:")));
+  EXPECT_THAT([&] { (void)vsd::Value::from_text(t, R"("@12")"); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("1:1: cannot resolve reference @12")));
+}
+
+struct StateResolver final : vsd::RefResolver {
+  explicit StateResolver(vsd::SimState& s) : state(s) {}
+  vsd::SimStateInstance* resolve(vsd::Id id) const override { return state.find(id); }
+  vsd::SimState& state;
+};
+
+std::string text_error(const vsd::MetaType& type, std::string_view text, const vsd::RefResolver* refs) {
+  try {
+    (void)vsd::Value::from_text(type, text, refs);
+  } catch (const vsd::Error& e) {
+    return e.what();
+  }
+  return "<no error>";
+}
+
+TEST_F(ReferenceTest, ReferenceTextIsJsonAndTheOlderFormReads) {
+  auto& a = state.create<vsd::Node>();
+  auto& b = state.create<vsd::Node>();
+  root.add_child(a);
+  root.add_child(b);
+  const StateResolver refs(state);
+  const std::string a_id = std::to_string(a.id());
+  const std::string b_id = std::to_string(b.id());
+
+  // A reference is the JSON string "@id" or null; the older bare @id reads too.
+  const auto& t = vsd::meta_type<vsd::SharedRef<vsd::Node>>();
+  EXPECT_EQ(vsd::Value(vsd::SharedRef<vsd::Node>(&a)).to_text(), "\"@" + a_id + "\"");
+  EXPECT_EQ(vsd::Value(vsd::SharedRef<vsd::Node>()).to_text(), "null");
+  for (const std::string& text : {"\"@" + a_id + "\"", "@" + a_id, " \"@" + a_id + "\" "}) {
+    const vsd::Value v = vsd::Value::from_text(t, text, &refs);
+    EXPECT_EQ(static_cast<const vsd::RefBase*>(v.data())->get(), &a) << text;
+  }
+  EXPECT_EQ(static_cast<const vsd::RefBase*>(vsd::Value::from_text(t, "null", &refs).data())->get(), nullptr);
+
+  // A reference list is a JSON array of them.
+  vsd::SharedRefList<vsd::Node> list;
+  list.push_back(&a);
+  list.push_back(&b);
+  const std::string list_text = "[\"@" + a_id + "\", \"@" + b_id + "\"]";
+  EXPECT_EQ(vsd::Value(list).to_text(), list_text);
+  EXPECT_EQ(vsd::Value(vsd::SharedRefList<vsd::Node>()).to_text(), "[]");
+  const auto& lt = vsd::meta_type<vsd::SharedRefList<vsd::Node>>();
+  for (const std::string& text :
+       {list_text, "[@" + a_id + ", @" + b_id + "]", "[@" + a_id + ", \"@" + b_id + "\"]"}) {
+    EXPECT_TRUE(vsd::Value::from_text(lt, text, &refs) == vsd::Value(list)) << text;
+  }
+
+  // Errors name the line and column of the offending reference.
+  EXPECT_THAT(text_error(t, R"("@x")", &refs), StartsWith("1:3: 'x' is not an unsigned integer"));
+  EXPECT_THAT(text_error(t, R"("42")", &refs), StartsWith("1:1: expected a reference"));
+  EXPECT_THAT(text_error(t, "\"@" + a_id, &refs), HasSubstr("ended"));
+  EXPECT_THAT(text_error(t, "nil", &refs),
+              StartsWith("1:1: expected a reference (\"@id\" or null), found 'nil'"));
+  EXPECT_THAT(text_error(t, "5", &refs), StartsWith("1:1: expected a reference"));
+  EXPECT_THAT(text_error(t, R"( "@999999999")", &refs), StartsWith("1:2: dangling reference"));
+  EXPECT_THAT(text_error(lt, "[\"@" + a_id + "\",\n null]", &refs),
+              StartsWith("2:2: a reference list cannot hold null"));
+  EXPECT_THAT(text_error(lt, "[\"@" + a_id + "\", \"@999999999\"]", &refs), HasSubstr("dangling reference"));
 }
 
 }  // namespace

@@ -176,7 +176,7 @@ TEST(Registry, ClassesDeclaredInThisFileAreRegisteredAutomatically) {
   vsd::Environment env;
   vsd::SimStateInstance& w = env.main_state().create("RgWidget");
   EXPECT_EQ(&w.meta(), &rg::RgWidget::static_meta());
-  EXPECT_EQ(w.get("mode").to_text(), "Idle");
+  EXPECT_EQ(w.get("mode").to_text(), "\"Idle\"");
 }
 
 TEST(Registry, ClassWithALongLongPropertyIsRegistered) {

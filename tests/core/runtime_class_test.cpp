@@ -208,7 +208,7 @@ TEST(RuntimeClass, InstanceWorksAsANode) {
   child.set_name("kid");
   node->add_child(child);
   EXPECT_EQ(child.path(), "/rt/kid");
-  EXPECT_EQ(x.get("children").to_text(), "[@" + std::to_string(child.id()) + "]");
+  EXPECT_EQ(x.get("children").to_text(), "[\"@" + std::to_string(child.id()) + "\"]");
   // Removing the run-time node from the tree deletes it with its subtree.
   const vsd::Id id = x.id();
   state.database().remove_child(*node);
@@ -257,7 +257,7 @@ TEST(RuntimeClass, SharedReferenceProperty) {
   auto& target = state.create<vsd::Node>();
   x.set("target", vsd::Value(vsd::SharedRef<vsd::Node>(&target)));
   EXPECT_EQ(target_of(x), &target);
-  EXPECT_EQ(x.get("target").to_text(), "@" + std::to_string(target.id()));
+  EXPECT_EQ(x.get("target").to_text(), "\"@" + std::to_string(target.id()) + "\"");
   EXPECT_EQ(target.composite_count(), 0u) << "a shared reference does not count";
 
   int changes = 0;
@@ -289,7 +289,8 @@ TEST(RuntimeClass, SharedListPropertyAcceptsTheCppListType) {
   list.push_back(&a);
   list.push_back(&b);
   EXPECT_NO_THROW(x.set("friends", vsd::Value(list)));
-  EXPECT_EQ(x.get("friends").to_text(), "[@" + std::to_string(a.id()) + ", @" + std::to_string(b.id()) + "]");
+  EXPECT_EQ(x.get("friends").to_text(),
+            "[\"@" + std::to_string(a.id()) + "\", \"@" + std::to_string(b.id()) + "\"]");
   EXPECT_NO_THROW((void)x.get<vsd::SharedRefList<vsd::Node>>("friends"));
 }
 

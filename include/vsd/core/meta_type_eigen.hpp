@@ -3,8 +3,10 @@
  *
  *  They are structs to the meta-information system: vectors have fields x, y, (z, w); a quaternion
  *  has w, x, y, z; a frame has a translation (Vector3d) and a rotation (Quaterniond). A struct whose
- *  fields are all numbers is written as a list, so a Vector3d reads `[1, 2, 3]` and a frame
- *  `{translation: [1, 2, 3], rotation: [1, 0, 0, 0]}`.
+ *  fields are all numbers is written as a list, so a Vector3d reads `[1, 2, 3]`. A frame's text carries
+ *  its exact matrix, the rotation as rows:
+ *  `{"translation": [1, 2, 3], "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}`; a rotation given as a
+ *  quaternion (`[w, x, y, z]` or `{"w": 1, ...}`, the older form) is read too and normalised.
  */
 #pragma once
 
@@ -82,6 +84,8 @@ struct TypeTraits<Eigen::Vector4d> {
 namespace detail {
 void make_quaternion_fields(MetaType& t);
 void make_isometry_fields(MetaType& t);
+void isometry_write_text(const Eigen::Isometry3d& v, std::string& out);
+void isometry_read_text(Eigen::Isometry3d& v, TextReader& in);
 }  // namespace detail
 
 template <>
@@ -93,9 +97,9 @@ struct TypeTraits<Eigen::Quaterniond> {
   }
 };
 namespace detail {
-// A frame's bytes and its equality use the exact matrix (translation and the 3x3 linear part): going
+// A frame's bytes, text and equality use the exact matrix (translation and the 3x3 linear part): going
 // through a quaternion rounds ordinary rotations in their last bits and cannot carry a damaged matrix.
-// The text form stays {translation, rotation} for people.
+// The fields (translation, rotation quaternion) remain for the generic field API.
 template <>
 inline bool equal_values<Eigen::Isometry3d>(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   for (int i = 0; i < 16; ++i)
@@ -107,6 +111,15 @@ inline std::size_t hash_value<Eigen::Isometry3d>(const Eigen::Isometry3d& v) {
   std::size_t h = 16;
   for (int i = 0; i < 16; ++i) h = hash_combine(h, hash_value(v.matrix().data()[i]));
   return h;
+}
+template <>
+inline void text_out<Eigen::Isometry3d>(const MetaType&, const Eigen::Isometry3d& v, std::string& out) {
+  isometry_write_text(v, out);
+}
+template <>
+inline void text_in<Eigen::Isometry3d>(const MetaType&, Eigen::Isometry3d& v, TextReader& in,
+                                       const RefResolver*) {
+  isometry_read_text(v, in);
 }
 template <>
 inline void bytes_out<Eigen::Isometry3d>(const MetaType&, const Eigen::Isometry3d& v, ByteWriter& out) {
