@@ -5,3 +5,4 @@
 
 #include "vsd/io/file.hpp"
 #include "vsd/io/snapshot.hpp"
+#include "vsd/io/tool.hpp"

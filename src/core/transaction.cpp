@@ -285,8 +285,9 @@ class Applier {
   using RefLink = vsd::detail::RefLink;
 
  public:
-  /// @param values_checked the bundle's plain values were checked by its maker (a loader): the dry run
-  /// then checks structure, references and cycles, not every value again.
+  /// @param values_checked the bundle's plain values, and that its composite references form no cycle,
+  /// were checked by its maker (a loader): the dry run then checks ids, classes, references and list
+  /// positions, not every value or edge again.
   Applier(SimState& s, const Transaction& t, bool values_checked = false)
       : s_(s), t_(t), values_checked_(values_checked) {}
 
@@ -529,6 +530,7 @@ class Applier {
   // it cannot be anybody's ancestor.
   bool holds_nothing(Id id) const { return created_.contains(id) && !holders_.contains(id); }
   void add_edge(const TxOp& op, std::size_t n, Id holder, Id child) {
+    if (values_checked_) return;  // the maker proved the bundle acyclic
     // Most edges of a big bundle point at instances it has just created and that hold nothing yet
     // (a load builds top down): no walk is needed for them.
     if (child == holder || (!holds_nothing(child) && holds_up(holder, child)))
@@ -578,8 +580,14 @@ class Applier {
         SimStateInstance& x = s_.make(cls, op.id);
         for (const auto& [name, bytes] : op.values) {
           const MetaProperty& p = *cls.find_property(name);
-          const Value v = decode(p, bytes);
-          p.type().assign(const_cast<void*>(p.address(x)), v.data());  // initial values: not changes
+          void* at = const_cast<void*>(p.address(x));  // initial values: not changes
+          if (values_checked_ && !p.type().is_reference()) {  // known good: straight into the instance
+            ByteReader r(bytes.data(), bytes.size());
+            p.type().read_bytes(at, r, nullptr);
+          } else {
+            const Value v = decode(p, bytes);
+            p.type().assign(at, v.data());
+          }
         }
         s_.finish_create(x);
         break;

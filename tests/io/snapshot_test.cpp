@@ -6,7 +6,7 @@
 #include <random>
 
 #include "../core/random_model.hpp"
-#include "../core/test_classes.hpp"
+#include "io_model.hpp"
 #include "vsd/io/file.hpp"
 
 using testing::HasSubstr;
@@ -14,52 +14,28 @@ using vsd_test::TRobot;
 using vsd_test::TSensor;
 using vsd_test::TTool;
 
+using vsd_test::build_model;
+using vsd_test::IoPlain;
+
 namespace {
-
-class IoPlain : public vsd::Node {
-  VSD_INSTANCE(IoPlain, vsd::Node)
-  VSD_PROPERTY(double, saved, 1.0, vsd::Savable)
-  VSD_PROPERTY(double, not_saved, 2.0, vsd::Editable)
-};
-
-// A model with every kind of value and reference.
-void build_model(vsd::SimState& s) {
-  auto& cell = s.create<vsd::Node>();
-  cell.set_name("cell");
-  s.database().add_child(cell);
-  auto& r = s.create<TRobot>();
-  r.set_name("arm");
-  r.set_speed(2.5);
-  r.set_joints({0.1, -0.2, 0.3});
-  Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
-  f.translate(Eigen::Vector3d(1, 2, 3));
-  r.set_frame(f);
-  cell.add_child(r);
-  auto& tool = s.create<TTool>();
-  tool.set_length(0.25);
-  r.set_tool(&tool);  // composite, not a child
-  auto& goal = s.create<vsd::Node>();
-  goal.set_name("goal");
-  cell.add_child(goal);
-  r.set_target(&goal);  // shared, pointing forward in id order from nothing
-  auto& sensor = s.create<TSensor>();
-  sensor.set_range(9);
-  r.add_extension(sensor);
-  const vsd::MetaProperty& watched = TRobot::vsd_prop_watched();
-  r.list_insert(watched, 0, goal);
-  r.list_insert(watched, 1, cell);
-  s.database().set_name("world");
-}
 
 std::string diff_of(const vsd::SimState& a, const vsd::SimState& b) {
   std::string d;
   return a.equals(b, &d) ? std::string() : d;
 }
 
-TEST(Snapshot, WholeStateRoundTripKeepsIdsAndEverything) {
+std::string format_name(vsd::io::Format f) { return f == vsd::io::Format::Text ? "Text" : "Binary"; }
+
+// What both formats must do alike.
+class Snapshot : public testing::TestWithParam<vsd::io::Format> {
+ protected:
+  static vsd::io::Format format() { return GetParam(); }
+};
+
+TEST_P(Snapshot, WholeStateRoundTripKeepsIdsAndEverything) {
   vsd::Environment env;
   build_model(env.main_state());
-  const auto bytes = vsd::io::save_bytes(env.main_state());
+  const auto bytes = vsd::io::save_bytes(env.main_state(), format());
   auto& copy = env.create_state("copy");
   const vsd::io::LoadReport report = vsd::io::load_bytes(copy, bytes);
   EXPECT_EQ(diff_of(env.main_state(), copy), "");
@@ -68,11 +44,11 @@ TEST(Snapshot, WholeStateRoundTripKeepsIdsAndEverything) {
   EXPECT_EQ(report.roots[0]->name(), "cell");
   EXPECT_TRUE(report.warnings.empty());
   EXPECT_EQ(vsd_test::check_reference_counts(copy), "");
-  EXPECT_EQ(vsd::io::save_bytes(copy), bytes) << "saving what was loaded gives the same bytes";
+  EXPECT_EQ(vsd::io::save_bytes(copy, format()), bytes) << "saving what was loaded gives the same bytes";
 }
 
 // A frame's rotation is stored as its exact matrix: an arbitrary rotation comes back bit for bit.
-TEST(Snapshot, FramesRoundTripExactly) {
+TEST_P(Snapshot, FramesRoundTripExactly) {
   vsd::Environment env;
   auto& r = env.main_state().create<TRobot>();
   Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
@@ -80,26 +56,26 @@ TEST(Snapshot, FramesRoundTripExactly) {
   f.translation() << 0.1, -0.2, 1e-300;
   r.set_frame(f);
   auto& copy = env.create_state("copy");
-  vsd::io::load_bytes(copy, vsd::io::save_bytes(env.main_state()));
+  vsd::io::load_bytes(copy, vsd::io::save_bytes(env.main_state(), format()));
   const Eigen::Isometry3d& g = copy.find<TRobot>(r.id())->frame();
   for (int i = 0; i < 16; ++i) EXPECT_EQ(f.matrix().data()[i], g.matrix().data()[i]) << i;
 }
 
-TEST(Snapshot, LoadedIdsAreNeverHandedOutAgain) {
+TEST_P(Snapshot, LoadedIdsAreNeverHandedOutAgain) {
   vsd::Environment source;
   build_model(source.main_state());
   for (int i = 0; i < 50; ++i) source.main_state().create<vsd::Node>();
-  const auto bytes = vsd::io::save_bytes(source.main_state());
+  const auto bytes = vsd::io::save_bytes(source.main_state(), format());
   vsd::Environment target;  // a fresh environment whose counter starts low
   vsd::io::load_bytes(target.main_state(), bytes);
   for (int i = 0; i < 100; ++i) target.main_state().create<vsd::Node>();  // must not clash
   EXPECT_EQ(target.main_state().size(), source.main_state().size() + 100);
 }
 
-TEST(Snapshot, LoadingUnderANodeGivesFreshIds) {
+TEST_P(Snapshot, LoadingUnderANodeGivesFreshIds) {
   vsd::Environment env;
   build_model(env.main_state());
-  const auto bytes = vsd::io::save_bytes(env.main_state());
+  const auto bytes = vsd::io::save_bytes(env.main_state(), format());
   vsd::SimState& s = env.main_state();
   auto& holder = s.create<vsd::Node>();
   holder.set_name("imports");
@@ -116,13 +92,13 @@ TEST(Snapshot, LoadingUnderANodeGivesFreshIds) {
   EXPECT_EQ(vsd_test::check_reference_counts(s), "");
 }
 
-TEST(Snapshot, SubtreesCutOutsideReferences) {
+TEST_P(Snapshot, SubtreesCutOutsideReferences) {
   vsd::Environment env;
   build_model(env.main_state());
   vsd::SimState& s = env.main_state();
   auto* arm = static_cast<TRobot*>(s.database().find_child("cell")->find_child("arm"));
   vsd::io::SaveReport saved;
-  const auto bytes = vsd::io::save_bytes(*arm, &saved);
+  const auto bytes = vsd::io::save_bytes(*arm, format(), &saved);
   EXPECT_EQ(saved.instances, 3u);       // arm, its tool, its sensor
   EXPECT_EQ(saved.cut_references, 3u);  // target and two watched nodes lie outside
   auto& other = env.create_state("other");
@@ -136,21 +112,21 @@ TEST(Snapshot, SubtreesCutOutsideReferences) {
   EXPECT_NE(loaded.find_extension<TSensor>(), nullptr);
 }
 
-TEST(Snapshot, OnlySavablePropertiesAreWritten) {
+TEST_P(Snapshot, OnlySavablePropertiesAreWritten) {
   vsd::Environment env;
   auto& p = env.main_state().create<IoPlain>();
   p.set_saved(5);
   p.set_not_saved(6);
   env.main_state().database().add_child(p);
   auto& copy = env.create_state("copy");
-  vsd::io::load_bytes(copy, vsd::io::save_bytes(env.main_state()));
+  vsd::io::load_bytes(copy, vsd::io::save_bytes(env.main_state(), format()));
   auto* q = copy.find<IoPlain>(p.id());
   ASSERT_NE(q, nullptr);
   EXPECT_EQ(q->saved(), 5);
   EXPECT_EQ(q->not_saved(), 2) << "not Savable: the default";
 }
 
-TEST(Snapshot, RunTimeClassesTravelWithTheFile) {
+TEST_P(Snapshot, RunTimeClassesTravelWithTheFile) {
   std::vector<std::uint8_t> bytes;
   {
     const vsd::MetaInstance& belt = vsd::ClassBuilder("IoBelt", vsd::Node::static_meta())
@@ -163,7 +139,7 @@ TEST(Snapshot, RunTimeClassesTravelWithTheFile) {
     b.set("speed", vsd::Value(3.0));
     b.set("label", vsd::Value("express"));
     env.main_state().database().add_child(b);
-    bytes = vsd::io::save_bytes(env.main_state());
+    bytes = vsd::io::save_bytes(env.main_state(), format());
   }
   vsd::Registry::global().undefine(vsd::Registry::global().get_class("IoFastBelt"));
   vsd::Registry::global().undefine(vsd::Registry::global().get_class("IoBelt"));
@@ -175,13 +151,13 @@ TEST(Snapshot, RunTimeClassesTravelWithTheFile) {
   EXPECT_EQ(report.roots[0]->get<double>("speed"), 3.0);
   EXPECT_EQ(report.roots[0]->get<std::string>("label"), "express");
   EXPECT_EQ(report.roots[0]->get<int>("lanes"), 2);
-  EXPECT_EQ(vsd::io::save_bytes(env.main_state()), bytes) << "loaded and saved again: unchanged";
+  EXPECT_EQ(vsd::io::save_bytes(env.main_state(), format()), bytes) << "loaded and saved again: unchanged";
   env.main_state().destroy(*report.roots[0]);
   vsd::Registry::global().undefine(vsd::Registry::global().get_class("IoFastBelt"));
   vsd::Registry::global().undefine(vsd::Registry::global().get_class("IoBelt"));
 }
 
-TEST(Snapshot, SchemaEvolution) {
+TEST_P(Snapshot, SchemaEvolution) {
   std::vector<std::uint8_t> bytes;
   {
     const vsd::MetaInstance& v1 = vsd::ClassBuilder("IoEvolving", vsd::Node::static_meta())
@@ -195,7 +171,7 @@ TEST(Snapshot, SchemaEvolution) {
     x.set("gone", vsd::Value(1.5));
     x.set("colour", vsd::Value("red"));
     env.main_state().database().add_child(static_cast<vsd::Node&>(x));
-    bytes = vsd::io::save_bytes(env.main_state());
+    bytes = vsd::io::save_bytes(env.main_state(), format());
     env.main_state().destroy(x);
     vsd::Registry::global().undefine(v1);
   }
@@ -222,6 +198,9 @@ TEST(Snapshot, SchemaEvolution) {
   }
   vsd::Registry::global().undefine(v2);
 }
+
+INSTANTIATE_TEST_SUITE_P(Formats, Snapshot, testing::Values(vsd::io::Format::Binary, vsd::io::Format::Text),
+                         [](const auto& info) { return format_name(info.param); });
 
 class HostileSnapshot : public testing::Test {
  protected:
@@ -268,7 +247,7 @@ TEST_F(HostileSnapshot, CorruptionNeverCrashesOrHalfLoads) {
 TEST_F(HostileSnapshot, HeaderAndVersion) {
   auto bad = bytes;
   bad[0] = 'X';
-  EXPECT_THAT(load_error(bad), HasSubstr("byte 0: not a vsd snapshot"));
+  EXPECT_THAT(load_error(bad), HasSubstr("byte 0: not a vsd file"));
   bad = bytes;
   bad[4] = 9;
   EXPECT_THAT(load_error(bad), HasSubstr("byte 4: snapshot format version 9"));
@@ -317,21 +296,22 @@ namespace {
 
 // Round trips of randomly grown models: every kind of value and reference, floating instances,
 // deletions and moves behind them.
-class SnapshotRandomModels : public testing::TestWithParam<std::uint32_t> {};
+class SnapshotRandomModels : public testing::TestWithParam<std::tuple<std::uint32_t, vsd::io::Format>> {};
 
 TEST_P(SnapshotRandomModels, RoundTripToEqualStates) {
   vsd::Environment env;
   vsd::SimState& state = env.main_state();
-  vsd_test::RandomModel model(state, GetParam());
+  const auto [seed, format] = GetParam();
+  vsd_test::RandomModel model(state, seed);
   for (int round = 0; round < 5; ++round) {
     for (int i = 0; i < 300; ++i) model.step();
-    const auto bytes = vsd::io::save_bytes(state);
+    const auto bytes = vsd::io::save_bytes(state, format);
     auto& copy = env.create_state("copy");
     vsd::io::load_bytes(copy, bytes);
     std::string diff;
     ASSERT_TRUE(copy.equals(state, &diff)) << "round " << round << ": " << diff;
     ASSERT_EQ(vsd_test::check_reference_counts(copy), "");
-    ASSERT_EQ(vsd::io::save_bytes(copy), bytes) << "round " << round;
+    ASSERT_EQ(vsd::io::save_bytes(copy, format), bytes) << "round " << round;
     // The same file under a node of another state: fresh ids, same shape.
     auto& other = env.create_state("other");
     auto& holder = other.create<vsd::Node>();
@@ -345,6 +325,11 @@ TEST_P(SnapshotRandomModels, RoundTripToEqualStates) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Seeds, SnapshotRandomModels, testing::Values(11u, 12u, 13u));
+INSTANTIATE_TEST_SUITE_P(Seeds, SnapshotRandomModels,
+                         testing::Combine(testing::Values(11u, 12u, 13u),
+                                          testing::Values(vsd::io::Format::Binary, vsd::io::Format::Text)),
+                         [](const auto& info) {
+                           return format_name(std::get<1>(info.param)) + std::to_string(std::get<0>(info.param));
+                         });
 
 }  // namespace

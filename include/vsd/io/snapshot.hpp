@@ -1,22 +1,27 @@
 /** @file
- *  @brief Binary snapshots: save a SimState (or one subtree) and load it into an empty state or under
- *  a node of an existing one.
+ *  @brief Save a SimState (or one subtree) and load it into an empty state or under a node of an existing
+ *  one, as a readable text file or a compact binary snapshot.
  *
  *  What is written is decided by the meta-information: every Savable, non-Transient property of every
  *  instance, references by id, and the definitions of the run-time classes the instances use (so a
- *  program that never defined them can load the file, inspect it and save it again).
+ *  program that never defined them can load the file, inspect it and save it again unchanged).
  *
- *  Format "VSDS", version 1: a class table (name, run-time definition if any, the saved properties by
- *  name and type name), then the instances (id, class, one length-framed value per saved property in
- *  each property type's binary form), then the top-level node ids.
+ *  Two formats, one API; a load recognises the format by the file's first bytes:
+ *  - Format::Text, "vsd-text" version 1: JSON (RFC 8259), one instance per object and one property per
+ *    line so that it diffs well; each value is its type's text form (MetaType::write_text). Errors say
+ *    line:col. See docs/file-formats.md.
+ *  - Format::Binary, "VSDS" version 1: a class table (name, run-time definition if any, the saved
+ *    properties by name and type name), then the instances (id, class, one length-framed value per saved
+ *    property in each property type's binary form), then the top-level node ids. Errors say the byte
+ *    offset.
  *
  *  Loading is all or nothing: the file is read and checked into a Transaction bundle, which the target
  *  SimState checks again (ids, classes, values, reference targets, list positions, composite cycles)
- *  before it changes anything. A malformed, truncated or hostile file gets a vsd::Error with the byte
- *  offset and what was wrong; the target state is exactly as before. Schema evolution: a property the
- *  class no longer has is reported (LoadReport::warnings) and dropped; one the file lacks keeps its
- *  default; a renamed one is found through the class's aliases (MetaProperty::add_alias); a value whose
- *  type changed converts when the number fits, and is reported otherwise.
+ *  before it changes anything. A malformed, truncated or hostile file gets a vsd::Error with the position
+ *  and what was wrong; the target state is exactly as before. Schema evolution: a property the class no
+ *  longer has is reported (LoadReport::warnings) and dropped; one the file lacks keeps its default; a
+ *  renamed one is found through the class's aliases (ClassBuilder::alias, MetaProperty::add_alias); a value
+ *  whose type changed converts when the number fits, and is reported otherwise.
  */
 #pragma once
 
@@ -32,6 +37,17 @@
 
 namespace vsd::io {
 
+/// @brief The two file formats.
+enum class Format : std::uint8_t {
+  Binary,  ///< "VSDS" snapshot: compact and fast
+  Text     ///< "vsd-text" JSON: readable, diffs well in version control
+};
+
+/// @brief The format a file name asks for: Text for ".json", Binary otherwise.
+Format format_for(const std::filesystem::path& path);
+/// @brief The format of a file's content (by its first bytes). @throws vsd::Error when it is neither.
+Format format_of(std::span<const std::uint8_t> bytes, std::string_view origin = "file");
+
 /// @brief What a save wrote.
 struct SaveReport {
   std::size_t instances = 0;
@@ -41,6 +57,9 @@ struct SaveReport {
 
 /// @brief What a load did.
 struct LoadReport {
+  /// The format the file was in, and whether it held a subtree (else a whole state).
+  Format format = Format::Binary;
+  bool subtree = false;
   std::size_t instances = 0;
   /// The nodes that were top level in the file (the subtree root, or the Database's children), now
   /// attached to the target.
@@ -51,23 +70,27 @@ struct LoadReport {
   std::vector<std::string> warnings;
 };
 
-/// @brief The whole state as a snapshot.
-std::vector<std::uint8_t> save_bytes(const SimState& state, SaveReport* report = nullptr);
+/// @brief The whole state in @p format.
+std::vector<std::uint8_t> save_bytes(const SimState& state, Format format = Format::Binary,
+                                     SaveReport* report = nullptr);
 /// @brief @p root and everything it holds compositely (children, extensions, composite references).
-std::vector<std::uint8_t> save_bytes(const Node& root, SaveReport* report = nullptr);
+std::vector<std::uint8_t> save_bytes(const Node& root, Format format = Format::Binary,
+                                     SaveReport* report = nullptr);
 
-/// @brief Loads a whole-state snapshot into @p state, which must be empty; ids are kept.
+/// @brief Loads a whole-state file (either format) into @p state, which must be empty; ids are kept.
 LoadReport load_bytes(SimState& state, std::span<const std::uint8_t> bytes,
                       std::string_view origin = "snapshot");
-/// @brief Loads a snapshot under @p parent; instances get fresh ids of @p parent's Environment. The
+/// @brief Loads a file (either format) under @p parent; instances get fresh ids of @p parent's Environment. The
 /// file's Database stands for @p parent: its children become @p parent's, references to it point at
 /// @p parent, and its own values are not copied.
 LoadReport load_bytes(Node& parent, std::span<const std::uint8_t> bytes,
                       std::string_view origin = "snapshot");
 
-/// @brief save_bytes() written with write_file_atomically().
+/// @brief save_bytes() written with write_file_atomically(), in the format the file name asks for.
 SaveReport save(const SimState& state, const std::filesystem::path& path);
 SaveReport save(const Node& root, const std::filesystem::path& path);
+SaveReport save(const SimState& state, const std::filesystem::path& path, Format format);
+SaveReport save(const Node& root, const std::filesystem::path& path, Format format);
 /// @brief load_bytes() of a file; errors name the file.
 LoadReport load(SimState& state, const std::filesystem::path& path);
 LoadReport load(Node& parent, const std::filesystem::path& path);

@@ -1,0 +1,53 @@
+// Internal to vsd::io: what both formats' writers share, and the entry points of each format.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+#include "load_model.hpp"
+
+namespace vsd::io::detail {
+
+/// The instances a save writes, and the classes they use in an order that defines run-time bases first.
+class SaveSet {
+ public:
+  SaveSet(std::vector<const SimStateInstance*> members, std::uint8_t kind, std::vector<Id> top,
+          SaveReport* report);
+
+  [[nodiscard]] const std::vector<const SimStateInstance*>& members() const noexcept { return members_; }
+  [[nodiscard]] const std::vector<const MetaInstance*>& classes() const noexcept { return classes_; }
+  [[nodiscard]] std::size_t class_index(const MetaInstance& c) const { return index_.at(&c); }
+  [[nodiscard]] std::uint8_t kind() const noexcept { return kind_; }
+  [[nodiscard]] const std::vector<Id>& top() const noexcept { return top_; }
+
+  /// The id a reference to @p t is written as: null for instances outside the set (counted as cut).
+  Id member_id(const SimStateInstance* t);
+  /// The ids reference property @p p of @p x is written as (a list leaves out targets outside the set).
+  void reference_ids(const SimStateInstance& x, const MetaProperty& p, std::vector<Id>& out);
+
+ private:
+  void add_class(const MetaInstance& c);
+
+  std::vector<const SimStateInstance*> members_;
+  std::unordered_set<const SimStateInstance*> member_set_;
+  std::uint8_t kind_;
+  std::vector<Id> top_;
+  SaveReport* report_;
+  std::vector<const MetaInstance*> classes_;
+  std::unordered_map<const MetaInstance*, std::size_t> index_;
+};
+
+std::vector<std::uint8_t> write_binary(SaveSet& set);
+std::vector<std::uint8_t> write_text(SaveSet& set);
+
+/// Reads a file of the format into a model and applies it to @p state (under @p parent when not null).
+LoadReport load_binary(SimState& state, Node* parent, std::span<const std::uint8_t> bytes,
+                       std::string_view origin);
+LoadReport load_text(SimState& state, Node* parent, std::span<const std::uint8_t> bytes,
+                     std::string_view origin);
+
+}  // namespace vsd::io::detail

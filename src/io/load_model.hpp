@@ -1,0 +1,130 @@
+// Internal to vsd::io: what a loader reads from a file, whatever its format, and how that becomes one
+// Transaction on the target state.
+//
+// A format's reader (binary: snapshot.cpp, text: text_snapshot.cpp) fills the model: the classes the
+// file uses (defining the run-time ones it carries), every instance with its values already checked and
+// in the binary form of the property's type, and references as the file's ids. finish() checks what
+// spans instances (duplicate ids, dangling references, top-level nodes); apply() maps the ids and
+// applies one bundle, which the SimState checks again before it changes anything.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <span>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "vsd/io/snapshot.hpp"
+
+namespace vsd::io::detail {
+
+inline constexpr std::uint8_t kind_state = 0;
+inline constexpr std::uint8_t kind_subtree = 1;
+
+/// What persistence writes: Savable properties that are not Transient.
+inline bool is_saved(const MetaProperty& p) { return p.has(Savable) && !p.has(Transient); }
+
+/// One saved property of a class, as the file describes it.
+struct Slot {
+  const MetaProperty* prop = nullptr;  // null: the class has no such property any more
+  const MetaType* file_type = nullptr;
+  bool convert = false;  // a number whose type changed: converted value by value
+};
+
+struct ClassEntry {
+  const MetaInstance* cls = nullptr;
+  std::vector<Slot> slots;
+};
+
+struct SavedValue {
+  const Slot* slot;
+  std::size_t offset;                   // in the file, for messages
+  std::span<const std::uint8_t> bytes;  // the value in the property's type (binary form)
+  std::uint32_t ids_first = 0;          // reference targets (file ids): ids_[ids_first, + ids_count)
+  std::uint32_t ids_count = 0;
+};
+
+struct SavedInstance {
+  Id id;
+  const ClassEntry* entry;
+  std::size_t offset;
+  std::size_t first;  // its values are values_[first, first + count)
+  std::size_t count;
+};
+
+/// A run-time class definition as a file carries it.
+struct ClassDefinition {
+  std::string name;
+  std::string base;
+  bool abstract = false;
+  struct Property {
+    std::string name;
+    const MetaType* type;
+    PropertyFlags flags;
+    Value default_value;
+  };
+  std::vector<Property> properties;
+};
+
+class LoadModel {
+ public:
+  LoadModel(Registry& registry, std::string_view origin) : registry_(registry), origin_(origin) {}
+  LoadModel(const LoadModel&) = delete;
+  LoadModel& operator=(const LoadModel&) = delete;
+  /// A load that did not commit leaves no class it defined behind.
+  virtual ~LoadModel();
+
+  /// Applies the model to @p state: under @p parent, or (nullptr) as the whole of an empty state.
+  LoadReport apply(SimState& state, Node* parent);
+
+ protected:
+  /// The origin and the position @p at in the format's terms ("file: byte 12", "file:3:14").
+  [[nodiscard]] virtual std::string where(std::size_t at) const = 0;
+  /// Throws vsd::Error naming where(at) and @p what.
+  [[noreturn]] void fail_at(std::size_t at, const std::string& what) const { throw Error(where(at) + ": " + what); }
+
+  /// The class named @p name, defined from @p def when this program does not know it (def may be null).
+  const MetaInstance& resolve_class(std::size_t at, const std::string& name, const ClassDefinition* def);
+  /// How a saved property @p prop of type @p type_name (empty: unknown) of @p cls maps to today's class;
+  /// schema differences are reported in warnings_.
+  Slot make_slot(std::size_t at, const MetaInstance& cls, std::string_view prop, std::string_view type_name);
+  const MetaType& type_named(std::size_t at, std::string_view name);
+
+  /// A copy of @p bytes owned by the model (converted or parsed values) that never moves.
+  std::span<const std::uint8_t> own(std::span<const std::uint8_t> bytes);
+
+  /// Checks across instances once all are read: ids unique, top-level ids present and Nodes, every
+  /// reference names an instance of the file.
+  void finish();
+
+  std::span<const Id> ids_of(const SavedValue& v) const {
+    return std::span<const Id>(ids_).subspan(v.ids_first, v.ids_count);
+  }
+  std::span<const SavedValue> values_of(const SavedInstance& x) const {
+    return std::span<const SavedValue>(values_).subspan(x.first, x.count);
+  }
+
+  Registry& registry_;
+  std::string_view origin_;
+  std::uint8_t kind_ = kind_state;
+  std::deque<ClassEntry> classes_;  // a deque: entries never move while instances point at them
+  std::vector<SavedInstance> instances_;
+  std::vector<SavedValue> values_;  // of all instances, in file order
+  std::vector<Id> ids_;             // reference targets of all values
+  std::vector<Id> top_;
+  std::vector<std::size_t> top_offsets_;
+  std::vector<std::string> warnings_;
+
+ private:
+  void check_composite_cycles() const;
+
+  std::deque<std::vector<std::uint8_t>> arena_;  // chunks that are filled, never grown
+  std::unordered_map<Id, const SavedInstance*> by_id_;
+  std::vector<const MetaInstance*> defined_;
+  bool committed_ = false;
+};
+
+}  // namespace vsd::io::detail

@@ -1,0 +1,153 @@
+// The public persistence API (vsd/io/snapshot.hpp): what a save writes, and the choice of format.
+#include <algorithm>
+
+#include "formats.hpp"
+#include "vsd/io/file.hpp"
+
+namespace vsd::io {
+
+namespace detail {
+
+SaveSet::SaveSet(std::vector<const SimStateInstance*> members, std::uint8_t kind, std::vector<Id> top,
+                 SaveReport* report)
+    : members_(std::move(members)), kind_(kind), top_(std::move(top)), report_(report) {
+  member_set_.reserve(members_.size());
+  for (const SimStateInstance* x : members_) {
+    member_set_.insert(x);
+    add_class(x->meta());
+  }
+  if (report_ != nullptr) *report_ = SaveReport{members_.size(), 0};
+}
+
+void SaveSet::add_class(const MetaInstance& c) {
+  if (index_.count(&c) != 0) return;
+  if (c.is_runtime()) add_class(*c.base());  // a run-time base is defined before its subclasses
+  index_.emplace(&c, classes_.size());
+  classes_.push_back(&c);
+}
+
+Id SaveSet::member_id(const SimStateInstance* t) {
+  if (t == nullptr) return null_id;
+  if (member_set_.count(t) != 0) return t->id();
+  if (report_ != nullptr) ++report_->cut_references;
+  return null_id;
+}
+
+void SaveSet::reference_ids(const SimStateInstance& x, const MetaProperty& p, std::vector<Id>& out) {
+  const void* at = p.address(x);
+  if (!p.type().is_ref_list()) {
+    out.push_back(member_id(static_cast<const RefBase*>(at)->get()));
+    return;
+  }
+  const auto& list = *static_cast<const RefListBase*>(at);
+  for (std::size_t i = 0; i < list.size(); ++i)
+    if (const Id id = member_id(list.at(i)); id != null_id) out.push_back(id);
+}
+
+}  // namespace detail
+
+namespace {
+
+// Everything @p root holds compositely, @p root first, each once.
+std::vector<const SimStateInstance*> composite_closure(const SimStateInstance& root) {
+  std::vector<const SimStateInstance*> out{&root};
+  std::unordered_set<const SimStateInstance*> seen{&root};
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    for (const MetaProperty* p : out[i]->meta().reference_properties()) {
+      if (!p->type().is_composite()) continue;
+      auto visit = [&](const SimStateInstance* t) {
+        if (t != nullptr && seen.insert(t).second) out.push_back(t);
+      };
+      if (p->type().is_ref_list()) {
+        const auto& list = *static_cast<const RefListBase*>(p->address(*out[i]));
+        for (std::size_t k = 0; k < list.size(); ++k) visit(list.at(k));
+      } else {
+        visit(static_cast<const RefBase*>(p->address(*out[i]))->get());
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<std::uint8_t> write(detail::SaveSet& set, Format format) {
+  return format == Format::Text ? detail::write_text(set) : detail::write_binary(set);
+}
+
+LoadReport load_into(SimState& state, Node* parent, std::span<const std::uint8_t> bytes,
+                     std::string_view origin) {
+  const Format format = format_of(bytes, origin);
+  LoadReport report = format == Format::Text ? detail::load_text(state, parent, bytes, origin)
+                                             : detail::load_binary(state, parent, bytes, origin);
+  report.format = format;
+  return report;
+}
+
+}  // namespace
+
+Format format_for(const std::filesystem::path& path) {
+  return path.extension() == ".json" ? Format::Text : Format::Binary;
+}
+
+Format format_of(std::span<const std::uint8_t> bytes, std::string_view origin) {
+  // A binary snapshot starts with "VSDS" (a shorter start of it is a truncated one: its reader says so).
+  const std::size_t head = std::min<std::size_t>(bytes.size(), 4);
+  if (head > 0 && std::equal(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(head), "VSDS"))
+    return Format::Binary;
+  // Text: JSON, after an optional UTF-8 byte order mark and blanks, starts with '{'.
+  std::size_t i = bytes.size() >= 3 && bytes[0] == 0xEF && bytes[1] == 0xBB && bytes[2] == 0xBF ? 3 : 0;
+  while (i < bytes.size() && (bytes[i] == ' ' || bytes[i] == '\t' || bytes[i] == '\n' || bytes[i] == '\r')) ++i;
+  if (i < bytes.size() && bytes[i] == '{') return Format::Text;
+  throw Error(std::string(origin) +
+              ": byte 0: not a vsd file: neither a binary snapshot (\"VSDS\") nor a text file (JSON, '{')");
+}
+
+std::vector<std::uint8_t> save_bytes(const SimState& state, Format format, SaveReport* report) {
+  std::vector<const SimStateInstance*> members;
+  for (SimStateInstance* x : state.instances()) members.push_back(x);
+  std::vector<Id> top;
+  for (const Node* n : state.database().children()) top.push_back(n->id());
+  detail::SaveSet set(std::move(members), detail::kind_state, std::move(top), report);
+  return write(set, format);
+}
+
+std::vector<std::uint8_t> save_bytes(const Node& root, Format format, SaveReport* report) {
+  if (root.is_a<Database>()) return save_bytes(root.state(), format, report);
+  detail::SaveSet set(composite_closure(root), detail::kind_subtree, {root.id()}, report);
+  return write(set, format);
+}
+
+LoadReport load_bytes(SimState& state, std::span<const std::uint8_t> bytes, std::string_view origin) {
+  return load_into(state, nullptr, bytes, origin);
+}
+
+LoadReport load_bytes(Node& parent, std::span<const std::uint8_t> bytes, std::string_view origin) {
+  return load_into(parent.state(), &parent, bytes, origin);
+}
+
+SaveReport save(const SimState& state, const std::filesystem::path& path, Format format) {
+  SaveReport report;
+  write_file_atomically(path, save_bytes(state, format, &report));
+  return report;
+}
+
+SaveReport save(const Node& root, const std::filesystem::path& path, Format format) {
+  SaveReport report;
+  write_file_atomically(path, save_bytes(root, format, &report));
+  return report;
+}
+
+SaveReport save(const SimState& state, const std::filesystem::path& path) {
+  return save(state, path, format_for(path));
+}
+
+SaveReport save(const Node& root, const std::filesystem::path& path) { return save(root, path, format_for(path)); }
+
+LoadReport load(SimState& state, const std::filesystem::path& path) {
+  return load_bytes(state, read_file(path), path.string());
+}
+
+LoadReport load(Node& parent, const std::filesystem::path& path) {
+  return load_bytes(parent, read_file(path), path.string());
+}
+
+}  // namespace vsd::io

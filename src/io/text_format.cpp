@@ -1,0 +1,603 @@
+// The text format "vsd-text" (see vsd/io/snapshot.hpp and docs/file-formats.md): JSON written one property
+// per line, and read into a LoadModel with line:col in every error.
+//
+// Each value is its type's own text form (MetaType::write_text, valid JSON by design), and is read back by
+// MetaType::read_text on the same TextReader, so an error deep inside a value still names its line:col.
+// The reader takes JSON's members in any order: the top level is scanned once for where each part starts,
+// and an instance whose "@class" comes after some of its properties reads those when the class is known.
+#include <algorithm>
+#include <charconv>
+#include <optional>
+
+#include "formats.hpp"
+#include "vsd/core/bytes.hpp"
+#include "vsd/core/text.hpp"
+
+namespace vsd::io::detail {
+
+namespace {
+
+constexpr std::string_view format_name = "vsd-text";
+constexpr int format_version = 1;
+
+// ---- property flags as names ------------------------------------------------------------------------------
+
+struct FlagName {
+  std::string_view name;
+  PropertyFlags flag;
+};
+constexpr FlagName flag_names[] = {{"Editable", Editable},
+                                   {"Savable", Savable},
+                                   {"Distributed", Distributed},
+                                   {"ReadOnly", ReadOnly},
+                                   {"Transient", Transient}};
+
+std::string flags_text(PropertyFlags flags) {
+  std::string out;
+  auto add = [&](std::string_view name) {
+    if (!out.empty()) out.push_back('|');
+    out += name;
+  };
+  for (const FlagName& f : flag_names)
+    if (flags.has(f.flag)) add(f.name);
+  for (unsigned n = 0; n < 16; ++n)
+    if (flags.has(UserFlag(n))) add("User" + std::to_string(n));
+  return out;
+}
+
+// ---- writing ----------------------------------------------------------------------------------------------
+
+void write_id(std::string& out, Id id) {
+  if (id == null_id) {
+    out += "null";
+    return;
+  }
+  out += "\"@";
+  out += std::to_string(id);
+  out.push_back('"');
+}
+
+void write_key(std::string& out, std::string_view indent, std::string_view key) {
+  out += indent;
+  write_quoted(out, key);
+  out += ": ";
+}
+
+void write_class(std::string& out, const MetaInstance& c) {
+  out += "    {";
+  write_key(out, "", "class");
+  write_quoted(out, c.name());
+  if (c.is_runtime()) {
+    out += ",\n";
+    write_key(out, "      ", "base");
+    write_quoted(out, c.base()->name());
+    out += ",\n";
+    write_key(out, "      ", "abstract");
+    out += c.is_abstract() ? "true" : "false";
+    out += ",\n";
+    write_key(out, "      ", "properties");
+    out += "[";
+    bool first = true;
+    for (const MetaProperty* p : c.own_properties()) {
+      out += first ? "\n        {" : ",\n        {";
+      first = false;
+      write_key(out, "", "name");
+      write_quoted(out, p->name());
+      write_key(out, ", ", "type");
+      write_quoted(out, p->type().name());
+      write_key(out, ", ", "flags");
+      write_quoted(out, flags_text(p->flags()));
+      write_key(out, ", ", "default");
+      if (p->type().is_reference())
+        out += p->type().is_ref_list() ? "[]" : "null";
+      else
+        p->type().write_text(p->default_value().data(), out);
+      out.push_back('}');
+    }
+    out += first ? "]" : "\n      ]";
+  }
+  out += ",\n";
+  write_key(out, "      ", "saved");
+  out.push_back('{');
+  bool first = true;
+  for (const MetaProperty* p : c.properties()) {
+    if (!is_saved(*p)) continue;
+    if (!first) out += ", ";
+    first = false;
+    write_quoted(out, p->name());
+    out += ": ";
+    write_quoted(out, p->type().name());
+  }
+  out += "}}";
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> write_text(SaveSet& set) {
+  std::string out;
+  out += "{\n";
+  write_key(out, "  ", "format");
+  write_quoted(out, format_name);
+  out += ",\n";
+  write_key(out, "  ", "version");
+  out += std::to_string(format_version);
+  out += ",\n";
+  write_key(out, "  ", "kind");
+  out += set.kind() == kind_state ? "\"state\"" : "\"subtree\"";
+  out += ",\n";
+  write_key(out, "  ", "classes");
+  out += "[\n";
+  for (std::size_t i = 0; i < set.classes().size(); ++i) {
+    write_class(out, *set.classes()[i]);
+    out += i + 1 < set.classes().size() ? ",\n" : "\n";
+  }
+  out += "  ],\n";
+  write_key(out, "  ", "instances");
+  out += "[\n";
+  std::vector<Id> ids;
+  for (std::size_t i = 0; i < set.members().size(); ++i) {
+    const SimStateInstance& x = *set.members()[i];
+    out += "    {\"@id\": ";
+    out += std::to_string(x.id());
+    out += ", \"@class\": ";
+    write_quoted(out, x.meta().name());
+    for (const MetaProperty* p : x.meta().properties()) {
+      if (!is_saved(*p)) continue;
+      out += ",\n";
+      write_key(out, "      ", p->name());
+      if (p->type().is_reference()) {
+        ids.clear();
+        set.reference_ids(x, *p, ids);
+        if (p->type().is_ref_list()) {
+          out.push_back('[');
+          for (std::size_t k = 0; k < ids.size(); ++k) {
+            if (k != 0) out += ", ";
+            write_id(out, ids[k]);
+          }
+          out.push_back(']');
+        } else {
+          write_id(out, ids.front());
+        }
+      } else {
+        p->type().write_text(p->address(x), out);
+      }
+    }
+    out += i + 1 < set.members().size() ? "},\n" : "}\n";
+  }
+  out += "  ],\n";
+  write_key(out, "  ", "top");
+  out.push_back('[');
+  for (std::size_t i = 0; i < set.top().size(); ++i) {
+    if (i != 0) out += ", ";
+    write_id(out, set.top()[i]);
+  }
+  out += "]\n}\n";
+  return {out.begin(), out.end()};
+}
+
+// ---- reading ----------------------------------------------------------------------------------------------
+
+namespace {
+
+std::string_view as_text(std::span<const std::uint8_t> bytes) {
+  return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
+}
+
+class TextSnapshotReader final : public LoadModel {
+ public:
+  TextSnapshotReader(Registry& registry, std::span<const std::uint8_t> bytes, std::string_view origin)
+      : LoadModel(registry, origin), in_(as_text(bytes), origin) {
+    // A UTF-8 byte order mark is allowed before the JSON text.
+    if (as_text(bytes).substr(0, 3) == "\xEF\xBB\xBF") in_.seek(3);
+  }
+
+  void read() {
+    // The top level: where each member starts, then read in the order meaning needs.
+    std::optional<std::size_t> format_at, version_at, kind_at, classes_at, instances_at, top_at;
+    in_.expect('{');
+    if (!in_.accept('}')) {
+      do {
+        const std::size_t key_at = in_.token_start();
+        const std::string key = in_.string();
+        in_.expect(':');
+        const std::size_t at = in_.token_start();
+        std::optional<std::size_t>* slot = key == "format"      ? &format_at
+                                           : key == "version"   ? &version_at
+                                           : key == "kind"      ? &kind_at
+                                           : key == "classes"   ? &classes_at
+                                           : key == "instances" ? &instances_at
+                                           : key == "top"       ? &top_at
+                                                                : nullptr;
+        if (slot == nullptr) {
+          warnings_.push_back(where(key_at) + ": unknown member '" + key + "' is ignored");
+        } else {
+          if (*slot) fail_at(key_at, "'" + key + "' is given twice");
+          *slot = at;
+        }
+        in_.skip_value();
+      } while (in_.accept(','));
+      in_.expect('}');
+    }
+    in_.expect_end();
+    const std::size_t end = in_.position();
+
+    if (!format_at) fail_at(0, "not a vsd text file (no \"format\": \"vsd-text\")");
+    in_.seek(*format_at);
+    if (in_.peek() != '"' || in_.string() != format_name)
+      fail_at(*format_at, "not a vsd text file (\"format\" is not \"vsd-text\")");
+    if (!version_at) fail_at(0, "the file names no format \"version\"");
+    in_.seek(*version_at);
+    const std::int64_t version = in_.integer();
+    if (version != format_version)
+      fail_at(*version_at, "format version " + std::to_string(version) + " is not supported (this is " +
+                               std::to_string(format_version) + ")");
+    if (kind_at) {
+      in_.seek(*kind_at);
+      const std::string kind = in_.string();
+      if (kind == "state")
+        kind_ = kind_state;
+      else if (kind == "subtree")
+        kind_ = kind_subtree;
+      else
+        fail_at(*kind_at, "unknown kind '" + kind + "' (state or subtree)");
+    }
+    if (classes_at) read_classes(*classes_at);
+    if (instances_at) read_instances(*instances_at);
+    if (top_at) {
+      in_.seek(*top_at);
+      read_array([&] {
+        top_offsets_.push_back(in_.token_start());
+        const Id id = read_id();
+        if (id == null_id) fail_at(top_offsets_.back(), "a top-level node cannot be null");
+        top_.push_back(id);
+      });
+    }
+    in_.seek(end);
+    finish();
+  }
+
+ private:
+  // A class as this file uses it: its properties' slots (one per saved property of today's class, plus
+  // the file's properties it no longer has), found by name for each key of an instance.
+  struct TextClass {
+    ClassEntry* entry;
+    std::unordered_map<std::string, std::size_t> file_types;  // "saved": property -> index in type_names
+    std::vector<std::string> type_names;
+    std::vector<std::string> reported;  // unknown keys already warned about
+    // Per slot: the class's property (kept even when the slot drops its values), the name the file uses,
+    // and where values are parsed (reset to the default each time).
+    std::vector<const MetaProperty*> props;
+    std::vector<std::string> names;
+    std::vector<Value> scratch;
+  };
+
+  [[nodiscard]] std::string where(std::size_t at) const override {
+    TextReader r = in_;
+    r.seek(at);
+    return std::string(origin_) + ":" + std::to_string(r.line()) + ":" + std::to_string(r.column());
+  }
+
+  template <class F>
+  void read_array(F&& each) {
+    TextReader::Nest nest(in_);
+    in_.expect('[');
+    if (in_.accept(']')) return;
+    do each();
+    while (in_.accept(','));
+    in_.expect(']');
+  }
+
+  template <class F>
+  void read_object(F&& each_key) {
+    TextReader::Nest nest(in_);
+    in_.expect('{');
+    if (in_.accept('}')) return;
+    do {
+      const std::size_t key_at = in_.token_start();
+      if (in_.peek() != '"') fail_at(key_at, "expected a quoted member name");
+      const std::string key = in_.string();
+      in_.expect(':');
+      each_key(key, key_at);
+    } while (in_.accept(','));
+    in_.expect('}');
+  }
+
+  // "@42" (also the bare @42 of the older value text) or null.
+  Id read_id() {
+    const std::size_t at = in_.token_start();
+    const char c = in_.peek();
+    if (c == '@') {
+      in_.expect('@');
+      return in_.unsigned_integer();
+    }
+    if (c == '"') {
+      const std::string s = in_.string();
+      Id id = 0;
+      const char* first = s.data() + 1;
+      const char* last = s.data() + s.size();
+      if (s.size() < 2 || s[0] != '@' || std::from_chars(first, last, id).ptr != last || id == null_id)
+        fail_at(at, "expected a reference \"@<id>\" or null, found \"" + s + "\"");
+      return id;
+    }
+    if (c == 'n' && in_.identifier() == "null") return null_id;
+    fail_at(at, "expected a reference \"@<id>\" or null");
+  }
+
+  std::string read_string(std::string_view what) {
+    const std::size_t at = in_.token_start();
+    if (in_.peek() != '"') fail_at(at, "expected " + std::string(what) + " (a quoted string)");
+    return in_.string();
+  }
+
+  bool read_bool() {
+    const std::size_t at = in_.token_start();
+    const auto w = in_.identifier();
+    if (w == "true") return true;
+    if (w != "false") fail_at(at, "expected true or false");
+    return false;
+  }
+
+  PropertyFlags read_flags() {
+    const std::size_t at = in_.token_start();
+    if (in_.peek() != '"') return PropertyFlags{static_cast<std::uint32_t>(in_.unsigned_integer())};
+    const std::string text = in_.string();
+    PropertyFlags flags;
+    std::string_view rest = text;
+    while (!rest.empty()) {
+      const std::size_t bar = rest.find('|');
+      const std::string_view name = rest.substr(0, bar);
+      rest = bar == std::string_view::npos ? std::string_view{} : rest.substr(bar + 1);
+      bool found = false;
+      for (const FlagName& f : flag_names)
+        if (f.name == name) flags = flags | f.flag, found = true;
+      unsigned n = 0;
+      if (!found && name.substr(0, 4) == "User" && name.size() > 4 &&
+          std::from_chars(name.data() + 4, name.data() + name.size(), n).ptr == name.data() + name.size() && n < 16)
+        flags = flags | UserFlag(n), found = true;
+      if (!found) fail_at(at, "unknown property flag '" + std::string(name) + "'");
+    }
+    return flags;
+  }
+
+  // ---- classes ----
+
+  void read_classes(std::size_t at) {
+    in_.seek(at);
+    read_array([&] { read_class(); });
+  }
+
+  void read_class() {
+    const std::size_t at = in_.token_start();
+    std::optional<std::string> name;
+    std::optional<ClassDefinition> def;
+    std::vector<std::pair<std::string, std::string>> saved;
+    std::vector<std::size_t> saved_at;
+    read_object([&](const std::string& key, std::size_t key_at) {
+      if (key == "class") {
+        name = read_string("a class name");
+      } else if (key == "base") {
+        if (!def) def.emplace();
+        def->base = read_string("a class name");
+      } else if (key == "abstract") {
+        if (!def) def.emplace();
+        def->abstract = read_bool();
+      } else if (key == "properties") {
+        if (!def) def.emplace();
+        read_array([&] { def->properties.push_back(read_definition_property()); });
+      } else if (key == "saved") {
+        read_object([&](const std::string& prop, std::size_t) {
+          saved_at.push_back(in_.token_start());
+          saved.emplace_back(prop, read_string("a type name"));
+        });
+      } else {
+        fail_at(key_at, "unknown member '" + key + "' in a class");
+      }
+    });
+    if (!name) fail_at(at, "a class needs a \"class\" name");
+    if (def) {
+      def->name = *name;
+      if (def->base.empty()) fail_at(at, "run-time class '" + *name + "' needs a \"base\"");
+    }
+    if (by_name_.count(*name) != 0) fail_at(at, "class '" + *name + "' is listed twice");
+    TextClass& tc = text_class(at, *name, def ? &*def : nullptr);
+    for (std::size_t i = 0; i < saved.size(); ++i) {
+      tc.file_types.emplace(saved[i].first, tc.type_names.size());
+      tc.type_names.push_back(saved[i].second);
+      (void)type_named(saved_at[i], saved[i].second);  // an unknown type is an error here, not later
+    }
+    make_slots(at, tc);
+  }
+
+  ClassDefinition::Property read_definition_property() {
+    const std::size_t at = in_.token_start();
+    std::optional<std::string> name;
+    const MetaType* type = nullptr;
+    PropertyFlags flags = DefaultFlags;
+    std::optional<std::size_t> default_at;
+    read_object([&](const std::string& key, std::size_t key_at) {
+      if (key == "name") {
+        name = read_string("a property name");
+      } else if (key == "type") {
+        const std::size_t type_at = in_.token_start();
+        type = &type_named(type_at, read_string("a type name"));
+      } else if (key == "flags") {
+        flags = read_flags();
+      } else if (key == "default") {
+        default_at = in_.token_start();
+        in_.skip_value();  // read once the type is known
+      } else {
+        fail_at(key_at, "unknown member '" + key + "' in a property definition");
+      }
+    });
+    if (!name || type == nullptr) fail_at(at, "a property definition needs a \"name\" and a \"type\"");
+    Value value(*type);
+    if (default_at && !type->is_reference()) {
+      const std::size_t resume = in_.position();
+      in_.seek(*default_at);
+      type->read_text(value.data(), in_, nullptr);
+      in_.seek(resume);
+    }
+    return {std::move(*name), type, flags, std::move(value)};
+  }
+
+  TextClass& text_class(std::size_t at, const std::string& name, const ClassDefinition* def) {
+    if (auto it = by_name_.find(name); it != by_name_.end()) return it->second;
+    ClassEntry& entry = classes_.emplace_back();
+    entry.cls = &resolve_class(at, name, def);
+    return by_name_.emplace(name, TextClass{&entry, {}, {}, {}, {}, {}, {}}).first->second;
+  }
+
+  // One slot per saved property of today's class (with the file's type where it names one), then one for
+  // each property the file lists that the class no longer has.
+  void make_slots(std::size_t at, TextClass& tc) {
+    ClassEntry& e = *tc.entry;
+    std::vector<bool> used(tc.type_names.size());
+    auto file_type_of = [&](const MetaProperty& p) -> std::string_view {
+      auto it = tc.file_types.find(p.name());
+      for (std::size_t k = 0; it == tc.file_types.end() && k < p.aliases().size(); ++k)
+        it = tc.file_types.find(p.aliases()[k]);
+      if (it == tc.file_types.end()) return {};
+      used[it->second] = true;
+      return tc.type_names[it->second];
+    };
+    for (const MetaProperty* p : e.cls->properties()) {
+      if (!is_saved(*p)) continue;
+      e.slots.push_back(make_slot(at, *e.cls, p->name(), file_type_of(*p)));
+      tc.props.push_back(p);
+      tc.names.push_back(p->name());
+    }
+    for (const auto& [prop, index] : tc.file_types) {
+      if (used[index] || e.cls->find_property(prop) != nullptr) continue;
+      e.slots.push_back(make_slot(at, *e.cls, prop, tc.type_names[index]));
+      tc.props.push_back(nullptr);
+      tc.names.push_back(prop);
+    }
+    for (const Slot& s : e.slots)
+      tc.scratch.emplace_back(s.prop == nullptr ? Value() : Value(s.convert ? *s.file_type : s.prop->type()));
+  }
+
+  TextClass& class_named(std::size_t at, const std::string& name) {
+    if (auto it = by_name_.find(name); it != by_name_.end()) return it->second;
+    TextClass& tc = text_class(at, name, nullptr);  // not in the class table: today's class as it is
+    make_slots(at, tc);
+    return tc;
+  }
+
+  // ---- instances ----
+
+  void read_instances(std::size_t at) {
+    in_.seek(at);
+    read_array([&] { read_instance(); });
+  }
+
+  void read_instance() {
+    SavedInstance x{null_id, nullptr, in_.token_start(), values_.size(), 0};
+    TextClass* tc = nullptr;
+    std::vector<std::pair<std::string, std::size_t>> early;  // properties seen before "@class"
+    bool has_id = false;
+    seen_.clear();
+    read_object([&](const std::string& key, std::size_t key_at) {
+      if (key == "@id") {
+        if (has_id) fail_at(key_at, "\"@id\" is given twice");
+        has_id = true;
+        const std::size_t id_at = in_.token_start();
+        x.id = in_.unsigned_integer();
+        if (x.id == null_id) fail_at(id_at, "instance id 0 is not valid");
+      } else if (key == "@class") {
+        if (tc != nullptr) fail_at(key_at, "\"@class\" is given twice");
+        const std::size_t class_at = in_.token_start();
+        tc = &class_named(class_at, read_string("a class name"));
+        x.entry = tc->entry;
+        const std::size_t resume = in_.position();
+        for (const auto& [name, value_at] : early) {
+          in_.seek(value_at);
+          read_property(*tc, name, value_at);
+        }
+        in_.seek(resume);
+      } else if (tc == nullptr) {
+        early.emplace_back(key, in_.token_start());
+        in_.skip_value();
+      } else {
+        read_property(*tc, key, key_at);
+      }
+    });
+    if (!has_id) fail_at(x.offset, "an instance needs an \"@id\"");
+    if (tc == nullptr) fail_at(x.offset, "instance #" + std::to_string(x.id) + " names no \"@class\"");
+    x.count = values_.size() - x.first;
+    instances_.push_back(x);
+  }
+
+  void read_property(TextClass& tc, const std::string& key, std::size_t key_at) {
+    const ClassEntry& e = *tc.entry;
+    const MetaProperty* prop = e.cls->find_property(key);  // through aliases too
+    std::size_t index = e.slots.size();
+    for (std::size_t i = 0; i < e.slots.size() && index == e.slots.size(); ++i)
+      if (prop != nullptr ? tc.props[i] == prop : tc.names[i] == key) index = i;
+    if (index == e.slots.size()) {  // neither a saved property of the class nor one the file declared
+      if (std::find(tc.reported.begin(), tc.reported.end(), key) == tc.reported.end()) {
+        tc.reported.push_back(key);
+        warnings_.push_back(where(key_at) + ": class '" + e.cls->name() + "' has no saved property '" + key +
+                            "': its values are dropped");
+      }
+      in_.skip_value();
+      return;
+    }
+    if (std::find(seen_.begin(), seen_.end(), index) != seen_.end())
+      fail_at(key_at, "property '" + key + "' is given twice");
+    seen_.push_back(index);
+    const Slot& s = e.slots[index];
+    if (s.prop == nullptr) {  // reported once per class, when the slots were made
+      in_.skip_value();
+      return;
+    }
+    const std::size_t at = in_.token_start();
+    SavedValue v{&s, at, {}, static_cast<std::uint32_t>(ids_.size()), 0};
+    const MetaType& type = s.prop->type();
+    if (type.is_ref_list()) {
+      read_array([&] {
+        const std::size_t id_at = in_.token_start();
+        const Id id = read_id();
+        if (id == null_id) fail_at(id_at, "a reference list cannot hold null");
+        ids_.push_back(id);
+      });
+    } else if (type.is_reference()) {
+      ids_.push_back(read_id());
+    } else {
+      Value& scratch = tc.scratch[index];
+      const MetaType& read_as = s.convert ? *s.file_type : type;
+      read_as.assign(scratch.data(), s.convert ? Value(read_as).data() : s.prop->default_value().data());
+      read_as.read_text(scratch.data(), in_, nullptr);
+      bytes_.clear();
+      ByteWriter w(bytes_);
+      if (s.convert) {
+        Value converted;
+        try {
+          converted = scratch.convert_to(type);
+        } catch (const Error& err) {
+          fail_at(at, "value of " + s.prop->name() + ": " + err.what());
+        }
+        type.write_bytes(converted.data(), w);
+      } else {
+        type.write_bytes(scratch.data(), w);
+      }
+      v.bytes = own(bytes_);
+    }
+    v.ids_count = static_cast<std::uint32_t>(ids_.size() - v.ids_first);
+    values_.push_back(v);
+  }
+
+  TextReader in_;
+  std::unordered_map<std::string, TextClass> by_name_;
+  std::vector<std::size_t> seen_;
+  std::vector<std::uint8_t> bytes_;
+};
+
+}  // namespace
+
+LoadReport load_text(SimState& state, Node* parent, std::span<const std::uint8_t> bytes, std::string_view origin) {
+  TextSnapshotReader reader(state.environment().registry(), bytes, origin);
+  reader.read();
+  return reader.apply(state, parent);
+}
+
+}  // namespace vsd::io::detail
