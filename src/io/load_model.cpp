@@ -84,27 +84,26 @@ std::span<const std::uint8_t> LoadModel::own(std::span<const std::uint8_t> bytes
 }
 
 void LoadModel::finish() {
-  by_id_.reserve(instances_.size());
-  for (const SavedInstance& x : instances_)
-    if (!by_id_.emplace(x.id, &x).second)
-      fail_at(x.offset, "instance #" + std::to_string(x.id) + " appears twice");
+  for (std::size_t i = 0; i < instances_.size(); ++i)
+    if (!by_id_.insert(instances_[i].id, i + 1))
+      fail_at(instances_[i].offset, "instance #" + std::to_string(instances_[i].id) + " appears twice");
   for (std::size_t i = 0; i < top_.size(); ++i) {
-    auto it = by_id_.find(top_[i]);
-    if (it == by_id_.end())
+    const SavedInstance* top = find(top_[i]);
+    if (top == nullptr)
       fail_at(top_offsets_[i], "top-level node #" + std::to_string(top_[i]) + " is not in the file");
-    if (!it->second->entry->cls->is_a(Node::static_meta()))
+    if (!top->entry->cls->is_a(Node::static_meta()))
       fail_at(top_offsets_[i], "top-level #" + std::to_string(top_[i]) + " is not a Node");
   }
   for (const SavedInstance& x : instances_)
     for (const SavedValue& v : values_of(x))
       for (Id id : ids_of(v)) {
         if (id == null_id) continue;
-        auto it = by_id_.find(id);
-        if (it == by_id_.end())
+        const SavedInstance* it = find(id);
+        if (it == nullptr)
           fail_at(v.offset, "dangling reference: #" + std::to_string(x.id) + "." + v.slot->prop->name() +
                                 " names #" + std::to_string(id) + ", which is not in the file");
         const MetaInstance& target = *v.slot->prop->type().target();
-        const MetaInstance& found = *it->second->entry->cls;
+        const MetaInstance& found = *it->entry->cls;
         if (!found.is_a(target))
           fail_at(v.offset, "#" + std::to_string(x.id) + "." + v.slot->prop->name() + " names #" +
                                 std::to_string(id) + ", a '" + found.name() + "', which is not a '" + target.name() +
@@ -122,7 +121,7 @@ void LoadModel::check_composite_cycles() const {
     std::size_t inst, value, id;
   };
   std::vector<Frame> path;
-  auto index_of = [&](Id id) { return static_cast<std::size_t>(by_id_.at(id) - instances_.data()); };
+  auto index_of = [&](Id id) { return by_id_.find(id) - 1; };  // present: finish() checked
   for (std::size_t root = 0; root < instances_.size(); ++root) {
     if (mark[root] != unvisited) continue;
     mark[root] = on_path;
@@ -170,26 +169,30 @@ LoadReport LoadModel::apply(SimState& state, Node* parent) {
                 state.name() + "' holds " + std::to_string(state.size()) + " instances");
   Environment& env = state.environment();
   // Ids: kept in an empty state, fresh under a node; the Database of a state file maps to the target's.
-  std::unordered_map<Id, Id> map;
-  map.reserve(instances_.size());
+  // A whole-state load keeps every id but the Database's (the same in any fresh state): no map needed.
+  vsd::detail::FlatIdMap<Id> map;
   const SavedInstance* saved_root = nullptr;
   for (const SavedInstance& x : instances_) {
     if (kind_ == kind_state && x.entry->cls->is_a(Database::static_meta())) {
       saved_root = &x;
       // Loaded under a node, the file's Database *is* that node: its children become the node's, and
       // references to it point at the node.
-      map[x.id] = whole ? state.database().id() : parent->id();
+      if (!whole) map.insert(x.id, parent->id());
       continue;
     }
     if (whole) {
       if (state.find(x.id) != nullptr) fail_at(x.offset, "instance #" + std::to_string(x.id) + " already exists");
       env.reserve_ids_through(x.id);
-      map[x.id] = x.id;
     } else {
-      map[x.id] = env.next_id();
+      map.insert(x.id, env.next_id());
     }
   }
-  auto mapped = [&](Id id) { return id == null_id ? null_id : map.at(id); };
+  const Id file_database = saved_root != nullptr ? saved_root->id : null_id;
+  auto mapped = [&](Id id) {
+    if (id == null_id) return null_id;
+    if (whole) return id == file_database ? state.database().id() : id;
+    return map.find(id);
+  };
 
   std::vector<std::uint8_t> bundle;
   vsd::detail::write_tx_header(bundle);

@@ -17,6 +17,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "vsd/core/detail/id_map.hpp"
 #include "vsd/io/snapshot.hpp"
 
 namespace vsd::io::detail {
@@ -122,7 +123,12 @@ class LoadModel {
   void check_composite_cycles() const;
 
   std::deque<std::vector<std::uint8_t>> arena_;  // chunks that are filled, never grown
-  std::unordered_map<Id, const SavedInstance*> by_id_;
+  [[nodiscard]] const SavedInstance* find(Id id) const {
+    const std::size_t i = by_id_.find(id);
+    return i == 0 ? nullptr : &instances_[i - 1];
+  }
+
+  vsd::detail::FlatIdMap<std::size_t> by_id_;  // id -> index in instances_ + 1 (0: none)
   std::vector<const MetaInstance*> defined_;
   bool committed_ = false;
 };
