@@ -94,4 +94,25 @@ void BM_Io_Load_1M(benchmark::State& state, Format format) {
 BENCHMARK_CAPTURE(BM_Io_Load_1M, binary, Format::Binary)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_CAPTURE(BM_Io_Load_1M, text, Format::Text)->Unit(benchmark::kMillisecond)->Iterations(3);
 
+// Reading and checking alone (vsd::io::check_bytes): the cost of the format itself, without building the
+// state that a load shares between both formats.
+void BM_Io_Check_1M(benchmark::State& state, Format format) {
+  std::vector<std::uint8_t> bytes;
+  std::size_t instances = 0;
+  {
+    vsd::Environment env;
+    build(env.main_state());
+    bytes = vsd::io::save_bytes(env.main_state(), format);
+    instances = env.main_state().size();
+  }
+  const bool reset = reset_peak();
+  for (auto _ : state) {
+    const auto report = vsd::io::check_bytes(bytes);
+    if (report.instances + 1 != instances) state.SkipWithError("the check miscounted");
+  }
+  counters(state, instances, bytes.size(), reset);
+}
+BENCHMARK_CAPTURE(BM_Io_Check_1M, binary, Format::Binary)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK_CAPTURE(BM_Io_Check_1M, text, Format::Text)->Unit(benchmark::kMillisecond)->Iterations(3);
+
 }  // namespace

@@ -272,11 +272,11 @@ std::vector<std::uint8_t> write_binary(SaveSet& set) {
   return out;
 }
 
-LoadReport load_binary(SimState& state, Node* parent, std::span<const std::uint8_t> bytes,
-                       std::string_view origin) {
-  BinaryReader reader(state.environment().registry(), bytes, origin);
-  reader.read();
-  return reader.apply(state, parent);
+std::unique_ptr<LoadModel> read_binary(Registry& registry, std::span<const std::uint8_t> bytes,
+                                       std::string_view origin) {
+  auto reader = std::make_unique<BinaryReader>(registry, bytes, origin);
+  reader->read();
+  return reader;
 }
 
 }  // namespace vsd::io::detail

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string_view>
 #include <unordered_map>
@@ -44,10 +45,11 @@ class SaveSet {
 std::vector<std::uint8_t> write_binary(SaveSet& set);
 std::vector<std::uint8_t> write_text(SaveSet& set);
 
-/// Reads a file of the format into a model and applies it to @p state (under @p parent when not null).
-LoadReport load_binary(SimState& state, Node* parent, std::span<const std::uint8_t> bytes,
-                       std::string_view origin);
-LoadReport load_text(SimState& state, Node* parent, std::span<const std::uint8_t> bytes,
-                     std::string_view origin);
+/// Reads and checks a file of the format into a model (then apply() it, or only look at it).
+/// @p bytes must outlive the model: values point into them.
+std::unique_ptr<LoadModel> read_binary(Registry& registry, std::span<const std::uint8_t> bytes,
+                                       std::string_view origin);
+std::unique_ptr<LoadModel> read_text(Registry& registry, std::span<const std::uint8_t> bytes,
+                                     std::string_view origin);
 
 }  // namespace vsd::io::detail

@@ -84,9 +84,17 @@ std::span<const std::uint8_t> LoadModel::own(std::span<const std::uint8_t> bytes
 }
 
 void LoadModel::finish() {
-  for (std::size_t i = 0; i < instances_.size(); ++i)
-    if (!by_id_.insert(instances_[i].id, i + 1))
-      fail_at(instances_[i].offset, "instance #" + std::to_string(instances_[i].id) + " appears twice");
+  for (std::size_t i = 0; i < instances_.size(); ++i) {
+    const SavedInstance& x = instances_[i];
+    if (!by_id_.insert(x.id, i + 1)) fail_at(x.offset, "instance #" + std::to_string(x.id) + " appears twice");
+    const MetaInstance& cls = *x.entry->cls;
+    if (cls.is_abstract()) fail_at(x.offset, "class '" + cls.name() + "' is abstract: it has no instances");
+    if (cls.is_a(Database::static_meta())) {  // a state file's root; it stands for the target's Database
+      if (kind_ != kind_state || file_root_ != nullptr)
+        fail_at(x.offset, "a Database is a state's root: a file holds at most one, in a whole state");
+      file_root_ = &x;
+    }
+  }
   for (std::size_t i = 0; i < top_.size(); ++i) {
     const SavedInstance* top = find(top_[i]);
     if (top == nullptr)
@@ -159,6 +167,15 @@ void LoadModel::check_composite_cycles() const {
   }
 }
 
+LoadReport LoadModel::summary() const {
+  LoadReport report;
+  report.subtree = kind_ == kind_subtree;
+  report.instances = instances_.size() - (file_root_ != nullptr ? 1 : 0);  // the Database is not added
+  for (const MetaInstance* c : defined_) report.defined_classes.push_back(c->name());
+  report.warnings = warnings_;
+  return report;
+}
+
 // Builds the bundle that creates the file's instances in @p state, under @p parent (nullptr: the state
 // must be empty and a whole-state file restores its Database's values and children too).
 LoadReport LoadModel::apply(SimState& state, Node* parent) {
@@ -169,12 +186,11 @@ LoadReport LoadModel::apply(SimState& state, Node* parent) {
                 state.name() + "' holds " + std::to_string(state.size()) + " instances");
   Environment& env = state.environment();
   // Ids: kept in an empty state, fresh under a node; the Database of a state file maps to the target's.
-  // A whole-state load keeps every id but the Database's (the same in any fresh state): no map needed.
+  // A whole-state load keeps every id but the Database's: no map needed.
   vsd::detail::FlatIdMap<Id> map;
-  const SavedInstance* saved_root = nullptr;
+  const SavedInstance* saved_root = file_root_;
   for (const SavedInstance& x : instances_) {
-    if (kind_ == kind_state && x.entry->cls->is_a(Database::static_meta())) {
-      saved_root = &x;
+    if (&x == saved_root) {
       // Loaded under a node, the file's Database *is* that node: its children become the node's, and
       // references to it point at the node.
       if (!whole) map.insert(x.id, parent->id());

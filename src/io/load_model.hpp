@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <deque>
 #include <span>
 #include <string>
@@ -80,6 +81,8 @@ class LoadModel {
 
   /// Applies the model to @p state: under @p parent, or (nullptr) as the whole of an empty state.
   LoadReport apply(SimState& state, Node* parent);
+  /// What a load would report, without loading (the classes the file defined are removed again).
+  [[nodiscard]] LoadReport summary() const;
 
  protected:
   /// The origin and the position @p at in the format's terms ("file: byte 12", "file:3:14").
@@ -128,7 +131,8 @@ class LoadModel {
     return i == 0 ? nullptr : &instances_[i - 1];
   }
 
-  vsd::detail::FlatIdMap<std::size_t> by_id_;  // id -> index in instances_ + 1 (0: none)
+  vsd::detail::FlatIdMap<std::size_t> by_id_;
+  const SavedInstance* file_root_ = nullptr;  // a state file's Database  // id -> index in instances_ + 1 (0: none)
   std::vector<const MetaInstance*> defined_;
   bool committed_ = false;
 };

@@ -73,12 +73,16 @@ std::vector<std::uint8_t> write(detail::SaveSet& set, Format format) {
   return format == Format::Text ? detail::write_text(set) : detail::write_binary(set);
 }
 
+std::unique_ptr<detail::LoadModel> read(Registry& registry, std::span<const std::uint8_t> bytes,
+                                        std::string_view origin) {
+  return format_of(bytes, origin) == Format::Text ? detail::read_text(registry, bytes, origin)
+                                                  : detail::read_binary(registry, bytes, origin);
+}
+
 LoadReport load_into(SimState& state, Node* parent, std::span<const std::uint8_t> bytes,
                      std::string_view origin) {
-  const Format format = format_of(bytes, origin);
-  LoadReport report = format == Format::Text ? detail::load_text(state, parent, bytes, origin)
-                                             : detail::load_binary(state, parent, bytes, origin);
-  report.format = format;
+  LoadReport report = read(state.environment().registry(), bytes, origin)->apply(state, parent);
+  report.format = format_of(bytes, origin);
   return report;
 }
 
@@ -114,6 +118,12 @@ std::vector<std::uint8_t> save_bytes(const Node& root, Format format, SaveReport
   if (root.is_a<Database>()) return save_bytes(root.state(), format, report);
   detail::SaveSet set(composite_closure(root), detail::kind_subtree, {root.id()}, report);
   return write(set, format);
+}
+
+LoadReport check_bytes(std::span<const std::uint8_t> bytes, std::string_view origin, Registry& registry) {
+  LoadReport report = read(registry, bytes, origin)->summary();
+  report.format = format_of(bytes, origin);
+  return report;
 }
 
 LoadReport load_bytes(SimState& state, std::span<const std::uint8_t> bytes, std::string_view origin) {

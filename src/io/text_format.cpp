@@ -594,10 +594,11 @@ class TextSnapshotReader final : public LoadModel {
 
 }  // namespace
 
-LoadReport load_text(SimState& state, Node* parent, std::span<const std::uint8_t> bytes, std::string_view origin) {
-  TextSnapshotReader reader(state.environment().registry(), bytes, origin);
-  reader.read();
-  return reader.apply(state, parent);
+std::unique_ptr<LoadModel> read_text(Registry& registry, std::span<const std::uint8_t> bytes,
+                                     std::string_view origin) {
+  auto reader = std::make_unique<TextSnapshotReader>(registry, bytes, origin);
+  reader->read();
+  return reader;
 }
 
 }  // namespace vsd::io::detail

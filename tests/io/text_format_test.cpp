@@ -283,3 +283,75 @@ TEST(TextFormat, FormatIsChosenByNameAndRecognisedByContent) {
 }
 
 }  // namespace
+
+namespace {
+
+// Shapes a transaction may hold but a model may not: a child twice in one list, a node under two
+// parents, an abstract class, a Database inside a subtree. Each loads consistently or is rejected whole.
+TEST(TextFormat, OddShapesLoadConsistentlyOrNotAtAll) {
+  const std::string head = "{\"format\": \"vsd-text\", \"version\": 1, \"kind\": \"subtree\", \"instances\": [\n";
+  const std::string files[] = {
+      head + "{\"@id\": 2, \"@class\": \"Node\", \"children\": [\"@3\", \"@3\"]}, {\"@id\": 3, \"@class\": \"Node\"}], "
+             "\"top\": [\"@2\"]}",
+      head + "{\"@id\": 2, \"@class\": \"Node\", \"children\": [\"@3\", \"@4\"]}, {\"@id\": 3, \"@class\": \"Node\"}, "
+             "{\"@id\": 4, \"@class\": \"Node\", \"children\": [\"@3\"]}], \"top\": [\"@2\"]}",
+      head + "{\"@id\": 2, \"@class\": \"Node\", \"extensions\": [\"@3\"]}, {\"@id\": 3, \"@class\": \"Extension\"}], "
+             "\"top\": [\"@2\"]}",
+      head + "{\"@id\": 2, \"@class\": \"Node\", \"children\": [\"@3\"]}, {\"@id\": 3, \"@class\": \"Database\"}], "
+             "\"top\": [\"@2\"]}",
+      head + "{\"@id\": 2, \"@class\": \"Node\", \"children\": [\"@2\"]}], \"top\": [\"@2\"]}",
+      head + "{\"@id\": 2, \"@class\": \"Node\"}], \"top\": [\"@2\", \"@2\"]}",
+  };
+  for (const std::string& file : files) {
+    vsd::Environment env;
+    std::string error;
+    try {
+      vsd::io::load_bytes(env.main_state(), bytes_of(file), "odd.json");
+    } catch (const vsd::Error& e) {
+      error = e.what();
+    }
+    if (error.empty()) {
+      EXPECT_EQ(vsd_test::check_reference_counts(env.main_state()), "") << file;
+    } else {
+      EXPECT_EQ(env.main_state().size(), 1u) << error;
+      EXPECT_THAT(error, HasSubstr("odd.json")) << error;
+    }
+  }
+  const std::string database = files[3];
+  EXPECT_THAT([&] { vsd::io::check_bytes(bytes_of(database), "odd.json"); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("odd.json:2:51: a Database is a state's root")));
+}
+
+TEST(TextFormat, AbstractClassesHaveNoInstances) {
+  const vsd::MetaInstance& shape = vsd::ClassBuilder("IoAbstractShape", vsd::Node::static_meta()).set_abstract(true).define();
+  const std::string file = "{\"format\": \"vsd-text\", \"version\": 1, \"kind\": \"subtree\",\n"
+                           "\"instances\": [{\"@id\": 2, \"@class\": \"IoAbstractShape\"}], \"top\": [\"@2\"]}";
+  EXPECT_THAT([&] { vsd::io::check_bytes(bytes_of(file), "odd.json"); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("odd.json:2:15: class 'IoAbstractShape' is abstract")));
+  vsd::Registry::global().undefine(shape);
+}
+
+// Checking a file reports what a load would, and leaves nothing behind.
+TEST(TextFormat, CheckingWithoutLoading) {
+  vsd::Environment env;
+  vsd_test::build_model(env.main_state());
+  const vsd::MetaInstance& belt = vsd::ClassBuilder("IoCheckedBelt", vsd::Node::static_meta()).define();
+  env.main_state().database().add_child(static_cast<vsd::Node&>(env.main_state().create(belt)));
+  for (const Format f : {Format::Binary, Format::Text}) {
+    const auto bytes = vsd::io::save_bytes(env.main_state(), f);
+    const auto report = vsd::io::check_bytes(bytes);
+    EXPECT_EQ(report.format, f);
+    EXPECT_FALSE(report.subtree);
+    EXPECT_EQ(report.instances, env.main_state().size() - 1);
+    EXPECT_TRUE(report.defined_classes.empty()) << "known here: not defined by the file";
+  }
+  const auto text = vsd::io::save_bytes(env.main_state(), Format::Text);
+  const auto& tops = env.main_state().database().children();
+  env.main_state().destroy(*tops[tops.size() - 1]);
+  vsd::Registry::global().undefine(belt);
+  const auto report = vsd::io::check_bytes(text);
+  EXPECT_THAT(report.defined_classes, testing::ElementsAre("IoCheckedBelt"));
+  EXPECT_EQ(vsd::Registry::global().find_class("IoCheckedBelt"), nullptr) << "removed again after the check";
+}
+
+}  // namespace

@@ -86,6 +86,12 @@ LoadReport load_bytes(SimState& state, std::span<const std::uint8_t> bytes,
 LoadReport load_bytes(Node& parent, std::span<const std::uint8_t> bytes,
                       std::string_view origin = "snapshot");
 
+/// @brief Reads and checks a file (either format) as a load would, without loading it: what a load
+/// would report (LoadReport::roots stays empty). Run-time classes the file defines are defined while it
+/// is checked and removed again. @throws vsd::Error as a load would.
+LoadReport check_bytes(std::span<const std::uint8_t> bytes, std::string_view origin = "file",
+                       Registry& registry = Registry::global());
+
 /// @brief save_bytes() written with write_file_atomically(), in the format the file name asks for.
 SaveReport save(const SimState& state, const std::filesystem::path& path);
 SaveReport save(const Node& root, const std::filesystem::path& path);
