@@ -31,6 +31,14 @@ void build(vsd::SimState& s) {
   }
 }
 
+// The model saved in @p format; @p instances is set to the size of the state it was saved from.
+std::vector<std::uint8_t> model_file(Format format, std::size_t& instances) {
+  vsd::Environment env;
+  build(env.main_state());
+  instances = env.main_state().size();
+  return vsd::io::save_bytes(env.main_state(), format);
+}
+
 bool reset_peak() {
   std::ofstream out("/proc/self/clear_refs");
   out << "5";
@@ -70,14 +78,8 @@ BENCHMARK_CAPTURE(BM_Io_Save_1M, binary, Format::Binary)->Unit(benchmark::kMilli
 BENCHMARK_CAPTURE(BM_Io_Save_1M, text, Format::Text)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 void BM_Io_Load_1M(benchmark::State& state, Format format) {
-  std::vector<std::uint8_t> bytes;
   std::size_t instances = 0;
-  {
-    vsd::Environment env;
-    build(env.main_state());
-    bytes = vsd::io::save_bytes(env.main_state(), format);
-    instances = env.main_state().size();
-  }
+  const std::vector<std::uint8_t> bytes = model_file(format, instances);
   const bool reset = reset_peak();  // the peak of the load: the file, the model and the loaded state
   for (auto _ : state) {
     state.PauseTiming();
@@ -97,14 +99,8 @@ BENCHMARK_CAPTURE(BM_Io_Load_1M, text, Format::Text)->Unit(benchmark::kMilliseco
 // Reading and checking alone (vsd::io::check_bytes): the cost of the format itself, without building the
 // state that a load shares between both formats.
 void BM_Io_Check_1M(benchmark::State& state, Format format) {
-  std::vector<std::uint8_t> bytes;
   std::size_t instances = 0;
-  {
-    vsd::Environment env;
-    build(env.main_state());
-    bytes = vsd::io::save_bytes(env.main_state(), format);
-    instances = env.main_state().size();
-  }
+  const std::vector<std::uint8_t> bytes = model_file(format, instances);
   const bool reset = reset_peak();
   for (auto _ : state) {
     const auto report = vsd::io::check_bytes(bytes);
