@@ -8,6 +8,11 @@
 #include <string>
 #include <vsd/vsd.hpp>
 
+#if VSD_DEMO_WITH_IO
+#include <filesystem>
+#include <vsd/io.hpp>
+#endif
+
 namespace cell {
 
 class Robot : public vsd::Node {
@@ -156,5 +161,21 @@ int main() {
   std::printf("robots: %zu, conveyors: %zu, nodes in the main database: %zu\n",
               replica.index().count(cell::Robot::static_meta()), replica.index().count(conveyor),
               state.database().size());
+
+#if VSD_DEMO_WITH_IO
+  std::printf("\n== 6. Saving and loading\n");
+  // Text (JSON, one property per line) for people and version control; binary for speed. The file
+  // carries the run-time class Conveyor's definition with it.
+  const auto path = std::filesystem::temp_directory_path() / "vsd_demo_cell.json";
+  vsd::io::save(replica, path);  // ".json": the text format; saved atomically
+  const auto text = vsd::io::read_file(path);
+  std::printf("%s", std::string(text.begin(), text.end()).c_str());
+  vsd::SimState& reloaded = env.create_state("reloaded");
+  const vsd::io::LoadReport report = vsd::io::load(reloaded, path);  // all or nothing
+  std::printf("loaded %zu instances; binary would take %zu bytes instead of %zu\n", report.instances,
+              vsd::io::save_bytes(replica, vsd::io::Format::Binary).size(), text.size());
+  std::printf("reloaded from text equals the replica: %s\n", reloaded.equals(replica) ? "yes" : "no");
+  std::filesystem::remove(path);
+#endif
   return 0;
 }
