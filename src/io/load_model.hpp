@@ -104,10 +104,10 @@ class LoadModel {
   /// reference names an instance of the file.
   void finish();
 
-  std::span<const Id> ids_of(const SavedValue& v) const {
+  [[nodiscard]] std::span<const Id> ids_of(const SavedValue& v) const {
     return std::span<const Id>(ids_).subspan(v.ids_first, v.ids_count);
   }
-  std::span<const SavedValue> values_of(const SavedInstance& x) const {
+  [[nodiscard]] std::span<const SavedValue> values_of(const SavedInstance& x) const {
     return std::span<const SavedValue>(values_).subspan(x.first, x.count);
   }
 

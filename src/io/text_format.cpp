@@ -261,8 +261,10 @@ class TextSnapshotReader final : public LoadModel {
   // the file's properties it no longer has), found by name for each key of an instance.
   struct TextClass {
     ClassEntry* entry;
-    std::unordered_map<std::string, std::size_t> file_types;  // "saved": property -> index in type_names
-    std::vector<std::string> type_names;
+    // "saved": each property's name, type name and where the type was written, in file order.
+    std::vector<std::string> saved_names, type_names;
+    std::vector<std::size_t> type_at;
+    std::unordered_map<std::string, std::size_t> file_types;  // property -> index in the vectors above
     std::vector<std::string> reported;  // unknown keys already warned about
     // Per slot: the class's property (kept even when the slot drops its values), the name the file uses,
     // and where values are parsed (reset to the default each time).
@@ -401,9 +403,11 @@ class TextSnapshotReader final : public LoadModel {
     if (by_name_.count(*name) != 0) fail_at(at, "class '" + *name + "' is listed twice");
     TextClass& tc = text_class(at, *name, def ? &*def : nullptr);
     for (std::size_t i = 0; i < saved.size(); ++i) {
-      tc.file_types.emplace(saved[i].first, tc.type_names.size());
+      if (!tc.file_types.emplace(saved[i].first, i).second)
+        fail_at(saved_at[i], "property '" + saved[i].first + "' is listed twice");
+      tc.saved_names.push_back(saved[i].first);
       tc.type_names.push_back(saved[i].second);
-      (void)type_named(saved_at[i], saved[i].second);  // an unknown type is an error here, not later
+      tc.type_at.push_back(saved_at[i]);
     }
     make_slots(at, tc);
   }
@@ -444,7 +448,7 @@ class TextSnapshotReader final : public LoadModel {
     if (auto it = by_name_.find(name); it != by_name_.end()) return it->second;
     ClassEntry& entry = classes_.emplace_back();
     entry.cls = &resolve_class(at, name, def);
-    return by_name_.emplace(name, TextClass{&entry, {}, {}, {}, {}, {}, {}}).first->second;
+    return by_name_.emplace(name, TextClass{&entry, {}, {}, {}, {}, {}, {}, {}, {}}).first->second;
   }
 
   // One slot per saved property of today's class (with the file's type where it names one), then one for
@@ -452,25 +456,29 @@ class TextSnapshotReader final : public LoadModel {
   void make_slots(std::size_t at, TextClass& tc) {
     ClassEntry& e = *tc.entry;
     std::vector<bool> used(tc.type_names.size());
-    auto file_type_of = [&](const MetaProperty& p) -> std::string_view {
+    auto saved_index = [&](const MetaProperty& p) -> std::size_t {  // npos: the file does not say
       auto it = tc.file_types.find(p.name());
       for (std::size_t k = 0; it == tc.file_types.end() && k < p.aliases().size(); ++k)
         it = tc.file_types.find(p.aliases()[k]);
-      if (it == tc.file_types.end()) return {};
-      used[it->second] = true;
-      return tc.type_names[it->second];
+      return it == tc.file_types.end() ? std::string::npos : it->second;
     };
     for (const MetaProperty* p : e.cls->properties()) {
       if (!is_saved(*p)) continue;
-      e.slots.push_back(make_slot(at, *e.cls, p->name(), file_type_of(*p)));
+      const std::size_t i = saved_index(*p);
+      if (i == std::string::npos) {
+        e.slots.push_back(make_slot(at, *e.cls, p->name(), {}));
+      } else {
+        used[i] = true;
+        e.slots.push_back(make_slot(tc.type_at[i], *e.cls, p->name(), tc.type_names[i]));
+      }
       tc.props.push_back(p);
       tc.names.push_back(p->name());
     }
-    for (const auto& [prop, index] : tc.file_types) {
-      if (used[index] || e.cls->find_property(prop) != nullptr) continue;
-      e.slots.push_back(make_slot(at, *e.cls, prop, tc.type_names[index]));
+    for (std::size_t i = 0; i < tc.saved_names.size(); ++i) {  // properties the class no longer has
+      if (used[i] || e.cls->find_property(tc.saved_names[i]) != nullptr) continue;
+      e.slots.push_back(make_slot(tc.type_at[i], *e.cls, tc.saved_names[i], tc.type_names[i]));
       tc.props.push_back(nullptr);
-      tc.names.push_back(prop);
+      tc.names.push_back(tc.saved_names[i]);
     }
     for (const Slot& s : e.slots)
       tc.scratch.emplace_back(s.prop == nullptr ? Value() : Value(s.convert ? *s.file_type : s.prop->type()));

@@ -355,3 +355,24 @@ TEST(TextFormat, CheckingWithoutLoading) {
 }
 
 }  // namespace
+
+namespace {
+
+// A property the class no longer has may be of a type the program no longer has either: its values
+// are dropped with a warning; a type the program does not know for a property it has is an error there.
+TEST(TextFormat, DroppedPropertiesOfUnknownTypes) {
+  const std::string file = "{\"format\": \"vsd-text\", \"version\": 1, \"kind\": \"subtree\", \"classes\": [\n"
+                           "{\"class\": \"TTool\", \"saved\": {\"length\": \"double\", \"grip\": \"OldGrip\"}}],\n"
+                           "\"instances\": [{\"@id\": 2, \"@class\": \"TTool\", \"length\": 3, \"grip\": {\"any\": [1]}}],\n"
+                           "\"top\": [\"@2\"]}";
+  vsd::Environment env;
+  const auto report = vsd::io::load_bytes(env.main_state(), bytes_of(file), "old.json");
+  EXPECT_THAT(report.warnings, testing::ElementsAre(HasSubstr("no property 'grip'")));
+  EXPECT_EQ(static_cast<vsd_test::TTool&>(*report.roots[0]).length(), 3);
+  std::string bad = file;
+  bad.replace(bad.find("\"double\""), 8, "\"Double2\"");
+  EXPECT_THAT([&] { vsd::io::check_bytes(bytes_of(bad), "old.json"); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("old.json:2:40: unknown type 'Double2'")));
+}
+
+}  // namespace
