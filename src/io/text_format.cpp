@@ -192,66 +192,67 @@ class TextSnapshotReader final : public LoadModel {
   }
 
   void read() {
-    // The top level: where each member starts, then read in the order meaning needs.
-    std::optional<std::size_t> format_at, version_at, kind_at, classes_at, instances_at, top_at;
+    // The top level. Members are read where they stand when what they need is known (the format and
+    // version before anything, the classes before the instances); a file that orders them otherwise is
+    // read in two passes: such members are skipped, remembered, and read at the end.
+    std::optional<std::size_t> classes_at, instances_at;
+    bool has_format = false, has_version = false, has_kind = false, has_top = false;
+    bool classes_read = false, instances_read = false;
     in_.expect('{');
     if (!in_.accept('}')) {
       do {
         const std::size_t key_at = in_.token_start();
+        if (in_.peek() != '"') fail_at(key_at, "expected a quoted member name");
         const std::string key = in_.string();
         in_.expect(':');
         const std::size_t at = in_.token_start();
-        std::optional<std::size_t>* slot = key == "format"      ? &format_at
-                                           : key == "version"   ? &version_at
-                                           : key == "kind"      ? &kind_at
-                                           : key == "classes"   ? &classes_at
-                                           : key == "instances" ? &instances_at
-                                           : key == "top"       ? &top_at
-                                                                : nullptr;
-        if (slot == nullptr) {
-          warnings_.push_back(where(key_at) + ": unknown member '" + key + "' is ignored");
+        auto once = [&](bool& seen) {
+          if (seen) fail_at(key_at, "'" + key + "' is given twice");
+          seen = true;
+        };
+        if (key == "format") {
+          once(has_format);
+          if (in_.peek() != '"' || in_.string() != format_name)
+            fail_at(at, "not a vsd text file (\"format\" is not \"vsd-text\")");
+        } else if (key == "version") {
+          once(has_version);
+          const std::int64_t version = in_.integer();
+          if (version != format_version)
+            fail_at(at, "format version " + std::to_string(version) + " is not supported (this is " +
+                            std::to_string(format_version) + ")");
+        } else if (key == "kind") {
+          once(has_kind);
+          read_kind(at);
+        } else if (key == "top") {
+          once(has_top);
+          read_top();
+        } else if (key == "classes" || key == "instances") {
+          std::optional<std::size_t>& slot = key == "classes" ? classes_at : instances_at;
+          if (slot) fail_at(key_at, "'" + key + "' is given twice");
+          slot = at;
+          const bool ready = has_format && has_version && (key == "classes" || classes_read);
+          if (!ready) {
+            in_.skip_value();
+          } else if (key == "classes") {
+            read_classes(at);
+            classes_read = true;
+          } else {
+            read_instances(at);
+            instances_read = true;
+          }
         } else {
-          if (*slot) fail_at(key_at, "'" + key + "' is given twice");
-          *slot = at;
+          warnings_.push_back(where(key_at) + ": unknown member '" + key + "' is ignored");
+          in_.skip_value();
         }
-        in_.skip_value();
       } while (in_.accept(','));
       in_.expect('}');
     }
     in_.expect_end();
     const std::size_t end = in_.position();
-
-    if (!format_at) fail_at(0, "not a vsd text file (no \"format\": \"vsd-text\")");
-    in_.seek(*format_at);
-    if (in_.peek() != '"' || in_.string() != format_name)
-      fail_at(*format_at, "not a vsd text file (\"format\" is not \"vsd-text\")");
-    if (!version_at) fail_at(0, "the file names no format \"version\"");
-    in_.seek(*version_at);
-    const std::int64_t version = in_.integer();
-    if (version != format_version)
-      fail_at(*version_at, "format version " + std::to_string(version) + " is not supported (this is " +
-                               std::to_string(format_version) + ")");
-    if (kind_at) {
-      in_.seek(*kind_at);
-      const std::string kind = in_.string();
-      if (kind == "state")
-        kind_ = kind_state;
-      else if (kind == "subtree")
-        kind_ = kind_subtree;
-      else
-        fail_at(*kind_at, "unknown kind '" + kind + "' (state or subtree)");
-    }
-    if (classes_at) read_classes(*classes_at);
-    if (instances_at) read_instances(*instances_at);
-    if (top_at) {
-      in_.seek(*top_at);
-      read_array([&] {
-        top_offsets_.push_back(in_.token_start());
-        const Id id = read_id();
-        if (id == null_id) fail_at(top_offsets_.back(), "a top-level node cannot be null");
-        top_.push_back(id);
-      });
-    }
+    if (!has_format) fail_at(0, "not a vsd text file (no \"format\": \"vsd-text\")");
+    if (!has_version) fail_at(0, "the file names no format \"version\"");
+    if (classes_at && !classes_read) read_classes(*classes_at);
+    if (instances_at && !instances_read) read_instances(*instances_at);
     in_.seek(end);
     finish();
   }
@@ -359,6 +360,25 @@ class TextSnapshotReader final : public LoadModel {
       if (!found) fail_at(at, "unknown property flag '" + std::string(name) + "'");
     }
     return flags;
+  }
+
+  void read_kind(std::size_t at) {
+    const std::string kind = read_string("a kind");
+    if (kind == "state")
+      kind_ = kind_state;
+    else if (kind == "subtree")
+      kind_ = kind_subtree;
+    else
+      fail_at(at, "unknown kind '" + kind + "' (state or subtree)");
+  }
+
+  void read_top() {
+    read_array([&] {
+      top_offsets_.push_back(in_.token_start());
+      const Id id = read_id();
+      if (id == null_id) fail_at(top_offsets_.back(), "a top-level node cannot be null");
+      top_.push_back(id);
+    });
   }
 
   // ---- classes ----
