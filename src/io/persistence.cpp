@@ -1,5 +1,6 @@
 // The public persistence API (vsd/io/snapshot.hpp): what a save writes, and the choice of format.
 #include <algorithm>
+#include <cctype>
 
 #include "formats.hpp"
 #include "vsd/io/file.hpp"
@@ -89,7 +90,9 @@ LoadReport load_into(SimState& state, Node* parent, std::span<const std::uint8_t
 }  // namespace
 
 Format format_for(const std::filesystem::path& path) {
-  return path.extension() == ".json" ? Format::Text : Format::Binary;
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".json" ? Format::Text : Format::Binary;
 }
 
 Format format_of(std::span<const std::uint8_t> bytes, std::string_view origin) {

@@ -274,6 +274,8 @@ TEST_F(BadText, StringsWithOddBytesRoundTrip) {
 TEST(TextFormat, FormatIsChosenByNameAndRecognisedByContent) {
   EXPECT_EQ(vsd::io::format_for("a/model.json"), Format::Text);
   EXPECT_EQ(vsd::io::format_for("a/model.vsds"), Format::Binary);
+  EXPECT_EQ(vsd::io::format_for("MODEL.JSON"), Format::Text);
+  EXPECT_EQ(vsd::io::format_for("model.json.bak"), Format::Binary);
   vsd::Environment env;
   vsd_test::build_model(env.main_state());
   EXPECT_EQ(vsd::io::format_of(vsd::io::save_bytes(env.main_state(), Format::Text)), Format::Text);

@@ -43,7 +43,7 @@ enum class Format : std::uint8_t {
   Text     ///< "vsd-text" JSON: readable, diffs well in version control
 };
 
-/// @brief The format a file name asks for: Text for ".json", Binary otherwise.
+/// @brief The format a file name asks for: Text for ".json" (any case), Binary otherwise.
 Format format_for(const std::filesystem::path& path);
 /// @brief The format of a file's content (by its first bytes). @throws vsd::Error when it is neither.
 Format format_of(std::span<const std::uint8_t> bytes, std::string_view origin = "file");
