@@ -144,12 +144,11 @@ int convert(std::span<const std::string_view> args, std::ostream& out, std::ostr
   const std::filesystem::path target(files[1]);
   const Format format = to.value_or(format_for(target));
   const SimState& state = l->env.main_state();
-  SaveReport saved;
   if (l->report.subtree && l->report.roots.size() == 1)
-    saved = save(*l->report.roots[0], target, format);
+    save(*l->report.roots[0], target, format);
   else
-    saved = save(state, target, format);
-  out << "wrote " << saved.instances << " instances to " << files[1] << " ("
+    save(state, target, format);
+  out << "wrote " << l->report.instances << " instances to " << files[1] << " ("
       << (format == Format::Text ? "text" : "binary") << ")\n";
   return 0;
 }
