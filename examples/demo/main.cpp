@@ -89,8 +89,8 @@ int main() {
           .property<double>("belt_speed", 0.2)
           .property<double>("position", 0.0)
           .method("stop", {}, nullptr,
-                  [](vsd::Instance& self, std::span<const vsd::Value>) {
-                    static_cast<vsd::SimStateInstance&>(self).set("belt_speed", vsd::Value(0.0));
+                  [](vsd::SimStateInstance& self, std::span<const vsd::Value>) {
+                    self.set("belt_speed", vsd::Value(0.0));
                     return vsd::Value();
                   })
           .define();

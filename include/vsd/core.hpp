@@ -13,6 +13,7 @@
 #include "vsd/core/flags.hpp"
 #include "vsd/core/fwd.hpp"
 #include "vsd/core/instance.hpp"
+#include "vsd/core/list_editor.hpp"
 #include "vsd/core/meta_instance.hpp"
 #include "vsd/core/meta_method.hpp"
 #include "vsd/core/meta_property.hpp"

@@ -2,33 +2,40 @@
 
 #include <algorithm>
 
+#include "vsd/core/error.hpp"
 #include "vsd/core/sim_state.hpp"
 
 namespace vsd {
 
+namespace {
+bool by_id(const Node* a, const Node* b) noexcept { return a->id() < b->id(); }
+}  // namespace
+
 View::View(SimState& state, Filter filter, Order order)
-    : filter_(std::move(filter)), order_(std::move(order)) {
-  state.index().for_each(Node::static_meta(), true, [&](SimStateInstance& i) {
+    : View(state, Node::static_meta(), std::move(filter), std::move(order)) {}
+
+View::View(SimState& state, const MetaInstance& cls, Filter filter, Order order)
+    : cls_(&cls), filter_(std::move(filter)), order_(std::move(order)) {
+  if (!cls.is_a(Node::static_meta()))
+    detail::throw_error("a View holds nodes, but class '" + cls.name() + "' is not a Node");
+  state.index().for_each(cls, true, [&](SimStateInstance& i) {
     auto& n = static_cast<Node&>(i);
     if (!filter_ || filter_(n)) nodes_.push_back(&n);
   });
-  if (order_) {
+  std::sort(nodes_.begin(), nodes_.end(), by_id);  // creation order; an order then sorts stably
+  if (order_)
     std::stable_sort(nodes_.begin(), nodes_.end(), [&](Node* a, Node* b) { return order_(*a, *b); });
-  } else {
-    std::sort(nodes_.begin(), nodes_.end(), [](Node* a, Node* b) { return a->id() < b->id(); });
-  }
-  connections_.push_back(state.on_created().connect([this](SimStateInstance& i) { consider(i); }));
-  connections_.push_back(state.on_deleted().connect([this](SimStateInstance& i) { drop(i); }));
+  members_.insert(nodes_.begin(), nodes_.end());
+  // Only the viewed class's signals: changes of other instances never reach the view.
+  ElementIndex& index = state.index();
+  connections_.push_back(index.on_created(cls, true).connect([this](SimStateInstance& i) { consider(i); }));
+  connections_.push_back(index.on_deleted(cls, true).connect([this](SimStateInstance& i) { drop(i); }));
   // Membership and order may depend on any property: re-evaluate on change.
-  connections_.push_back(
-      state.on_property_changed().connect([this](SimStateInstance& i, const MetaProperty&) { consider(i); }));
+  connections_.push_back(state.on_property_changed(cls, true).connect(
+      [this](SimStateInstance& i, const MetaProperty&) { consider(i); }));
 }
 
 View::~View() = default;
-
-bool View::contains(const Node& n) const {
-  return std::find(nodes_.begin(), nodes_.end(), &n) != nodes_.end();
-}
 
 void View::for_each(const std::function<void(Node&)>& fn) const {
   const std::vector<Node*> copy = nodes_;  // fn may change the view
@@ -36,43 +43,50 @@ void View::for_each(const std::function<void(Node&)>& fn) const {
 }
 
 void View::consider(SimStateInstance& inst) {
-  Node* n = inst.as<Node>();
-  if (n == nullptr || n->is_being_deleted()) return;
-  const bool wanted = !filter_ || filter_(*n);
-  auto it = std::find(nodes_.begin(), nodes_.end(), n);
+  auto& n = static_cast<Node&>(inst);  // the signals are those of the viewed class, a Node class
+  if (n.is_being_deleted()) return;
+  const bool wanted = !filter_ || filter_(n);
+  const bool member = members_.contains(&n);
   if (!wanted) {
-    if (it != nodes_.end()) {
-      nodes_.erase(it);
-      removed_.emit(*n);
+    if (member) {
+      unplace(n);
+      members_.erase(&n);
+      removed_.emit(n);
     }
     return;
   }
-  if (it != nodes_.end()) {
-    if (!order_) return;
-    nodes_.erase(it);  // re-place: the order key may have changed
-    place(*n);
+  if (member) {
+    if (!order_) return;  // creation order does not change
+    unplace(n);           // re-place: the order key may have changed
+    place(n);
     return;
   }
-  place(*n);
-  added_.emit(*n);
+  place(n);
+  members_.insert(&n);
+  added_.emit(n);
 }
 
 void View::place(Node& n) {
-  if (!order_) {
-    nodes_.push_back(&n);
-    return;
-  }
-  auto at =
-      std::upper_bound(nodes_.begin(), nodes_.end(), &n, [&](Node* a, Node* b) { return order_(*a, *b); });
+  const auto at = order_ ? std::upper_bound(nodes_.begin(), nodes_.end(), &n,
+                                            [&](Node* a, Node* b) { return order_(*a, *b); })
+                         : std::upper_bound(nodes_.begin(), nodes_.end(), &n, by_id);
   nodes_.insert(at, &n);
 }
 
-void View::drop(SimStateInstance& inst) {
-  auto it = std::find(nodes_.begin(), nodes_.end(), &inst);
-  if (it == nodes_.end()) return;
-  Node* n = *it;
+void View::unplace(Node& n) {
+  // Without an order the nodes are sorted by id; with one, the key may already have changed.
+  const auto it = order_ ? std::find(nodes_.begin(), nodes_.end(), &n)
+                         : std::lower_bound(nodes_.begin(), nodes_.end(), &n, by_id);
+  VSD_ASSERT(it != nodes_.end() && *it == &n, "a member of a view is in its list");
   nodes_.erase(it);
-  removed_.emit(*n);
+}
+
+void View::drop(SimStateInstance& inst) {
+  auto& n = static_cast<Node&>(inst);
+  if (!members_.contains(&n)) return;
+  unplace(n);
+  members_.erase(&n);
+  removed_.emit(n);
 }
 
 }  // namespace vsd

@@ -249,10 +249,14 @@ ClassBuilder& ClassBuilder::property(std::string name, const MetaType& type, Val
 }
 
 ClassBuilder& ClassBuilder::method(std::string name, std::vector<const MetaType*> arguments,
-                                   const MetaType* result, MetaMethod::Invoker fn) {
+                                   const MetaType* result, Invoker fn) {
   if (!fn) detail::throw_error("method '" + name + "' of run-time class '" + meta_->name() + "' has no body");
+  // MetaInstance::call has checked that self is an instance of this class, hence a SimStateInstance.
+  MetaMethod::Invoker call = [fn = std::move(fn)](Instance& self, std::span<const Value> args) {
+    return fn(static_cast<SimStateInstance&>(self), args);
+  };
   meta_->add_method(
-      std::make_unique<MetaMethod>(std::move(name), result, std::move(arguments), std::move(fn)));
+      std::make_unique<MetaMethod>(std::move(name), result, std::move(arguments), std::move(call)));
   return *this;
 }
 
@@ -448,9 +452,10 @@ std::string Value::to_text() const {
   return type_->to_text(data());
 }
 
-Value Value::from_text(const MetaType& type, std::string_view text, const RefResolver* refs) {
+Value Value::from_text(const MetaType& type, std::string_view text, const RefResolver* refs,
+                       std::string_view origin) {
   Value v(type);
-  type.from_text(v.data(), text, refs);
+  type.from_text(v.data(), text, refs, origin);
   return v;
 }
 

@@ -90,8 +90,10 @@ std::string MetaType::to_text(const void* obj) const {
   return out;
 }
 
-void MetaType::from_text(void* obj, std::string_view text, const RefResolver* refs) const {
-  TextReader in(text);
+void MetaType::from_text(void* obj, std::string_view text, const RefResolver* refs,
+                         std::string_view origin) const {
+  const std::string fallback = origin.empty() ? "<" + name_ + " value>" : std::string();
+  TextReader in(text, origin.empty() ? std::string_view(fallback) : origin);
   read_text(obj, in, refs);
   in.expect_end();
 }

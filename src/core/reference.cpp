@@ -72,15 +72,24 @@ struct RefAccess {
   static void reset(RefLink& l, SimStateInstance* t) {
     SimStateInstance* old = l.target;
     if (t == old) return;
-    if (t != nullptr) check(l, *t);
+    if (t != nullptr) check(l, *t);  // throws before anything changes
     if (old != nullptr) unlink(l);
+    l.adopted = false;
     if (t != nullptr) {
       link(l, *t);
-      if (l.composite) ++t->refs_;
+      if (l.composite) {
+        ++t->refs_;
+        // A property adopts a floating instance; a free reference only keeps it alive.
+        if (l.holder != nullptr && t->is_floating()) {
+          t->life_ &= static_cast<std::uint8_t>(~SimStateInstance::floating_bit);
+          l.adopted = true;
+        }
+      }
     } else {
       l.target = nullptr;
     }
-    if (old != nullptr && l.composite && --old->refs_ == 0) old->state_->released(*old);
+    if (old != nullptr && l.composite && --old->refs_ == 0 && !old->is_floating())
+      old->state_->released(*old);
   }
 
   static void drop(RefLink& l) noexcept {
@@ -88,6 +97,15 @@ struct RefAccess {
     unlink(l);
     if (l.composite) --l.target->refs_;
     l.target = nullptr;
+    l.adopted = false;
+  }
+
+  static void revert(RefLink& l) noexcept {
+    SimStateInstance* t = l.target;
+    if (t == nullptr) return;
+    const bool adopted = l.adopted;
+    drop(l);
+    if (adopted) t->life_ |= SimStateInstance::floating_bit;
   }
 
   static std::vector<RefLink*>& links(RefListBase& r) noexcept { return r.links_; }
@@ -107,6 +125,7 @@ struct RefAccess {
 
 void RefLink::reset(SimStateInstance* t) { RefAccess::reset(*this, t); }
 void RefLink::drop() noexcept { RefAccess::drop(*this); }
+void RefLink::revert() noexcept { RefAccess::revert(*this); }
 
 }  // namespace detail
 
@@ -127,7 +146,10 @@ RefListBase& RefListBase::operator=(const RefListBase& o) {
   try {
     for (const detail::RefLink* l : o.links_) insert_at(links_.size(), l->target);
   } catch (...) {
-    for (auto* l : links_) delete l;
+    for (auto* l : links_) {  // undo, not release: instances this list adopted float again
+      l->revert();
+      delete l;
+    }
     links_ = std::move(old);
     throw;
   }

@@ -62,7 +62,12 @@ Registry::Registry() {
     add_locked(*c);
 }
 
-Registry::~Registry() = default;
+Registry::~Registry() {
+  // Subclasses before their bases (a run-time class unlinks itself from its base), and classes before
+  // the types their properties' default values use: the reverse of the order of definition.
+  while (!runtime_classes_.empty()) runtime_classes_.pop_back();
+  while (!runtime_types_.empty()) runtime_types_.pop_back();
+}
 
 void Registry::add(const MetaInstance& cls) {
   std::unique_lock lock(mutex_);
@@ -192,6 +197,10 @@ const MetaInstance& Registry::define(std::unique_ptr<MetaInstance> cls) {
   std::unique_lock lock(mutex_);
   if (classes_.count(cls->name()) != 0)
     detail::throw_error("class name '" + cls->name() + "' is already registered");
+  // A base must outlive its subclasses: a built-in class (never destroyed) or one of this registry's.
+  if (const MetaInstance* base = cls->base(); base != nullptr && base->is_runtime() && !owns_locked(*base))
+    detail::throw_error("run-time class '" + cls->name() + "' derives from run-time class '" + base->name() +
+                        "' of another registry; define both in the same registry");
   for (const MetaProperty* p : cls->own_properties()) check_type_locked(p->type());
   runtime_classes_.reserve(runtime_classes_.size() + 1);  // nothing below may fail half way
   cls->link_to_base();
@@ -200,6 +209,11 @@ const MetaInstance& Registry::define(std::unique_ptr<MetaInstance> cls) {
   for (const MetaProperty* p : ref.own_properties()) add_type_locked(p->type());
   runtime_classes_.push_back(std::move(cls));
   return ref;
+}
+
+bool Registry::owns_locked(const MetaInstance& cls) const noexcept {
+  return std::any_of(runtime_classes_.begin(), runtime_classes_.end(),
+                     [&](auto& p) { return p.get() == &cls; });
 }
 
 void Registry::undefine(const MetaInstance& cls) {

@@ -70,6 +70,7 @@ SimStateInstance& SimState::make(const MetaInstance& cls, Id id) {
   }
   obj->state_ = this;
   obj->id_ = id;
+  obj->life_ = SimStateInstance::floating_bit;
   obj->watch_ = state_watch_ ? SimStateInstance::state_watch : 0;
   by_id_.insert(id, obj);
   index_.add(*obj);
@@ -87,8 +88,12 @@ void SimState::finish_create(SimStateInstance& inst) {
 }
 
 SimStateInstance& SimState::create(const MetaInstance& cls) {
+  Dispatch d(*this);  // an instance deleted by a creation listener stays allocated until the check below
   SimStateInstance& inst = make(cls, env_->next_id());
   finish_create(inst);
+  if (VSD_UNLIKELY(inst.is_being_deleted()))
+    detail::throw_error("the new instance #" + std::to_string(inst.id()) + " of class '" + cls.name() +
+                        "' was deleted by a listener of its creation");
   return inst;
 }
 
@@ -311,9 +316,8 @@ Transaction SimState::stop_recording() {
 }
 
 Transaction SimState::snapshot() const {
-  Transaction t;
+  Transaction t;  // starts with the header
   std::vector<std::uint8_t>& out = t.bytes_;
-  detail::write_tx_header(out);
   const auto all = instances();
   for (SimStateInstance* x : all) {
     if (x == root_) {
@@ -344,7 +348,6 @@ Transaction SimState::snapshot() const {
       }
     }
   }
-  if (t.ops_ == 0) t.bytes_.clear();
   return t;
 }
 

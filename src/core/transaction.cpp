@@ -187,11 +187,11 @@ void write_span(std::vector<std::uint8_t>& out, std::span<const std::uint8_t> s)
 
 }  // namespace detail
 
-Transaction::Transaction() = default;
+Transaction::Transaction() : bytes_{'V', 'S', 'D', 'T', format_version} {}
 
 Transaction Transaction::from_bytes(std::vector<std::uint8_t> bytes) {
   Transaction t;
-  if (bytes.empty()) return t;
+  if (bytes.empty()) return t;  // the empty bundle (a header alone reads as one too)
   if (bytes.size() < detail::header_size || std::memcmp(bytes.data(), detail::magic, 4) != 0)
     throw Error("byte 0: not a vsd transaction bundle (no VSDT header)");
   if (bytes[4] != format_version)
@@ -203,11 +203,9 @@ Transaction Transaction::from_bytes(std::vector<std::uint8_t> bytes) {
 }
 
 Transaction Transaction::inverted() const {
-  Transaction inv;
+  Transaction inv;  // starts with the header
   const auto ops = detail::parse_tx(*this);
-  if (ops.empty()) return inv;
   auto& out = inv.bytes_;
-  detail::write_tx_header(out);
   ByteWriter w(out);
   for (auto it = ops.rbegin(); it != ops.rend(); ++it) {
     const detail::TxOp& op = *it;
@@ -573,6 +571,18 @@ class Applier {
     return v;
   }
 
+  // The dry run proved every id; only a listener that deletes instances while the bundle is applied can
+  // take one away. That is reported (the bundle stops there) rather than dereferenced.
+  SimStateInstance& live(const TxOp& op, Id id) const {
+    SimStateInstance* x = s_.find(id);
+    if (VSD_UNLIKELY(x == nullptr))
+      throw Error("byte " + std::to_string(op.offset) + " (" + op_name(op) + "): instance #" +
+                  std::to_string(id) +
+                  " was deleted by a listener while the bundle was applied to SimState '" + s_.name() +
+                  "'; the operations before this one were applied");
+    return *x;
+  }
+
   void apply(const TxOp& op) {
     switch (op.op) {
       case Transaction::Op::Create: {
@@ -580,7 +590,7 @@ class Applier {
         SimStateInstance& x = s_.make(cls, op.id);
         for (const auto& [name, bytes] : op.values) {
           const MetaProperty& p = *cls.find_property(name);
-          void* at = const_cast<void*>(p.address(x));  // initial values: not changes
+          void* at = const_cast<void*>(p.address(x));         // initial values: not changes
           if (values_checked_ && !p.type().is_reference()) {  // known good: straight into the instance
             ByteReader r(bytes.data(), bytes.size());
             p.type().read_bytes(at, r, nullptr);
@@ -593,22 +603,22 @@ class Applier {
         break;
       }
       case Transaction::Op::Delete:
-        s_.destroy(*s_.find(op.id));
+        s_.destroy(live(op, op.id));
         break;
       case Transaction::Op::Set: {
-        SimStateInstance& x = *s_.find(op.id);
+        SimStateInstance& x = live(op, op.id);
         const MetaProperty& p = *x.meta().find_property(op.name);
         const Value v = decode(p, op.new_value);
         p.assign_raw(x, v.data());
         break;
       }
       case Transaction::Op::Insert: {
-        SimStateInstance& x = *s_.find(op.id);
-        x.list_insert(*x.meta().find_property(op.name), op.index, *s_.find(op.target));
+        SimStateInstance& x = live(op, op.id);
+        x.list_insert(*x.meta().find_property(op.name), op.index, live(op, op.target));
         break;
       }
       case Transaction::Op::Erase: {
-        SimStateInstance& x = *s_.find(op.id);
+        SimStateInstance& x = live(op, op.id);
         x.list_erase(*x.meta().find_property(op.name), op.index);
         break;
       }

@@ -73,6 +73,58 @@ TEST_F(ViewTest, MembershipFollowsTheFilter) {
   EXPECT_EQ(visited, 0);
 }
 
+TEST_F(ViewTest, ANodeThatLeavesAndComesBackTakesItsCreationPlace) {
+  vsd::View named(state, [](const vsd::Node& n) { return !n.name().empty(); });
+  auto& a = robot("a", 1);
+  auto& b = robot("b", 1);
+  auto& c = robot("c", 1);
+  EXPECT_THAT(names(named), ElementsAre("a", "b", "c"));
+  a.set_name("");
+  EXPECT_THAT(names(named), ElementsAre("b", "c"));
+  a.set_name("a2");
+  EXPECT_THAT(names(named), ElementsAre("a2", "b", "c")) << "creation order, not the order of entry";
+  b.set_name("");
+  c.set_name("c2");
+  b.set_name("b2");
+  EXPECT_THAT(names(named), ElementsAre("a2", "b2", "c2"));
+  state.destroy(b);
+  EXPECT_THAT(names(named), ElementsAre("a2", "c2"));
+  EXPECT_TRUE(named.contains(a));
+  EXPECT_FALSE(named.contains(state.database()));
+}
+
+TEST_F(ViewTest, ATypedViewFiltersOrdersAndIteratesItsClass) {
+  robot("slow", 1);
+  robot("fast", 9);
+  state.create<vsd::Node>().set_name("plain");
+  vsd::TypedView<TRobot> moving(
+      state, [](const TRobot& r) { return r.speed() > 0; },
+      [](const TRobot& a, const TRobot& b) { return a.speed() > b.speed(); });
+  EXPECT_EQ(&moving.viewed_class(), &TRobot::static_meta());
+  std::vector<double> speeds;
+  for (TRobot* r : moving) speeds.push_back(r->speed());
+  EXPECT_THAT(speeds, ElementsAre(9.0, 1.0));
+  auto& mid = robot("mid", 5);
+  EXPECT_EQ(moving[1], &mid);
+  mid.home();  // speed 0: filtered out
+  EXPECT_EQ(moving.size(), 2u);
+  EXPECT_FALSE(moving.contains(mid));
+}
+
+TEST_F(ViewTest, AViewOfAClassIgnoresOtherInstances) {
+  vsd::TypedView<TRobot> robots(state);
+  int changes = 0;
+  auto c = robots.on_added().connect([&](vsd::Node&) { ++changes; });
+  auto& n = state.create<vsd::Node>();
+  n.set_name("x");
+  EXPECT_EQ(changes, 0);
+  EXPECT_EQ(robots.size(), 0u);
+  robot("r", 1);
+  EXPECT_EQ(changes, 1);
+  EXPECT_THAT([&] { vsd::View bad(state, vsd::Extension::static_meta()); },
+              testing::ThrowsMessage<vsd::Error>(testing::HasSubstr("is not a Node")));
+}
+
 TEST_F(ViewTest, WithoutAnOrderKeepsCreationOrder) {
   auto& a = robot("a", 3);
   vsd::View all(state);

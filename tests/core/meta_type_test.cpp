@@ -96,12 +96,14 @@ T binary_round_trip(const T& v) {
   return read_back<T>(bytes_of(v));
 }
 
-// The message of the vsd::Error that parsing @p text as @p type throws ("<no error>" when none is thrown).
+// The message of the vsd::Error that parsing @p text as @p type throws ("<no error>" when none is thrown),
+// after the origin every such message starts with ("<TYPE value>:"), which it checks and strips.
 std::string text_error(const vsd::MetaType& type, std::string_view text) {
   try {
     (void)vsd::Value::from_text(type, text);
   } catch (const vsd::Error& e) {
-    return e.what();
+    const std::string msg = e.what(), origin = "<" + type.name() + " value>:";
+    return msg.rfind(origin, 0) == 0 ? msg.substr(origin.size()) : "no origin in: " + msg;
   }
   return "<no error>";
 }

@@ -5,6 +5,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "test_classes.hpp"
 
@@ -117,6 +118,131 @@ TEST_F(ReferenceTest, FreeRefOwnsLikeASharedPointer) {
   EXPECT_EQ(state.find(id), nullptr);
 }
 
+TEST_F(ReferenceTest, AFreeRefDoesNotAdoptAFloatingInstance) {
+  auto& n = state.create<vsd::Node>();
+  EXPECT_TRUE(n.is_floating());
+  const vsd::Id id = n.id();
+  {
+    vsd::Ref<vsd::Node> hold(&n);
+    EXPECT_EQ(n.composite_count(), 1u);
+    vsd::Value as_value(hold);
+    EXPECT_EQ(n.composite_count(), 2u);
+  }
+  ASSERT_EQ(state.find(id), &n) << "dropping free references leaves a floating instance floating";
+  EXPECT_TRUE(n.is_floating());
+  EXPECT_EQ(n.composite_count(), 0u);
+  root.add_child(n);  // a property adopts it
+  EXPECT_FALSE(n.is_floating());
+  root.remove_child(n);
+  EXPECT_EQ(state.find(id), nullptr) << "an adopted instance goes with its last composite reference";
+}
+
+// Records everything the state announces, to prove that a rejected change announces nothing.
+struct Announcements {
+  std::vector<std::string> log;
+  std::vector<vsd::Connection> c;
+  explicit Announcements(vsd::SimState& s) {
+    c.push_back(s.on_created().connect(
+        [this](vsd::SimStateInstance& i) { log.push_back("create #" + std::to_string(i.id())); }));
+    c.push_back(s.on_deleted().connect(
+        [this](vsd::SimStateInstance& i) { log.push_back("delete #" + std::to_string(i.id())); }));
+    c.push_back(s.on_property_changed().connect([this](vsd::SimStateInstance& i, const vsd::MetaProperty& p) {
+      log.push_back("set #" + std::to_string(i.id()) + "." + p.name());
+    }));
+  }
+};
+
+TEST_F(ReferenceTest, ARejectedCompositeSetDeletesNothing) {
+  // x floats (never attached) and holds h as its child; h.tool = x would make x its own ancestor.
+  auto& x = state.create<TTool>();
+  auto& h = state.create<TRobot>();
+  x.add_child(h);
+  const vsd::Id xid = x.id(), hid = h.id();
+  Announcements seen(state);
+  state.start_recording();
+  EXPECT_THAT([&] { h.set_tool(&x); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("its own ancestor")));
+  EXPECT_THAT([&] { h.set("tool", vsd::Value(vsd::Ref<TTool>(&x))); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("its own ancestor")));
+  EXPECT_THAT(
+      [&] {
+        vsd::MetaProperty const& p = TRobot::vsd_prop_tool();
+        p.set(h, vsd::Ref<TTool>(x));
+      },
+      testing::ThrowsMessage<vsd::Error>(HasSubstr("its own ancestor")));
+  EXPECT_TRUE(state.stop_recording().empty());
+  EXPECT_TRUE(seen.log.empty());
+  ASSERT_EQ(state.find(xid), &x);
+  ASSERT_EQ(state.find(hid), &h);
+  EXPECT_TRUE(x.is_floating());
+  EXPECT_EQ(x.composite_count(), 0u);
+  EXPECT_EQ(h.composite_count(), 1u);
+  EXPECT_EQ(h.tool().get(), nullptr);
+  EXPECT_EQ(h.parent(), &x);
+  EXPECT_EQ(vsd_test::check_reference_counts(state), "");
+}
+
+TEST_F(ReferenceTest, ARejectedSetToAnotherSimStateDeletesNothing) {
+  auto& other = env.create_state("other");
+  auto& far = other.create<TTool>();  // floating over there
+  auto& far_node = other.create<vsd::Node>();
+  auto& h = state.create<TRobot>();
+  root.add_child(h);
+  EXPECT_THAT([&] { h.set_tool(&far); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("different SimStates")));
+  EXPECT_THAT([&] { h.edit_watched().push_back(far_node); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("different SimStates")));
+  EXPECT_THAT([&] { root.add_child(far_node); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("different SimStates")));
+  EXPECT_EQ(other.find(far.id()), &far);
+  EXPECT_EQ(other.find(far_node.id()), &far_node);
+  EXPECT_TRUE(far.is_floating());
+  EXPECT_EQ(far.composite_count(), 0u);
+  EXPECT_EQ(far_node.composite_count(), 0u);
+  EXPECT_EQ(other.size(), 3u);
+}
+
+TEST_F(ReferenceTest, AListAssignmentThatFailsHalfWayDeletesNothing) {
+  // children = [a, far]: a is linked (and adopted) first, then far is refused; the rollback must give a
+  // back its floating state instead of releasing it.
+  auto& other = env.create_state("other");
+  auto& a = state.create<vsd::Node>();
+  auto& far = other.create<vsd::Node>();
+  auto& holder = state.create<vsd::Node>();
+  root.add_child(holder);
+  vsd::RefList<vsd::Node> list;
+  list.push_back(&a);
+  list.push_back(&far);
+  Announcements seen(state);
+  EXPECT_THAT([&] { holder.set_children(list); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("different SimStates")));
+  EXPECT_THAT([&] { holder.set("children", vsd::Value(list)); }, testing::Throws<vsd::Error>());
+  list.clear();
+  EXPECT_TRUE(seen.log.empty());
+  EXPECT_EQ(state.find(a.id()), &a);
+  EXPECT_TRUE(a.is_floating());
+  EXPECT_EQ(a.composite_count(), 0u);
+  EXPECT_TRUE(holder.children().empty());
+  EXPECT_EQ(vsd_test::check_reference_counts(state), "");
+}
+
+TEST_F(ReferenceTest, ARejectedListInsertDeletesNothing) {
+  auto& x = state.create<vsd::Node>();
+  auto& h = state.create<vsd::Node>();
+  x.add_child(h);  // x floats, h is its child
+  Announcements seen(state);
+  EXPECT_THAT([&] { h.add_child(x); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("its own ancestor")));
+  EXPECT_THAT([&] { h.edit_children().insert(0, x); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("its own ancestor")));
+  EXPECT_THAT([&] { h.list_insert(vsd::Node::vsd_prop_children(), 0, x); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("its own ancestor")));
+  EXPECT_TRUE(seen.log.empty());
+  EXPECT_EQ(state.find(x.id()), &x);
+  EXPECT_EQ(state.find(h.id()), &h);
+  EXPECT_TRUE(x.is_floating());
+  EXPECT_EQ(h.parent(), &x);
+  EXPECT_EQ(vsd_test::check_reference_counts(state), "");
+}
+
 TEST_F(ReferenceTest, FreeReferencesOutlivingTheEnvironmentBecomeNull) {
   vsd::SharedRef<vsd::Node> weak;
   vsd::Ref<vsd::Node> strong;
@@ -202,11 +328,13 @@ struct StateResolver final : vsd::RefResolver {
   vsd::SimState& state;
 };
 
+// The error parsing @p text throws, after the origin it starts with ("<TYPE value>:", checked and stripped).
 std::string text_error(const vsd::MetaType& type, std::string_view text, const vsd::RefResolver* refs) {
   try {
     (void)vsd::Value::from_text(type, text, refs);
   } catch (const vsd::Error& e) {
-    return e.what();
+    const std::string msg = e.what(), origin = "<" + type.name() + " value>:";
+    return msg.rfind(origin, 0) == 0 ? msg.substr(origin.size()) : "no origin in: " + msg;
   }
   return "<no error>";
 }

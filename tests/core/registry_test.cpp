@@ -250,3 +250,33 @@ TEST(Registry, AddIsAllOrNothing) {
 }
 
 }  // namespace
+
+TEST(Registry, APrivateRegistryTearsDownRunTimeClassHierarchies) {
+  // Run under AddressSanitizer: a subclass must unlink from its base before the base is freed, and the
+  // classes' default values from their types before the types go.
+  {
+    vsd::Registry local;
+    const vsd::MetaInstance& base = vsd::ClassBuilder("RgPrivBase", vsd::Node::static_meta())
+                                        .property<double>("speed", 1.0)
+                                        .define(local);
+    const vsd::MetaInstance& mid = vsd::ClassBuilder("RgPrivMid", base)
+                                       .property("next", local.reference_type(vsd::TypeKind::SharedRef, base))
+                                       .define(local);
+    const vsd::MetaInstance& leaf = vsd::ClassBuilder("RgPrivLeaf", mid).property<int>("n", 3).define(local);
+    EXPECT_TRUE(leaf.is_a(base));
+    vsd::Environment env(0, local);
+    auto& x = env.main_state().create("RgPrivLeaf");
+    EXPECT_EQ(x.get<int>("n"), 3);
+  }
+  EXPECT_EQ(vsd::Registry::global().find_class("RgPrivBase"), nullptr);
+}
+
+TEST(Registry, ARunTimeBaseMustLiveInTheSameRegistry) {
+  vsd::Registry one;
+  vsd::Registry two;
+  const vsd::MetaInstance& base = vsd::ClassBuilder("RgOneBase", vsd::Node::static_meta()).define(one);
+  EXPECT_THAT([&] { (void)vsd::ClassBuilder("RgTwoSub", base).define(two); },
+              testing::ThrowsMessage<vsd::Error>(testing::HasSubstr("another registry")));
+  EXPECT_EQ(two.find_class("RgTwoSub"), nullptr);
+  EXPECT_TRUE(base.derived().empty());
+}

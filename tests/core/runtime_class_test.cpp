@@ -84,13 +84,12 @@ const vsd::MetaInstance& define_robot(const std::string& name) {
       .property("target", shared_node_type())
       .property<std::int32_t>("count", 0, vsd::Editable | vsd::Transient)
       .method("scaled_speed", {&vsd::meta_type<double>()}, &vsd::meta_type<double>(),
-              [](vsd::Instance& self, std::span<const vsd::Value> args) -> vsd::Value {
-                auto& obj = static_cast<vsd::SimStateInstance&>(self);
-                return vsd::Value(obj.get<double>("speed") * args[0].as<double>());
+              [](vsd::SimStateInstance& self, std::span<const vsd::Value> args) -> vsd::Value {
+                return vsd::Value(self.get<double>("speed") * args[0].as<double>());
               })
       .method("reset_speed", {}, nullptr,
-              [](vsd::Instance& self, std::span<const vsd::Value>) -> vsd::Value {
-                static_cast<vsd::SimStateInstance&>(self).set("speed", vsd::Value(0.0));
+              [](vsd::SimStateInstance& self, std::span<const vsd::Value>) -> vsd::Value {
+                self.set("speed", vsd::Value(0.0));
                 return {};
               })
       .define();

@@ -168,6 +168,38 @@ TEST_F(SimStateTest, AListenerMayDeleteTheInstanceItIsToldAbout) {
   EXPECT_THAT(later, testing::Contains(other.id()));
 }
 
+TEST_F(SimStateTest, CreateThrowsInsteadOfReturningAnInstanceItsListenerDeleted) {
+  auto veto = state.on_created().connect([&](vsd::SimStateInstance& i) {
+    if (i.is_a<TGripper>()) state.destroy(i);
+  });
+  std::vector<std::string> log;
+  auto seen = state.on_deleted().connect([&](vsd::SimStateInstance& i) { log.push_back(i.meta().name()); });
+  state.start_recording();
+  EXPECT_THAT([&] { (void)state.create<TGripper>(); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("was deleted by a listener of its creation")));
+  const vsd::Transaction t = state.stop_recording();
+  EXPECT_EQ(t.size(), 2u) << t.describe();  // create and delete, both recorded
+  EXPECT_THAT(log, ElementsAre("TGripper"));
+  EXPECT_EQ(state.size(), 1u);
+  EXPECT_TRUE(state.index().exact(TGripper::static_meta()).empty());
+  auto& kept = state.create<TRobot>();  // others are untouched
+  EXPECT_EQ(state.find(kept.id()), &kept);
+}
+
+TEST_F(SimStateTest, AnInstanceCreatedInsideAListenerIsUsableThere) {
+  std::vector<vsd::Id> made;
+  auto c = state.on_created().connect([&](vsd::SimStateInstance& i) {
+    if (!i.is_a<TRobot>() || i.is_a<TGripper>()) return;
+    auto& g = state.create<TGripper>();  // nested create: returns a live instance
+    g.set_speed(4.0);
+    made.push_back(g.id());
+  });
+  auto& r = state.create<TRobot>();
+  ASSERT_EQ(made.size(), 1u);
+  EXPECT_EQ(state.find<TGripper>(made[0])->speed(), 4.0);
+  EXPECT_EQ(state.find(r.id()), &r);
+}
+
 TEST_F(SimStateTest, AListenerMayDisconnectAnotherDuringDispatch) {
   auto& r = state.create<TRobot>();
   int first = 0, second = 0;

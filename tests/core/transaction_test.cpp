@@ -218,6 +218,38 @@ TEST_F(TransactionTest, ApplyingTwiceIsRejectedAsAWhole) {
   EXPECT_EQ(replica.size(), 2u);
 }
 
+TEST_F(TransactionTest, AnEmptyBundleIsItsHeader) {
+  const vsd::Transaction empty;
+  EXPECT_TRUE(empty.empty());
+  ASSERT_EQ(empty.bytes().size(), 5u);
+  EXPECT_EQ(std::string(empty.bytes().begin(), empty.bytes().begin() + 4), "VSDT");
+  EXPECT_EQ(empty.bytes()[4], vsd::Transaction::format_version);
+  EXPECT_TRUE(vsd::Transaction::from_bytes(empty.bytes()).empty());
+  EXPECT_EQ(empty.inverted().bytes(), empty.bytes());
+  source.start_recording();
+  EXPECT_EQ(source.stop_recording().bytes(), empty.bytes());
+  EXPECT_EQ(replica.snapshot().bytes(), empty.bytes()) << "an empty state snapshots to the empty bundle";
+  replica.apply(empty);
+  replica.apply(vsd::Transaction::from_bytes(empty.bytes()));
+}
+
+TEST_F(TransactionTest, AListenerDeletingWhatTheBundleNeedsIsAnErrorNotACrash) {
+  auto& r = source.create<TRobot>();
+  source.database().add_child(r);
+  replica.copy_from(source);
+  source.start_recording();
+  r.set_speed(3.0);
+  auto& tool = source.create<TTool>();
+  r.add_child(tool);
+  const vsd::Transaction t = source.stop_recording();
+  // On the replica, a listener deletes the robot as soon as its speed changes.
+  auto c = replica.on_property_changed().connect([&](vsd::SimStateInstance& i, const vsd::MetaProperty& p) {
+    if (p.name() == "speed" && !i.is_being_deleted()) replica.destroy(i);
+  });
+  EXPECT_THAT([&] { replica.apply(t); }, testing::ThrowsMessage<vsd::Error>(HasSubstr(
+                                             "was deleted by a listener while the bundle was applied")));
+}
+
 TEST_F(TransactionTest, HeaderAndVersionAreChecked) {
   EXPECT_THAT(
       [] {

@@ -386,8 +386,17 @@ TEST(Value, FromText) {
 TEST(Value, FromTextErrorNamesThePosition) {
   const std::string e =
       error_of([] { (void)vsd::Value::from_text(vsd::meta_type<std::vector<double>>(), "[1, 2, oops]"); });
-  EXPECT_THAT(e, testing::StartsWith("1:8: "));
+  EXPECT_THAT(e, testing::StartsWith("<vector<double> value>:1:8: "));
   EXPECT_THAT(e, HasSubstr("oops"));
+}
+
+TEST(Value, FromTextErrorNamesTheOriginItIsGiven) {
+  const std::string e = error_of(
+      [] { (void)vsd::Value::from_text(vsd::meta_type<double>(), "\n 1.5x", nullptr, "cell.ini: speed"); });
+  EXPECT_THAT(e, testing::StartsWith("cell.ini: speed:2:2: '1.5x' is not a number"));
+  vsd::Value v(vsd::meta_type<double>());
+  EXPECT_THAT(error_of([&] { vsd::meta_type<double>().from_text(v.data(), "true", nullptr, "arg 1"); }),
+              testing::StartsWith("arg 1:1:1: "));
 }
 
 }  // namespace

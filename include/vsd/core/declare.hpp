@@ -15,6 +15,8 @@
  *  VSD_PROPERTY(Type, name, default, flags...) gives a private member `name_`, an inline getter
  *  `name()` (a plain load), a setter `set_name(v)` (a store behind one branch while nobody observes the
  *  instance) and an entry in the class's MetaProperty table. Flags default to Editable|Savable|Distributed.
+ *  A reference-list property (`RefList<T>`, `SharedRefList<T>`) also gets `edit_name()`, a ListEditor<T>
+ *  with push_back, insert, erase, remove and clear, recorded and signalled like the setter.
  *  Write a default containing commas in parentheses: `(std::vector<int>{1, 2})`.
  *
  *  The tables are built by a chain of overloads numbered with __COUNTER__; do not declare another
@@ -29,6 +31,7 @@
 
 #include "vsd/core/flags.hpp"
 #include "vsd/core/instance.hpp"
+#include "vsd/core/list_editor.hpp"
 #include "vsd/core/meta_instance.hpp"
 #include "vsd/core/meta_method.hpp"
 
@@ -112,7 +115,13 @@ void declare_property(MetaInstance& m, std::size_t slot, const char* name, std::
   /** @brief Sets property `name` (signals and records when observed). */                              \
   void set_##name(const Type& v) { this->vsd_assign(name##_, v, &vsd_prop_##name); }                   \
   /** @brief The MetaProperty of `name`. */                                                            \
-  static const ::vsd::MetaProperty& vsd_prop_##name() { return static_meta().slot(vsd_slot_##name); }
+  static const ::vsd::MetaProperty& vsd_prop_##name() { return static_meta().slot(vsd_slot_##name); }  \
+  /** @brief Typed, recorded editing of reference list `name` (see list_editor.hpp). */                \
+  template <class vsd_L = Type>                                                                        \
+  requires ::vsd::detail::IsRefList<vsd_L>                                                             \
+  [[nodiscard]] ::vsd::ListEditor<typename vsd_L::element_type> edit_##name() {                        \
+    return {*this, vsd_prop_##name()};                                                                 \
+  }
 
 /// @brief Publishes member function @p name as a MetaMethod (callable through vsdMetaCall).
 #define VSD_METHOD(name)                                                                     \

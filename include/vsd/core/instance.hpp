@@ -89,6 +89,11 @@ class SimStateInstance : public Instance {
   [[nodiscard]] std::uint32_t composite_count() const noexcept { return refs_; }
   /// @brief True from the moment its deletion starts.
   [[nodiscard]] bool is_being_deleted() const noexcept { return (life_ & dying_bit) != 0; }
+  /// @brief True while no property has ever held this instance compositely: it was created and never
+  /// attached. A floating instance is not deleted when its count falls back to zero (a free Ref or a
+  /// rejected change that held it for a moment leaves it floating); it lives until it is deleted
+  /// explicitly or attached and later released.
+  [[nodiscard]] bool is_floating() const noexcept { return (life_ & floating_bit) != 0; }
   /// @brief Instances holding composite references to this one (a Node's parent among them).
   [[nodiscard]] std::vector<SimStateInstance*> composite_holders() const;
   /// @brief The first instance holding this one compositely through property @p p, or nullptr.
@@ -148,8 +153,9 @@ class SimStateInstance : public Instance {
   friend struct detail::RefAccess;
   friend class detail::Applier;
   static constexpr std::uint8_t dying_bit = 1;
-  static constexpr std::uint8_t own_watch = 1;    // this instance has listeners
-  static constexpr std::uint8_t state_watch = 2;  // its SimState records or has listeners
+  static constexpr std::uint8_t floating_bit = 2;  // never held compositely by a property yet
+  static constexpr std::uint8_t own_watch = 1;     // this instance has listeners
+  static constexpr std::uint8_t state_watch = 2;   // its SimState records or has listeners
 
   template <class T>
   void assign_at(T& field, const T& v, const MetaProperty& p) {

@@ -217,9 +217,12 @@ class ClassBuilder {
   ClassBuilder& property(std::string name, T default_value, PropertyFlags flags = DefaultFlags) {
     return property(std::move(name), meta_type<T>(), Value(std::move(default_value)), flags);
   }
-  /// @brief Adds a method bound to a callable; arguments arrive checked against @p arguments.
+  /// @brief The body of a run-time method: instances of run-time classes are always SimStateInstances.
+  using Invoker = std::function<Value(SimStateInstance& self, std::span<const Value> args)>;
+  /// @brief Adds a method bound to a callable; arguments arrive checked against @p arguments (numbers
+  /// converted where exact). @throws vsd::Error when @p fn is empty or the name is taken.
   ClassBuilder& method(std::string name, std::vector<const MetaType*> arguments, const MetaType* result,
-                       MetaMethod::Invoker fn);
+                       Invoker fn);
   ClassBuilder& set_abstract(bool abstract = true);
   /// @brief Lets the last added property also be found as @p old_name (a property that was renamed:
   /// files and bundles that use the old name still load).

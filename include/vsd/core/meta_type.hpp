@@ -164,8 +164,11 @@ class MetaType {
   }
   /// @brief The text form of a value.
   [[nodiscard]] std::string to_text(const void* obj) const;
-  /// @brief Parses a whole text into @p obj; throws vsd::Error with line:col on bad text.
-  void from_text(void* obj, std::string_view text, const RefResolver* refs = nullptr) const;
+  /// @brief Parses a whole text into @p obj.
+  /// @param origin names the text in errors (a file, "property speed", ...); empty: "<TYPE value>".
+  /// @throws vsd::Error "origin:line:col: what" on bad text.
+  void from_text(void* obj, std::string_view text, const RefResolver* refs = nullptr,
+                 std::string_view origin = {}) const;
 
   // Building (used by the declaration macros and by run-time type creation).
   MetaType& add_enum_value(std::string name, std::int64_t value) {

@@ -4,7 +4,10 @@
  *  - Composite aggregation, `Ref<T>` / `RefList<T>`: counted. All parent-child relations are composite.
  *    When the last composite reference to an instance goes away, the instance is deleted with its own
  *    composite subtree. A newly created instance has no composite reference; it lives (floating, still
- *    in the element index) until it is attached and later released, or deleted explicitly.
+ *    in the element index) until a property attaches it and later releases it, or it is deleted
+ *    explicitly. Only a property adopts a floating instance: a free Ref (a local, a Value, the temporary
+ *    a setter's argument becomes) keeps an attached instance alive like a shared pointer, but dropping
+ *    it leaves a floating instance floating. So a change that is rejected never deletes anything.
  *  - Shared aggregation, `SharedRef<T>` / `SharedRefList<T>`: not counted. When the target is deleted,
  *    the reference becomes null (a list loses the element) and the holding instance emits a property
  *    change, so holders are notified without polling.
@@ -18,6 +21,7 @@
 
 #include <cstddef>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "vsd/core/config.hpp"
@@ -37,17 +41,22 @@ struct RefLink {
   RefLink* prev = nullptr;
   RefLink* next = nullptr;
   bool composite = false;
+  bool adopted = false;  // this link ended its target's floating state (revert() restores it)
 
   explicit RefLink(bool is_composite) noexcept : composite(is_composite) {}
   RefLink(const RefLink&) = delete;
   RefLink& operator=(const RefLink&) = delete;
   ~RefLink() { reset(nullptr); }
 
-  /// Points the link at @p t (nullptr clears). Releasing the last composite link of an instance deletes
-  /// it; linking to an instance that is being deleted throws vsd::Error.
+  /// Points the link at @p t (nullptr clears). Releasing the last composite link of an instance that
+  /// is not floating deletes it; linking to an instance that is being deleted throws vsd::Error, and so
+  /// does a property link that would cross SimStates or close a composite cycle (nothing changes then).
   void reset(SimStateInstance* t);
   /// Detaches from the target without releasing it (the target is going away).
   void drop() noexcept;
+  /// Undoes this link as if it had never been made: the count goes back and a target it adopted floats
+  /// again, so nothing is deleted. For the rollback of an operation that failed half way.
+  void revert() noexcept;
 };
 
 }  // namespace detail
@@ -180,11 +189,13 @@ class TypedRefList : public Base {
     const TypedRefList* l_ = nullptr;
     std::size_t i_ = 0;
   };
+  using element_type = T;
   using Base::Base;
   [[nodiscard]] T* operator[](std::size_t i) const noexcept { return static_cast<T*>(this->at(i)); }
   [[nodiscard]] iterator begin() const noexcept { return {this, 0}; }
   [[nodiscard]] iterator end() const noexcept { return {this, this->size()}; }
-  /// @brief Appends to a free list (lists held in properties change through their holder).
+  /// @brief Appends to a free list (a list held in a property changes through its holder: use the
+  /// property's `edit_name()` ListEditor, or SimStateInstance::list_insert).
   void push_back(T* p) { this->insert_at(this->size(), p); }
   void insert(std::size_t i, T* p) { this->insert_at(i, p); }
   void erase(std::size_t i) { this->erase_at(i); }
@@ -207,6 +218,12 @@ class SharedRefList : public detail::TypedRefList<T, RefListBase> {
 };
 
 namespace detail {
+/// True for RefList<T> and SharedRefList<T>.
+template <class L>
+concept IsRefList = std::is_base_of_v<RefListBase, L> && requires {
+  typename L::element_type;
+};
+
 extern const TypeOps ref_ops;
 extern const TypeOps ref_list_ops;
 

@@ -4,6 +4,10 @@
  *  Built-in classes register themselves when the program starts (and again, harmlessly, when a module
  *  registers them explicitly with `add<T>()`: static linking may drop the automatic path, never the
  *  explicit one). All methods are thread-safe.
+ *
+ *  Lifetime: the global registry is never destroyed. A private registry (an Environment's or a tool's)
+ *  owns the run-time classes and types defined in it and destroys them with itself, subclasses first;
+ *  no instance of them may outlive it.
  */
 #pragma once
 
@@ -58,7 +62,8 @@ class Registry {
   [[nodiscard]] std::vector<const MetaInstance*> classes() const;
   [[nodiscard]] std::vector<const MetaType*> types() const;
 
-  /// @brief Takes ownership of a run-time class built by ClassBuilder. @throws vsd::Error on a name clash.
+  /// @brief Takes ownership of a run-time class built by ClassBuilder. @throws vsd::Error on a name clash,
+  /// or when its base is a run-time class of another registry (a base must outlive its subclasses).
   const MetaInstance& define(std::unique_ptr<MetaInstance> cls);
   /// @brief Removes a run-time class that has no live instances and no subclasses.
   /// @throws vsd::Error otherwise, or for built-in classes.
@@ -68,6 +73,7 @@ class Registry {
   void add_locked(const MetaInstance& cls);
   void add_type_locked(const MetaType& type);
   void check_type_locked(const MetaType& type) const;
+  [[nodiscard]] bool owns_locked(const MetaInstance& cls) const noexcept;
   static bool same_reference(const MetaType& a, const MetaType& b) noexcept;
 
   mutable std::shared_mutex mutex_;

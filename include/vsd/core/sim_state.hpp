@@ -51,11 +51,16 @@ class SimState : public Instance {
 
   // ---- instances ----
   /// @brief Creates an instance of class T (built-in or a C++ class declared with VSD_INSTANCE).
+  /// The new instance floats (see is_floating()) until a property attaches it. The on_created listeners
+  /// run before this returns; should one of them delete the new instance, create() throws vsd::Error
+  /// instead of returning a reference to a deleted instance (the creation and the deletion both happened
+  /// and were recorded).
   template <class T>
   T& create() {
     return static_cast<T&>(create(T::static_meta()));
   }
-  /// @brief Creates an instance of @p cls (built-in or run-time). @throws vsd::Error for abstract classes.
+  /// @brief Creates an instance of @p cls (built-in or run-time). @throws vsd::Error for abstract classes,
+  /// and when an on_created listener deleted the new instance (see create<T>()).
   SimStateInstance& create(const MetaInstance& cls);
   /// @brief Creates an instance of the class named @p cls. @throws vsd::Error for unknown names.
   SimStateInstance& create(std::string_view cls);

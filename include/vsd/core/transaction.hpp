@@ -30,7 +30,7 @@ class Transaction {
   enum class Op : std::uint8_t { Create = 1, Delete = 2, Set = 3, Insert = 4, Erase = 5 };
   static constexpr std::uint8_t format_version = 1;
 
-  /// @brief An empty bundle.
+  /// @brief An empty bundle: bytes() is the header alone.
   Transaction();
   /// @brief A bundle from bytes received elsewhere. @throws vsd::Error when the header is wrong; the
   /// operations themselves are checked when the bundle is applied.

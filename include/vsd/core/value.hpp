@@ -103,8 +103,11 @@ class Value {
 
   /// @brief The text form ("<empty>" when empty).
   [[nodiscard]] std::string to_text() const;
-  /// @brief Parses @p text as a value of @p type; throws vsd::Error with line:col on bad text.
-  static Value from_text(const MetaType& type, std::string_view text, const RefResolver* refs = nullptr);
+  /// @brief Parses @p text as a value of @p type.
+  /// @param origin names the text in errors (a file, "property speed", ...); empty: "<TYPE value>".
+  /// @throws vsd::Error "origin:line:col: what" on bad text.
+  static Value from_text(const MetaType& type, std::string_view text, const RefResolver* refs = nullptr,
+                         std::string_view origin = {});
 
   /// @brief Same type and equal values (two empty values are equal).
   friend bool operator==(const Value& a, const Value& b) {
