@@ -22,11 +22,13 @@
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <thread>
 
 #include "compiled_net.hpp"
+#include "place_bounds.hpp"
 #include "vsd/core/error.hpp"
 
 namespace vsd::soml::analysis {
@@ -169,11 +171,13 @@ class Explorer {
   ExploreResult run() {
     const auto start = Clock::now();
     start_ = start;
+    if (c_.places > 0) bounds_ = detail::place_bounds(net_);  // timed: part of the analysis
     // Conserving nets never hold more than the initial token count in a place: size fields for that.
-    // Fields start as narrow as the initial marking allows (1 bit for a safe-looking net) and double
-    // when a place outgrows them; a conserving net never needs more than its initial token count.
+    // A net with structural bounds gets fields that hold them, and needs no unboundedness check. Other
+    // nets start as narrow as the initial marking allows and double the fields when a place outgrows them.
     unsigned bits = bits_for(std::max<std::uint32_t>(c_.initial_max, 1));
-    if (c_.conserving) bits = std::min(bits, bits_for(std::max<std::uint64_t>(c_.initial_sum, 1)));
+    if (bounds_)
+      bits = bits_for(std::max<std::uint64_t>(*std::max_element(bounds_->begin(), bounds_->end()), 1));
     ExploreResult r;
     while (true) {
       r = ExploreResult{};
@@ -293,6 +297,7 @@ class Explorer {
 
   const PtNet& net_;
   Compiled c_;
+  std::optional<std::vector<std::uint64_t>> bounds_;  // structural place bounds, when the net proves them
   ExploreOptions opt_;
   unsigned threads_ = 1;
   std::size_t limit_ = 0;
@@ -321,7 +326,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
   edges_ = 0;
   const std::uint32_t P = c_.places;
   const Layout L = layout_;
-  const bool check_cover = !c_.conserving;
+  const bool check_cover = !bounds_.has_value();
 
   {  // the initial marking
     std::vector<std::uint64_t> m0(L.words, 0);

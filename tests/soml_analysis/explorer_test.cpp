@@ -162,7 +162,29 @@ TEST(Explore, RingFamilyMatchesTheClosedForm) {
 }
 
 TEST(Explore, EncodingWidensWhenAPlaceOutgrowsIt) {
-  // p0 starts with 1 token (1 bit per place), one firing puts 300 on p1: 16 bits needed.
+  // q -> q + r while r < 20 (inhibitor): no P-semiflow covers r, so fields start at 1 bit (the initial
+  // marking) and widen 1 -> 2 -> 4 -> 8 as r grows.
+  PtNet grow("grow");
+  const auto q = grow.add_place("q", {}, 1);
+  const auto r = grow.add_place("r");
+  const auto t = grow.add_transition("t");
+  grow.add_input(t, q);
+  grow.add_output(t, q);
+  grow.add_output(t, r);
+  grow.add_inhibitor(t, r, 20);
+  for (unsigned threads : {1u, 2u}) {
+    const ExploreResult res = an::explore(grow, quiet(threads));
+    ASSERT_TRUE(res.complete()) << res.message;
+    EXPECT_EQ(res.states, 21u);
+    EXPECT_EQ(res.edges, 20u);
+    EXPECT_EQ(res.max_tokens_place, 20u);
+    EXPECT_EQ(res.bits_per_place, 8u);
+    EXPECT_EQ(res.dead_trace.size(), 20u);
+  }
+}
+
+TEST(Explore, EncodingFollowsTheStructuralBounds) {
+  // p0 starts with 1 token, one firing puts 300 on p1: the P-semiflow 300*p0 + p1 bounds p1 by 300.
   PtNet net("widen");
   const auto p0 = net.add_place("p0", {}, 1);
   const auto p1 = net.add_place("p1");

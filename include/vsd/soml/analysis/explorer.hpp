@@ -9,8 +9,9 @@
  *
  *  How (see docs/soml_analysis.md for the details):
  *  - Markings are stored packed, b bits per place with b in {1, 2, 4, 8, 16, 32}, in one arena of
- *    64-bit words; b starts from a bound proved from the net (token-conserving nets) or the initial
- *    marking, and the exploration restarts with 2b when a place outgrows it.
+ *    64-bit words. When the net proves bounds on its places (P-semiflows covering every place, or no
+ *    transition adding tokens), b holds the largest bound; otherwise b starts from the initial marking
+ *    and the exploration restarts with 2b when a place outgrows it.
  *  - A sharded open-addressing hash set holds state indices (no allocation per marking).
  *  - Enabling is incremental: a successor's enabled set is its parent's, with only the transitions that
  *    read a place the fired transition changed (as input or inhibitor place) tested again.
@@ -18,10 +19,9 @@
  *    result (including the firing sequence to a dead marking) is the same for any thread count.
  *  - Unboundedness: a new marking M' that strictly covers an ancestor M on its breadth-first path (and
  *    equals it on every inhibitor place) proves the net unbounded: the sequence from M to M' can fire
- *    again forever. The exploration stops and reports the pair. This check is skipped for nets whose
- *    transitions never add tokens in total (bounded by the initial token count). For nets with inhibitor
- *    arcs the test is sound but not complete (their boundedness is undecidable); the memory limit ends
- *    the rest.
+ *    again forever. The exploration stops and reports the pair. Nets with structural bounds (above)
+ *    skip this check. For nets with inhibitor arcs the test is sound but not complete (their boundedness
+ *    is undecidable); the memory limit ends the rest.
  *  - Memory: the arena, hash set and frontier buffers are counted; exceeding the limit stops the run
  *    with Status::memory_limit and a message, instead of an out-of-memory kill.
  */
