@@ -355,6 +355,9 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     const unsigned workers = static_cast<unsigned>(std::min<std::size_t>(threads_, nchunks));
     std::atomic<std::size_t> next_chunk{0};
     std::atomic<bool> stop{false};
+    std::size_t base_memory = memory();
+    for (std::size_t ci = 0; ci < chunks_.size(); ++ci) base_memory -= chunks_[ci].bytes();
+    std::atomic<std::size_t> successor_bytes{0};
 
     // ---- phase A: expand the frontier -------------------------------------------------------------
     run_workers(workers, [&](unsigned wi) {
@@ -424,7 +427,8 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
         }
         ch.fresh.assign(ch.hashes.size(), 0);
         ch.ids.resize(ch.hashes.size());
-        if (ch.bytes() > limit_ / 4 / threads_ + (std::size_t{64} << 20)) stop.store(true);  // runaway level
+        // A level whose successors alone would pass the limit stops here, before it exhausts the machine.
+        if (base_memory + (successor_bytes += ch.bytes()) > limit_) stop.store(true);
       }
     });
     for (auto& w : ws) {
