@@ -365,6 +365,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     std::size_t base_memory = memory();
     for (std::size_t ci = 0; ci < chunks_.size(); ++ci) base_memory -= chunks_[ci].bytes();
     std::atomic<std::size_t> successor_bytes{0};
+    const double successors_per_state = lo == 0 ? 1.0 : static_cast<double>(edges_) / static_cast<double>(lo);
 
     // ---- phase A: expand the frontier -------------------------------------------------------------
     run_workers(workers, [&](unsigned wi) {
@@ -377,6 +378,15 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
         ch.clear();
         const std::uint64_t first = lo + ci * kChunkStates;
         const std::uint64_t last = std::min(hi, first + kChunkStates);
+        // Size the buffers from the successors per state so far: few reallocations while filling them.
+        const auto expect =
+            static_cast<std::size_t>(static_cast<double>(last - first) * successors_per_state * 1.25) + 16;
+        if (ch.hashes.capacity() < expect) {
+          ch.markings.reserve(expect * L.words);
+          ch.hashes.reserve(expect);
+          ch.parents.reserve(expect);
+          ch.firings.reserve(expect);
+        }
         for (std::uint64_t s64 = first; s64 < last; ++s64) {
           const auto s = static_cast<std::uint32_t>(s64);
           const std::uint64_t* rec = record(s);
@@ -406,15 +416,21 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
             }
           }
           std::uint64_t count = 0;
+          for (std::uint32_t wd = 0; wd < tw_; ++wd)
+            count += static_cast<std::uint64_t>(std::popcount(en[wd]));
+          // Room for all successors at once: no per-successor growth checks in the loop below.
+          std::size_t k = ch.hashes.size();
+          ch.markings.resize((k + count) * L.words);
+          ch.hashes.resize(k + count);
+          ch.parents.resize(k + count);
+          ch.firings.resize(k + count);
           for (std::uint32_t wd = 0; wd < tw_; ++wd) {
             std::uint64_t bitsw = en[wd];
-            count += static_cast<std::uint64_t>(std::popcount(bitsw));
             while (bitsw != 0) {
               const std::uint32_t t = wd * 64 + static_cast<std::uint32_t>(std::countr_zero(bitsw));
               bitsw &= bitsw - 1;
-              const std::size_t at = ch.markings.size();
-              ch.markings.insert(ch.markings.end(), rec, rec + L.words);
-              std::uint64_t* out = ch.markings.data() + at;
+              std::uint64_t* out = ch.markings.data() + k * L.words;
+              for (std::uint32_t w = 0; w < L.words; ++w) out[w] = rec[w];
               for (std::uint32_t i = c_.delta_begin[t]; i < c_.delta_begin[t + 1]; ++i) {
                 const auto& d = c_.delta[i];
                 const std::int64_t v = static_cast<std::int64_t>(m[d.place]) + d.delta;
@@ -424,9 +440,10 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
                 }
                 L.set(out, d.place, static_cast<std::uint64_t>(v) & L.mask);
               }
-              ch.hashes.push_back(hash_words(out, L.words));
-              ch.parents.push_back(s);
-              ch.firings.push_back(t);
+              ch.hashes[k] = hash_words(out, L.words);
+              ch.parents[k] = s;
+              ch.firings[k] = t;
+              ++k;
             }
           }
           st.edges += count;

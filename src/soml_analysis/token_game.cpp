@@ -5,12 +5,31 @@
 
 namespace vsd::soml::analysis {
 
+// Besides the compiled net, for every place the arcs that test it: firing then adjusts, per changed place,
+// the count of unsatisfied arcs of each reading transition, instead of testing those transitions again.
 struct TokenGame::Net {
+  struct Test {
+    std::uint32_t transition;
+    std::uint32_t weight;
+    bool inhibitor;
+  };
   detail::Compiled c;
   std::vector<std::uint32_t> initial;
   std::vector<std::string> transition_ids;
+  std::vector<std::uint32_t> tests_begin;  // per place, into tests
+  std::vector<Test> tests;
   explicit Net(const PtNet& net) : c(net), initial(net.initial_marking()) {
     for (const auto& t : net.transitions()) transition_ids.push_back(t.id);
+    std::vector<std::vector<Test>> by_place(net.place_count());
+    for (std::uint32_t t = 0; t < net.transition_count(); ++t) {
+      for (const auto& a : net.transitions()[t].inputs) by_place[a.place].push_back({t, a.weight, false});
+      for (const auto& a : net.transitions()[t].inhibitors) by_place[a.place].push_back({t, a.weight, true});
+    }
+    for (const auto& v : by_place) {
+      tests_begin.push_back(static_cast<std::uint32_t>(tests.size()));
+      tests.insert(tests.end(), v.begin(), v.end());
+    }
+    tests_begin.push_back(static_cast<std::uint32_t>(tests.size()));
   }
 };
 
@@ -23,34 +42,54 @@ void TokenGame::reset() {
   marking_ = net_->initial;
   enabled_.clear();
   position_.assign(net_->c.transitions, kAbsent);
-  for (std::uint32_t t = 0; t < net_->c.transitions; ++t) update(t);
+  unsatisfied_.assign(net_->c.transitions, 0);
+  for (std::uint32_t p = 0; p < marking_.size(); ++p)
+    for (std::uint32_t i = net_->tests_begin[p]; i < net_->tests_begin[p + 1]; ++i) {
+      const auto& test = net_->tests[i];
+      if ((marking_[p] >= test.weight) == test.inhibitor) ++unsatisfied_[test.transition];
+    }
+  for (std::uint32_t t = 0; t < net_->c.transitions; ++t)
+    if (unsatisfied_[t] == 0) add(t);
 }
 
-void TokenGame::update(std::uint32_t t) {
-  const bool on = net_->c.enabled(t, marking_.data());
-  if (on && position_[t] == kAbsent) {
-    position_[t] = static_cast<std::uint32_t>(enabled_.size());
-    enabled_.push_back(t);
-  } else if (!on && position_[t] != kAbsent) {
-    const std::uint32_t last = enabled_.back();
-    enabled_[position_[t]] = last;
-    position_[last] = position_[t];
-    enabled_.pop_back();
-    position_[t] = kAbsent;
-  }
+void TokenGame::add(std::uint32_t t) {
+  position_[t] = static_cast<std::uint32_t>(enabled_.size());
+  enabled_.push_back(t);
+}
+
+void TokenGame::remove(std::uint32_t t) {
+  const std::uint32_t last = enabled_.back();
+  enabled_[position_[t]] = last;
+  position_[last] = position_[t];
+  enabled_.pop_back();
+  position_[t] = kAbsent;
 }
 
 void TokenGame::fire_unchecked(std::uint32_t t) {
   const detail::Compiled& c = net_->c;
   for (std::uint32_t i = c.delta_begin[t]; i < c.delta_begin[t + 1]; ++i) {
     const auto& d = c.delta[i];
-    const std::int64_t v = static_cast<std::int64_t>(marking_[d.place]) + d.delta;
+    const std::uint32_t before = marking_[d.place];
+    const std::int64_t v = static_cast<std::int64_t>(before) + d.delta;
     if (v > static_cast<std::int64_t>(UINT32_MAX))
       vsd::detail::throw_error("TokenGame::fire: a place would exceed 2^32-1 tokens firing '" +
                                net_->transition_ids[t] + "'");
-    marking_[d.place] = static_cast<std::uint32_t>(v);
+    const auto after = static_cast<std::uint32_t>(v);
+    marking_[d.place] = after;
+    for (std::uint32_t k = net_->tests_begin[d.place]; k < net_->tests_begin[d.place + 1]; ++k) {
+      const auto& test = net_->tests[k];
+      // An input arc is satisfied at >= weight, an inhibitor arc below it.
+      const bool was = (before >= test.weight) != test.inhibitor;
+      const bool is = (after >= test.weight) != test.inhibitor;
+      if (was == is) continue;
+      std::uint32_t& u = unsatisfied_[test.transition];
+      if (is) {
+        if (--u == 0) add(test.transition);
+      } else {
+        if (u++ == 0) remove(test.transition);
+      }
+    }
   }
-  for (std::uint32_t i = c.aff_begin[t]; i < c.aff_begin[t + 1]; ++i) update(c.aff[i]);
 }
 
 void TokenGame::fire(std::uint32_t t) {

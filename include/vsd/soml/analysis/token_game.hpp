@@ -2,9 +2,10 @@
  *  @brief vsd::soml::analysis::TokenGame: plays a PtNet, one firing at a time, with an incrementally kept
  *  set of enabled transitions.
  *
- *  After each firing only the transitions that read a place the fired transition changed (as input or
- *  inhibitor place) are tested again. The game owns a copy of what it needs from the net, so the PtNet
- *  may go away after construction.
+ *  Each transition keeps the number of its arcs that the marking does not satisfy (input arcs short of
+ *  tokens, inhibitor arcs with too many); a firing adjusts these counts only for the arcs on the places
+ *  it changes, so it never tests a whole transition again. The game owns a copy of what it needs from the
+ * net, so the PtNet may go away after construction.
  */
 #pragma once
 
@@ -42,14 +43,16 @@ class TokenGame {
 
  private:
   static constexpr std::uint32_t kAbsent = UINT32_MAX;
-  void update(std::uint32_t t);
+  void add(std::uint32_t t);
+  void remove(std::uint32_t t);
   void fire_unchecked(std::uint32_t t);
 
   struct Net;
   std::unique_ptr<Net> net_;
   std::vector<std::uint32_t> marking_;
   std::vector<std::uint32_t> enabled_;
-  std::vector<std::uint32_t> position_;  // index in enabled_, or kAbsent
+  std::vector<std::uint32_t> position_;     // index in enabled_, or kAbsent
+  std::vector<std::uint32_t> unsatisfied_;  // per transition: arcs the marking does not satisfy
 };
 
 }  // namespace vsd::soml::analysis
