@@ -405,3 +405,36 @@ TEST(ParseSize, UnitsAndErrors) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Explore, ReportsOfUnboundedAndIncompleteRuns) {
+  PtNet net("pump");
+  const auto p0 = net.add_place("p0", {}, 1);
+  const auto p1 = net.add_place("p1");
+  const auto t = net.add_transition("t");
+  net.add_input(t, p0);
+  net.add_output(t, p0);
+  net.add_output(t, p1);
+  const ExploreResult r = an::explore(net, quiet());
+  std::ostringstream json, text;
+  an::write_json(json, net, r);
+  an::write_summary(text, net, r);
+  EXPECT_NE(json.str().find("\"status\": \"unbounded\""), std::string::npos) << json.str();
+  EXPECT_NE(json.str().find("\"bounded\": false"), std::string::npos);
+  EXPECT_NE(json.str().find("\"unbounded_cycle\": [\"t\"]"), std::string::npos);
+  EXPECT_NE(text.str().find("UNBOUNDED"), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("at least"), std::string::npos);
+
+  ExploreOptions o = quiet();
+  o.memory_limit = 100 * 1024;
+  const PtNet big = an::test::ring(12, 6);
+  const ExploreResult m = an::explore(big, o);
+  std::ostringstream json2;
+  an::write_json(json2, big, m);
+  EXPECT_NE(json2.str().find("\"status\": \"memory_limit\""), std::string::npos) << json2.str();
+  EXPECT_NE(json2.str().find("\"bounded\": null"), std::string::npos);
+  EXPECT_GE(an::default_memory_limit(), std::size_t{64} << 20);
+}
+
+}  // namespace
