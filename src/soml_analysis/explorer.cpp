@@ -159,7 +159,8 @@ struct Chunk {
   }
 };
 
-struct Shard {
+// One cache line apart: two threads inserting into neighbouring shards must not share a line.
+struct alignas(64) Shard {
   std::vector<std::uint64_t> slots;
   std::size_t used = 0;
   std::vector<std::uint64_t> pending;  // (chunk << 32 | index) of the candidates inserted as pending
