@@ -12,6 +12,8 @@ PACKAGES=(
   cmake
   g++
   libeigen3-dev
+  # vsd::soml_analysis: the PNML reader's XML parser (the module is skipped without it)
+  libpugixml-dev
   # tests and benchmarks
   libgtest-dev
   libgmock-dev

@@ -1,7 +1,11 @@
 // The program each consumer project builds (find_package/, add_subdirectory/, fetch_content/): vsd's
-// public headers, an Environment with a Node, and a snapshot round trip through vsd::io.
+// public headers, an Environment with a Node, and a snapshot round trip through vsd::io; with
+// vsd::soml_analysis, a net through PNML and the explorer.
 #include <vsd/io.hpp>
 #include <vsd/vsd.hpp>
+#ifdef CONSUMER_HAS_SOML_ANALYSIS
+#include <vsd/soml_analysis.hpp>
+#endif
 
 int main() {
   vsd::Environment env;
@@ -11,5 +15,13 @@ int main() {
   state.database().add_child(n);
   auto& copy = env.create_state("copy");
   vsd::io::load_bytes(copy, vsd::io::save_bytes(state));
+#ifdef CONSUMER_HAS_SOML_ANALYSIS
+  vsd::soml::analysis::PtNet net("n");
+  const auto p = net.add_place("p", {}, 2);
+  const auto t = net.add_transition("t");
+  net.add_input(t, p);
+  const auto back = vsd::soml::analysis::read_pnml(vsd::soml::analysis::write_pnml(net));
+  if (vsd::soml::analysis::explore(back.net).states != 3) return 1;
+#endif
   return n.name() == "hello" && copy.equals(state) ? 0 : 1;
 }

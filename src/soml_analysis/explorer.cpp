@@ -1,0 +1,826 @@
+// Breadth-first exploration of a PtNet's reachable markings. See explorer.hpp for the design; the
+// comments here say why each piece is the way it is.
+//
+// One level of the breadth-first search runs in four phases:
+//   A (parallel over chunks of the frontier): enabled sets (incrementally from the parent's), counts,
+//     and the successor markings ("candidates") in per-chunk buffers, each with its hash;
+//   B (parallel over hash-set shards): each candidate is looked up in, or inserted into, its shard;
+//     a new marking is inserted as "pending" (a reference to its candidate), in candidate order;
+//   C (sequential): new markings get consecutive state indices in candidate order and are copied into
+//     the arena: numbering never depends on the thread count;
+//   D (parallel over shards): pending entries are rewritten to state indices.
+#include "vsd/soml/analysis/explorer.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <sstream>
+#include <thread>
+
+#include "compiled_net.hpp"
+#include "place_bounds.hpp"
+#include "vsd/core/error.hpp"
+
+namespace vsd::soml::analysis {
+
+namespace {
+
+using detail::Compiled;
+using Clock = std::chrono::steady_clock;
+
+constexpr std::uint32_t kNone = UINT32_MAX;
+constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
+constexpr std::uint64_t kPendingBit = std::uint64_t{1} << 63;
+constexpr unsigned kShardBits = 6;
+constexpr std::size_t kShards = std::size_t{1} << kShardBits;
+constexpr std::size_t kChunkStates = 256;             // frontier states per work item of phase A
+constexpr unsigned kBlockBits = 12;                   // states per arena block = 2^12
+constexpr std::uint64_t kMaxStates = UINT32_MAX - 1;  // indices are 32-bit; kNone is reserved
+
+std::string format_bytes(std::size_t b) {
+  char buf[32];
+  if (b >= (std::size_t{1} << 30))
+    std::snprintf(buf, sizeof buf, "%.1f GiB", static_cast<double>(b) / (1 << 30));
+  else if (b >= (std::size_t{1} << 20))
+    std::snprintf(buf, sizeof buf, "%.1f MiB", static_cast<double>(b) / (1 << 20));
+  else
+    std::snprintf(buf, sizeof buf, "%.1f KiB", static_cast<double>(b) / 1024);
+  return buf;
+}
+
+unsigned bits_for(std::uint64_t max_value) {
+  unsigned b = 1;
+  while (b < 32 && (max_value >> b) != 0) b *= 2;
+  return b;
+}
+
+// Packed marking layout: `bits` bits per place, 64/bits places per word, no field straddles words.
+struct Layout {
+  unsigned bits = 1;
+  unsigned shift = 0;  // log2(places per word)
+  std::uint64_t mask = 1;
+  std::uint32_t words = 1;   // words of a marking
+  std::uint32_t record = 2;  // words of an arena record: marking + (parent << 32 | transition)
+
+  Layout(unsigned b, std::uint32_t places) : bits(b) {
+    shift = static_cast<unsigned>(std::countr_zero(64u / b));
+    mask = b == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << b) - 1;
+    const std::uint32_t per_word = 64u / b;
+    words = std::max<std::uint32_t>(1, (places + per_word - 1) / per_word);
+    record = words + 1;
+  }
+  std::uint32_t get(const std::uint64_t* w, std::uint32_t p) const {
+    const unsigned off = (p & ((1u << shift) - 1)) * bits;
+    return static_cast<std::uint32_t>((w[p >> shift] >> off) & mask);
+  }
+  void set(std::uint64_t* w, std::uint32_t p, std::uint64_t v) const {
+    const unsigned off = (p & ((1u << shift) - 1)) * bits;
+    std::uint64_t& x = w[p >> shift];
+    x = (x & ~(mask << off)) | (v << off);
+  }
+  void unpack(const std::uint64_t* w, std::uint32_t places, std::uint32_t* out) const {
+    for (std::uint32_t p = 0; p < places; ++p) out[p] = get(w, p);
+  }
+};
+
+std::uint64_t hash_words(const std::uint64_t* w, std::uint32_t n) {
+  std::uint64_t h = 0x243F6A8885A308D3ull ^ n;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    h ^= w[i];
+    h *= 0x9E3779B97F4A7C15ull;
+    h ^= h >> 29;
+  }
+  h ^= h >> 32;
+  h *= 0xD6E8FEB86659FD93ull;
+  h ^= h >> 32;
+  return h;
+}
+
+// Markings are a few words: a plain loop beats a call to memcmp.
+inline bool same(const std::uint64_t* a, const std::uint64_t* b, std::uint32_t words) {
+  for (std::uint32_t i = 0; i < words; ++i)
+    if (a[i] != b[i]) return false;
+  return true;
+}
+
+// Work split for phases with a fixed item count: threads take items from a shared counter.
+template <class F>
+void run_workers(unsigned threads, F&& body) {
+  if (threads <= 1) {
+    body(0u);
+    return;
+  }
+  std::vector<std::thread> pool;
+  pool.reserve(threads - 1);
+  for (unsigned w = 1; w < threads; ++w) pool.emplace_back([&body, w] { body(w); });
+  body(0u);
+  for (auto& t : pool) t.join();
+}
+
+struct alignas(64) WorkerStats {
+  std::uint64_t edges = 0;
+  std::uint32_t max_place = 0;
+  std::uint64_t max_sum = 0;
+  std::uint32_t first_dead = kNone;
+  std::uint32_t first_cover = kNone;  // smallest new state covering an ancestor
+  std::uint32_t covered = kNone;      // ... and that ancestor
+  bool overflow = false;
+  std::vector<std::uint32_t> unpacked;
+  std::vector<std::uint32_t> unpacked2;
+};
+
+// Successors of one chunk of the frontier.
+struct Chunk {
+  std::vector<std::uint64_t> markings;  // `words` per candidate
+  std::vector<std::uint64_t> hashes;
+  std::vector<std::uint32_t> parents;
+  std::vector<std::uint32_t> firings;
+  std::vector<std::uint8_t> fresh;  // phase B: first occurrence of a new marking
+  std::vector<std::uint32_t> ids;   // phase C: its state index
+  void clear() {
+    markings.clear();
+    hashes.clear();
+    parents.clear();
+    firings.clear();
+  }
+  std::size_t bytes() const {
+    return markings.capacity() * 8 + hashes.capacity() * 8 + parents.capacity() * 4 + firings.capacity() * 4 +
+           fresh.capacity() + ids.capacity() * 4;
+  }
+};
+
+// One cache line apart: two threads inserting into neighbouring shards must not share a line.
+struct alignas(64) Shard {
+  std::vector<std::uint64_t> slots;
+  std::size_t used = 0;
+  std::vector<std::uint64_t> pending;  // (chunk << 32 | index) of the candidates inserted as pending
+};
+
+class Explorer {
+ public:
+  Explorer(const PtNet& net, const ExploreOptions& opt) : net_(net), c_(net), opt_(opt) {
+    threads_ = opt.threads == 0 ? std::max(1u, std::thread::hardware_concurrency()) : opt.threads;
+    limit_ = opt.memory_limit == 0 ? default_memory_limit() : opt.memory_limit;
+    show_progress_ = opt.progress == ExploreOptions::Progress::always ||
+                     (opt.progress == ExploreOptions::Progress::automatic && isatty(STDERR_FILENO) == 1);
+    tw_ = std::max<std::uint32_t>(1, (c_.transitions + 63) / 64);
+  }
+
+  ExploreResult run() {
+    const auto start = Clock::now();
+    start_ = start;
+    if (c_.places > 0) bounds_ = detail::place_bounds(net_);  // timed: part of the analysis
+    // Conserving nets never hold more than the initial token count in a place: size fields for that.
+    // A net with structural bounds gets fields that hold them, and needs no unboundedness check. Other
+    // nets start as narrow as the initial marking allows and double the fields when a place outgrows them.
+    unsigned bits = bits_for(std::max<std::uint32_t>(c_.initial_max, 1));
+    if (bounds_)
+      bits = bits_for(std::max<std::uint64_t>(*std::max_element(bounds_->begin(), bounds_->end()), 1));
+    ExploreResult r;
+    while (true) {
+      r = ExploreResult{};
+      if (attempt(bits, r)) break;
+      if (bits == 32)
+        vsd::detail::throw_error("explore: a place of net '" + net_.id() +
+                                 "' would hold more than 2^32-1 tokens");
+      bits *= 2;  // a place outgrew the fields: start again with wider ones
+    }
+    r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    r.threads = threads_;
+    r.memory_limit = limit_;
+    r.peak_memory = peak_;
+    if (progress_shown_) std::fputs("\n", stderr);
+    return r;
+  }
+
+ private:
+  const std::uint64_t* record(std::uint32_t id) const {
+    return blocks_[id >> kBlockBits].get() + std::size_t(id & ((1u << kBlockBits) - 1)) * layout_.record;
+  }
+  std::uint64_t* record(std::uint32_t id) {
+    return blocks_[id >> kBlockBits].get() + std::size_t(id & ((1u << kBlockBits) - 1)) * layout_.record;
+  }
+  std::uint32_t parent(std::uint32_t id) const {
+    return static_cast<std::uint32_t>(record(id)[layout_.words] >> 32);
+  }
+  std::uint32_t firing(std::uint32_t id) const {
+    return static_cast<std::uint32_t>(record(id)[layout_.words] & 0xFFFFFFFFu);
+  }
+
+  std::size_t memory() const {
+    std::size_t m = blocks_.size() * (std::size_t{1} << kBlockBits) * layout_.record * 8;
+    for (const auto& s : shards_) m += s.slots.capacity() * 8 + s.pending.capacity() * 8;
+    for (const auto& ch : chunks_) m += ch.bytes();
+    m += (prev_enabled_.capacity() + cur_enabled_.capacity()) * 8;
+    return m;
+  }
+  bool check_memory(ExploreResult& r) {
+    const std::size_t m = memory();
+    peak_ = std::max(peak_, m);
+    if (m <= limit_) return true;
+    r.status = ExploreResult::Status::memory_limit;
+    r.message = "memory limit of " + format_bytes(limit_) + " reached after " + std::to_string(states_) +
+                " states (" + format_bytes(m) +
+                " in use); the figures count the states visited so far. Raise it with --limit-mem.";
+    return false;
+  }
+
+  std::uint32_t add_state(const std::uint64_t* marking, std::uint32_t par, std::uint32_t t) {
+    const auto id = static_cast<std::uint32_t>(states_);
+    if ((id >> kBlockBits) >= blocks_.size())
+      blocks_.emplace_back(new std::uint64_t[(std::size_t{1} << kBlockBits) * layout_.record]);
+    std::uint64_t* rec = record(id);
+    std::memcpy(rec, marking, layout_.words * 8);
+    rec[layout_.words] = (std::uint64_t{par} << 32) | t;
+    ++states_;
+    return id;
+  }
+
+  std::vector<std::uint32_t> path_to(std::uint32_t id) const {
+    std::vector<std::uint32_t> seq;
+    while (id != 0) {
+      seq.push_back(firing(id));
+      id = parent(id);
+    }
+    std::reverse(seq.begin(), seq.end());
+    return seq;
+  }
+  std::vector<std::uint32_t> unpack(std::uint32_t id) const {
+    std::vector<std::uint32_t> m(c_.places);
+    layout_.unpack(record(id), c_.places, m.data());
+    return m;
+  }
+
+  // Inserts a marking known to be new (the initial one) directly.
+  void insert_committed(std::uint64_t h, std::uint32_t id) {
+    Shard& s = shards_[h >> (64 - kShardBits)];
+    insert_slot(s, h, (h & 0x7FFFFFFFull) << 32 | id);
+  }
+  static void grow(Shard& s) {
+    std::vector<std::uint64_t> old = std::move(s.slots);
+    s.slots.assign(old.size() * 2, kEmpty);
+    const std::size_t mask = s.slots.size() - 1;
+    for (std::uint64_t v : old) {
+      if (v == kEmpty) continue;
+      std::size_t i = ((v >> 32) & 0x7FFFFFFFull) & mask;
+      while (s.slots[i] != kEmpty) i = (i + 1) & mask;
+      s.slots[i] = v;
+    }
+  }
+  static void insert_slot(Shard& s, std::uint64_t h, std::uint64_t value) {
+    if ((s.used + 1) * 2 > s.slots.size()) grow(s);
+    const std::size_t mask = s.slots.size() - 1;
+    std::size_t i = (h & 0x7FFFFFFFull) & mask;
+    while (s.slots[i] != kEmpty) i = (i + 1) & mask;
+    s.slots[i] = value;
+    ++s.used;
+  }
+
+  void progress(std::uint32_t level, bool force) {
+    if (!show_progress_) return;
+    const auto now = Clock::now();
+    if (!force && now - last_progress_ < std::chrono::seconds(1)) return;
+    if (!progress_shown_ && now - start_ < std::chrono::seconds(1)) return;
+    last_progress_ = now;
+    progress_shown_ = true;
+    const double secs = std::chrono::duration<double>(now - start_).count();
+    std::fprintf(stderr, "\rvsd-soml: level %u, %llu states, %llu edges, %.0f states/s, %zu MiB   ", level,
+                 static_cast<unsigned long long>(states_), static_cast<unsigned long long>(edges_),
+                 secs > 0 ? static_cast<double>(states_) / secs : 0.0, memory() >> 20);
+    std::fflush(stderr);
+  }
+
+  // One exploration with `bits` per place; false when a place outgrew them.
+  bool attempt(unsigned bits, ExploreResult& r);
+
+  const PtNet& net_;
+  Compiled c_;
+  std::optional<std::vector<std::uint64_t>> bounds_;  // structural place bounds, when the net proves them
+  ExploreOptions opt_;
+  unsigned threads_ = 1;
+  std::size_t limit_ = 0;
+  std::size_t peak_ = 0;
+  bool show_progress_ = false;
+  bool progress_shown_ = false;
+  Clock::time_point start_, last_progress_;
+  std::uint32_t tw_ = 1;  // words of an enabled-transition bitset
+  Layout layout_{1, 0};
+  std::vector<std::unique_ptr<std::uint64_t[]>> blocks_;
+  std::vector<Shard> shards_;
+  std::vector<Chunk> chunks_;
+  std::vector<std::uint64_t> prev_enabled_, cur_enabled_;
+  std::uint64_t states_ = 0;
+  std::uint64_t edges_ = 0;
+};
+
+bool Explorer::attempt(unsigned bits, ExploreResult& r) {
+  layout_ = Layout(bits, c_.places);
+  r.bits_per_place = bits;
+  blocks_.clear();
+  shards_.assign(kShards, Shard{});
+  for (auto& s : shards_) s.slots.assign(16, kEmpty);
+  chunks_.clear();
+  states_ = 0;
+  edges_ = 0;
+  const std::uint32_t P = c_.places;
+  const Layout L = layout_;
+  const bool check_cover = !bounds_.has_value();
+
+  {  // the initial marking
+    std::vector<std::uint64_t> m0(L.words, 0);
+    for (std::uint32_t p = 0; p < P; ++p) {
+      const std::uint32_t v = net_.places()[p].initial;
+      if (v > L.mask) return false;
+      L.set(m0.data(), p, v);
+    }
+    insert_committed(hash_words(m0.data(), L.words), add_state(m0.data(), kNone, kNone));
+  }
+
+  std::vector<WorkerStats> ws(threads_);
+  for (auto& w : ws) {
+    w.unpacked.assign(P, 0);
+    w.unpacked2.assign(P, 0);
+  }
+  std::uint32_t first_dead = kNone;
+  std::uint64_t lo = 0, hi = 1, prev_lo = 0;
+  prev_enabled_.clear();
+  std::uint32_t level = 0;
+  for (; lo < hi; ++level) {
+    const std::uint64_t n = hi - lo;
+    const std::size_t nchunks = (n + kChunkStates - 1) / kChunkStates;
+    if (chunks_.size() < nchunks) chunks_.resize(nchunks);
+    cur_enabled_.assign(n * tw_, 0);
+    const unsigned workers = static_cast<unsigned>(std::min<std::size_t>(threads_, nchunks));
+    std::atomic<std::size_t> next_chunk{0};
+    std::atomic<bool> stop{false};
+    std::size_t base_memory = memory();
+    for (std::size_t ci = 0; ci < chunks_.size(); ++ci) base_memory -= chunks_[ci].bytes();
+    std::atomic<std::size_t> successor_bytes{0};
+    const double successors_per_state = lo == 0 ? 1.0 : static_cast<double>(edges_) / static_cast<double>(lo);
+
+    // ---- phase A: expand the frontier -------------------------------------------------------------
+    run_workers(workers, [&](unsigned wi) {
+      WorkerStats& st = ws[wi];
+      std::uint32_t* m = st.unpacked.data();
+      while (!stop.load(std::memory_order_relaxed)) {
+        const std::size_t ci = next_chunk.fetch_add(1);
+        if (ci >= nchunks) break;
+        Chunk& ch = chunks_[ci];
+        ch.clear();
+        const std::uint64_t first = lo + ci * kChunkStates;
+        const std::uint64_t last = std::min(hi, first + kChunkStates);
+        // Size the buffers from the successors per state so far: few reallocations while filling them.
+        const auto expect =
+            static_cast<std::size_t>(static_cast<double>(last - first) * successors_per_state * 1.25) + 16;
+        if (ch.hashes.capacity() < expect) {
+          ch.markings.reserve(expect * L.words);
+          ch.hashes.reserve(expect);
+          ch.parents.reserve(expect);
+          ch.firings.reserve(expect);
+        }
+        for (std::uint64_t s64 = first; s64 < last; ++s64) {
+          const auto s = static_cast<std::uint32_t>(s64);
+          const std::uint64_t* rec = record(s);
+          L.unpack(rec, P, m);
+          std::uint64_t sum = 0;
+          for (std::uint32_t p = 0; p < P; ++p) {
+            sum += m[p];
+            st.max_place = std::max(st.max_place, m[p]);
+          }
+          st.max_sum = std::max(st.max_sum, sum);
+          std::uint64_t* en = cur_enabled_.data() + (s64 - lo) * tw_;
+          if (s == 0) {
+            for (std::uint32_t t = 0; t < c_.transitions; ++t)
+              if (c_.enabled(t, m)) en[t >> 6] |= std::uint64_t{1} << (t & 63);
+          } else {
+            // Incremental enabling: the parent's set, with the transitions reading a changed place retested.
+            const std::uint32_t par = static_cast<std::uint32_t>(rec[L.words] >> 32);
+            const std::uint32_t ft = static_cast<std::uint32_t>(rec[L.words] & 0xFFFFFFFFu);
+            std::memcpy(en, prev_enabled_.data() + (par - prev_lo) * tw_, tw_ * 8);
+            for (std::uint32_t i = c_.aff_begin[ft]; i < c_.aff_begin[ft + 1]; ++i) {
+              const std::uint32_t u = c_.aff[i];
+              const std::uint64_t bit = std::uint64_t{1} << (u & 63);
+              if (c_.enabled(u, m))
+                en[u >> 6] |= bit;
+              else
+                en[u >> 6] &= ~bit;
+            }
+          }
+          std::uint64_t count = 0;
+          for (std::uint32_t wd = 0; wd < tw_; ++wd)
+            count += static_cast<std::uint64_t>(std::popcount(en[wd]));
+          // Room for all successors at once: no per-successor growth checks in the loop below.
+          std::size_t k = ch.hashes.size();
+          ch.markings.resize((k + count) * L.words);
+          ch.hashes.resize(k + count);
+          ch.parents.resize(k + count);
+          ch.firings.resize(k + count);
+          for (std::uint32_t wd = 0; wd < tw_; ++wd) {
+            std::uint64_t bitsw = en[wd];
+            while (bitsw != 0) {
+              const std::uint32_t t = wd * 64 + static_cast<std::uint32_t>(std::countr_zero(bitsw));
+              bitsw &= bitsw - 1;
+              std::uint64_t* out = ch.markings.data() + k * L.words;
+              for (std::uint32_t w = 0; w < L.words; ++w) out[w] = rec[w];
+              for (std::uint32_t i = c_.delta_begin[t]; i < c_.delta_begin[t + 1]; ++i) {
+                const auto& d = c_.delta[i];
+                const std::int64_t v = static_cast<std::int64_t>(m[d.place]) + d.delta;
+                if (static_cast<std::uint64_t>(v) > L.mask) {
+                  st.overflow = true;
+                  stop.store(true, std::memory_order_relaxed);
+                }
+                L.set(out, d.place, static_cast<std::uint64_t>(v) & L.mask);
+              }
+              ch.hashes[k] = hash_words(out, L.words);
+              ch.parents[k] = s;
+              ch.firings[k] = t;
+              ++k;
+            }
+          }
+          st.edges += count;
+          if (count == 0 && s < st.first_dead) st.first_dead = s;
+        }
+        ch.fresh.assign(ch.hashes.size(), 0);
+        ch.ids.resize(ch.hashes.size());
+        // A level whose successors alone would pass the limit stops here, before it exhausts the machine.
+        if (base_memory + (successor_bytes += ch.bytes()) > limit_) stop.store(true);
+      }
+    });
+    for (auto& w : ws) {
+      if (w.overflow) return false;
+      edges_ += w.edges;
+      w.edges = 0;
+      r.max_tokens_place = std::max(r.max_tokens_place, w.max_place);
+      r.max_tokens_marking = std::max(r.max_tokens_marking, w.max_sum);
+      first_dead = std::min(first_dead, w.first_dead);
+    }
+    std::swap(prev_enabled_, cur_enabled_);
+    prev_lo = lo;
+    r.levels = level + 1;
+    if (stop.load() || !check_memory(r)) {
+      if (r.status == ExploreResult::Status::complete) {
+        r.status = ExploreResult::Status::memory_limit;
+        r.message = "memory limit of " + format_bytes(limit_) + ": the successors of level " +
+                    std::to_string(level) + " do not fit; stopped after " + std::to_string(states_) +
+                    " states. Raise it with --limit-mem.";
+      }
+      break;
+    }
+
+    // ---- phase B: look up / insert into the shards ----------------------------------------------------
+    std::size_t candidates = 0;
+    for (std::size_t ci = 0; ci < nchunks; ++ci) candidates += chunks_[ci].hashes.size();
+    const unsigned bworkers = candidates > 4096 ? threads_ : 1u;
+    run_workers(bworkers, [&](unsigned wi) {
+      // Worker wi owns shards with (shard % bworkers == wi); it reads every candidate's hash in order.
+      constexpr std::size_t kAhead = 8;  // the table probes are cache misses: prefetch a few candidates ahead
+      for (std::size_t ci = 0; ci < nchunks; ++ci) {
+        Chunk& ch = chunks_[ci];
+        const std::size_t count = ch.hashes.size();
+        for (std::size_t i = 0; i < count; ++i) {
+          if (i + kAhead < count) {
+            const std::uint64_t ha = ch.hashes[i + kAhead];
+            const Shard& sa = shards_[ha >> (64 - kShardBits)];
+            if ((ha >> (64 - kShardBits)) % bworkers == wi)
+              __builtin_prefetch(sa.slots.data() + ((ha & 0x7FFFFFFFull) & (sa.slots.size() - 1)));
+          }
+          const std::uint64_t h = ch.hashes[i];
+          const std::size_t si = h >> (64 - kShardBits);
+          if (si % bworkers != wi) continue;
+          Shard& sh = shards_[si];
+          const std::uint64_t frag = h & 0x7FFFFFFFull;
+          const std::uint64_t* mk = ch.markings.data() + i * L.words;
+          std::size_t mask = sh.slots.size() - 1;
+          std::size_t pos = frag & mask;
+          bool found = false;
+          for (;; pos = (pos + 1) & mask) {
+            const std::uint64_t v = sh.slots[pos];
+            if (v == kEmpty) break;
+            if (((v >> 32) & 0x7FFFFFFFull) != frag) continue;
+            const std::uint64_t* other;
+            if (v & kPendingBit) {
+              const std::uint64_t ref = sh.pending[v & 0xFFFFFFFFull];
+              other = chunks_[ref >> 32].markings.data() + (ref & 0xFFFFFFFFull) * L.words;
+            } else {
+              other = record(static_cast<std::uint32_t>(v & 0xFFFFFFFFull));
+            }
+            if (same(other, mk, L.words)) {
+              found = true;
+              break;
+            }
+          }
+          if (found) continue;
+          ch.fresh[i] = 1;
+          const std::uint64_t pidx = sh.pending.size();
+          sh.pending.push_back((std::uint64_t{ci} << 32) | i);
+          insert_slot(sh, h, kPendingBit | frag << 32 | pidx);
+        }
+      }
+    });
+
+    // ---- phase C: number the new markings in candidate order ----------------------------------------
+    const std::uint64_t new_lo = states_;
+    bool too_many = false;
+    for (std::size_t ci = 0; ci < nchunks && !too_many; ++ci) {
+      Chunk& ch = chunks_[ci];
+      for (std::size_t i = 0; i < ch.fresh.size(); ++i) {
+        if (!ch.fresh[i]) continue;
+        if (states_ >= kMaxStates) {
+          too_many = true;
+          break;
+        }
+        ch.ids[i] = add_state(ch.markings.data() + i * L.words, ch.parents[i], ch.firings[i]);
+      }
+    }
+    if (too_many) vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
+
+    // ---- phase D: pending entries become state indices ----------------------------------------------
+    run_workers(bworkers, [&](unsigned wi) {
+      for (std::size_t si = wi; si < kShards; si += bworkers) {
+        Shard& sh = shards_[si];
+        const std::size_t mask = sh.slots.size() - 1;
+        for (std::size_t k = 0; k < sh.pending.size(); ++k) {
+          const std::uint64_t ref = sh.pending[k];
+          const Chunk& ch = chunks_[ref >> 32];
+          const std::size_t i = ref & 0xFFFFFFFFull;
+          const std::uint64_t h = ch.hashes[i];
+          const std::uint64_t frag = h & 0x7FFFFFFFull;
+          const std::uint64_t want = kPendingBit | frag << 32 | k;
+          std::size_t pos = frag & mask;
+          while (sh.slots[pos] != want) pos = (pos + 1) & mask;
+          sh.slots[pos] = frag << 32 | ch.ids[i];
+        }
+        sh.pending.clear();
+      }
+    });
+
+    // ---- unboundedness: does a new marking strictly cover an ancestor? -------------------------------
+    if (check_cover && states_ > new_lo) {
+      std::atomic<std::uint64_t> next{new_lo};
+      const unsigned cworkers =
+          static_cast<unsigned>(std::min<std::uint64_t>(threads_, (states_ - new_lo) / 64 + 1));
+      run_workers(cworkers, [&](unsigned wi) {
+        WorkerStats& st = ws[wi];
+        std::uint32_t* m = st.unpacked.data();
+        while (true) {
+          const std::uint64_t from = next.fetch_add(256);
+          if (from >= states_) break;
+          const std::uint64_t to = std::min<std::uint64_t>(states_, from + 256);
+          for (std::uint64_t s64 = from; s64 < to; ++s64) {
+            const auto s = static_cast<std::uint32_t>(s64);
+            if (s >= st.first_cover) break;
+            L.unpack(record(s), P, m);
+            for (std::uint32_t a = parent(s);; a = parent(a)) {
+              const std::uint64_t* am = record(a);
+              bool ge = true, gt = false;
+              for (std::uint32_t p = 0; p < P && ge; ++p) {
+                const std::uint32_t v = L.get(am, p);
+                if (m[p] < v || (m[p] != v && c_.inhibitor_place[p])) ge = false;
+                gt = gt || m[p] > v;
+              }
+              if (ge && gt) {
+                st.first_cover = s;
+                st.covered = a;
+                break;
+              }
+              if (a == 0) break;
+            }
+            if (st.first_cover == s) break;
+          }
+        }
+      });
+      std::uint32_t cover = kNone, covered = kNone;
+      for (auto& w : ws)
+        if (w.first_cover < cover) {
+          cover = w.first_cover;
+          covered = w.covered;
+        }
+      if (cover != kNone) {
+        r.status = ExploreResult::Status::unbounded;
+        r.unbounded_prefix = path_to(covered);
+        const auto full = path_to(cover);
+        r.unbounded_cycle.assign(full.begin() + static_cast<std::ptrdiff_t>(r.unbounded_prefix.size()),
+                                 full.end());
+        r.unbounded_covered = unpack(covered);
+        r.unbounded_covering = unpack(cover);
+        r.message = "the net is unbounded: firing " + trace_to_string(net_, r.unbounded_cycle) +
+                    " from the marking reached by [" + trace_to_string(net_, r.unbounded_prefix) +
+                    "] gives a marking that strictly covers it, and the sequence can be repeated forever";
+        break;
+      }
+    }
+    lo = hi;
+    hi = states_;
+    if (!check_memory(r)) break;
+    progress(level, false);
+  }
+  progress(level, true);
+  r.states = states_;
+  r.edges = edges_;
+  if (first_dead != kNone) {
+    r.deadlock = true;
+    r.dead_trace = path_to(first_dead);
+    r.dead_marking = unpack(first_dead);
+  }
+  return true;
+}
+
+}  // namespace
+
+ExploreResult explore(const PtNet& net, const ExploreOptions& options) {
+  return Explorer(net, options).run();
+}
+
+std::size_t default_memory_limit() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  std::size_t kib = 0;
+  std::string unit;
+  while (in >> key >> kib >> unit)
+    if (key == "MemAvailable:") return std::max<std::size_t>(kib * 1024 / 4 * 3, std::size_t{64} << 20);
+  return std::size_t{4} << 30;  // no /proc: a cautious guess
+}
+
+std::size_t parse_size(const std::string& text) {
+  std::size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    vsd::detail::throw_error("size '" + text + "' is not a number with an optional unit (K, M, G, T)");
+  }
+  std::string unit = text.substr(used);
+  for (auto& ch : unit) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  double scale = 1;
+  if (unit.empty() || unit == "B")
+    scale = 1;
+  else if (unit == "K" || unit == "KB" || unit == "KIB")
+    scale = 1024.0;
+  else if (unit == "M" || unit == "MB" || unit == "MIB")
+    scale = 1024.0 * 1024;
+  else if (unit == "G" || unit == "GB" || unit == "GIB")
+    scale = 1024.0 * 1024 * 1024;
+  else if (unit == "T" || unit == "TB" || unit == "TIB")
+    scale = 1024.0 * 1024 * 1024 * 1024;
+  else
+    vsd::detail::throw_error("size '" + text + "': unknown unit '" + unit + "' (use K, M, G or T)");
+  if (!(v > 0) || !std::isfinite(v) || v * scale > 1.8e19)
+    vsd::detail::throw_error("size '" + text + "' must be positive and finite");
+  return static_cast<std::size_t>(v * scale);
+}
+
+std::string trace_to_string(const PtNet& net, const std::vector<std::uint32_t>& trace) {
+  std::string s;
+  for (std::uint32_t t : trace) {
+    if (!s.empty()) s += ' ';
+    s += net.transitions().at(t).id;
+  }
+  return s;
+}
+
+namespace {
+void json_string(std::ostream& out, std::string_view s) {
+  out << '"';
+  for (char ch : s) {
+    switch (ch) {
+      case '"':
+        out << "\\\"";
+        break;
+      case '\\':
+        out << "\\\\";
+        break;
+      case '\n':
+        out << "\\n";
+        break;
+      case '\t':
+        out << "\\t";
+        break;
+      case '\r':
+        out << "\\r";
+        break;
+      default:
+        if (static_cast<unsigned char>(ch) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(ch)));
+          out << buf;
+        } else {
+          out << ch;
+        }
+    }
+  }
+  out << '"';
+}
+void json_trace(std::ostream& out, const PtNet& net, const std::vector<std::uint32_t>& trace) {
+  out << '[';
+  for (std::size_t i = 0; i < trace.size(); ++i) {
+    if (i) out << ", ";
+    json_string(out, net.transitions().at(trace[i]).id);
+  }
+  out << ']';
+}
+void json_marking(std::ostream& out, const PtNet& net, const std::vector<std::uint32_t>& m) {
+  // Sparse: only marked places, by id.
+  out << '{';
+  bool first = true;
+  for (std::size_t p = 0; p < m.size(); ++p) {
+    if (m[p] == 0) continue;
+    if (!first) out << ", ";
+    first = false;
+    json_string(out, net.places()[p].id);
+    out << ": " << m[p];
+  }
+  out << '}';
+}
+const char* status_name(ExploreResult::Status s) {
+  switch (s) {
+    case ExploreResult::Status::complete:
+      return "complete";
+    case ExploreResult::Status::unbounded:
+      return "unbounded";
+    case ExploreResult::Status::memory_limit:
+      return "memory_limit";
+  }
+  return "?";
+}
+}  // namespace
+
+void write_json(std::ostream& out, const PtNet& net, const ExploreResult& r) {
+  out << "{\"net\": ";
+  json_string(out, net.id());
+  out << ", \"status\": \"" << status_name(r.status) << "\", \"states\": " << r.states
+      << ", \"edges\": " << r.edges << ", \"deadlock\": " << (r.deadlock ? "true" : "false")
+      << ", \"max_tokens_place\": " << r.max_tokens_place
+      << ", \"max_tokens_marking\": " << r.max_tokens_marking << ", \"bounded\": ";
+  if (r.status == ExploreResult::Status::complete)
+    out << "true";
+  else if (r.status == ExploreResult::Status::unbounded)
+    out << "false";
+  else
+    out << "null";
+  if (r.deadlock) {
+    out << ", \"dead_trace\": ";
+    json_trace(out, net, r.dead_trace);
+    out << ", \"dead_marking\": ";
+    json_marking(out, net, r.dead_marking);
+  }
+  if (r.status == ExploreResult::Status::unbounded) {
+    out << ", \"unbounded_prefix\": ";
+    json_trace(out, net, r.unbounded_prefix);
+    out << ", \"unbounded_cycle\": ";
+    json_trace(out, net, r.unbounded_cycle);
+  }
+  if (!r.message.empty()) {
+    out << ", \"message\": ";
+    json_string(out, r.message);
+  }
+  char secs[32];
+  std::snprintf(secs, sizeof secs, "%.6f", r.seconds);
+  out << ", \"levels\": " << r.levels << ", \"bits_per_place\": " << r.bits_per_place
+      << ", \"threads\": " << r.threads << ", \"seconds\": " << secs << ", \"peak_memory\": " << r.peak_memory
+      << "}\n";
+}
+
+void write_summary(std::ostream& out, const PtNet& net, const ExploreResult& r) {
+  out << "net " << net.id() << ": " << net.place_count() << " places, " << net.transition_count()
+      << " transitions, " << net.arc_count() << " arcs\n";
+  switch (r.status) {
+    case ExploreResult::Status::complete:
+      out << "state space complete\n";
+      break;
+    case ExploreResult::Status::unbounded:
+      out << "UNBOUNDED (exploration stopped)\n";
+      break;
+    case ExploreResult::Status::memory_limit:
+      out << "INCOMPLETE: memory limit reached\n";
+      break;
+  }
+  const char* prefix = r.complete() ? "" : "at least ";
+  out << "  states (reachable markings): " << prefix << r.states << "\n"
+      << "  edges (firings):             " << prefix << r.edges << "\n"
+      << "  max tokens in one place:     " << prefix << r.max_tokens_place << "\n"
+      << "  max tokens in one marking:   " << prefix << r.max_tokens_marking << "\n"
+      << "  deadlock:                    " << (r.deadlock ? "yes" : (r.complete() ? "no" : "none found"))
+      << "\n";
+  if (r.deadlock)
+    out << "  shortest firing sequence to a dead marking (" << r.dead_trace.size() << " firings): "
+        << (r.dead_trace.empty() ? "(the initial marking is dead)" : trace_to_string(net, r.dead_trace))
+        << "\n";
+  if (!r.message.empty()) out << "  " << r.message << "\n";
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "  %u levels, %u bits per place, %u thread(s), %.3f s, peak %.1f MiB\n",
+                r.levels, r.bits_per_place, r.threads, r.seconds,
+                static_cast<double>(r.peak_memory) / (1 << 20));
+  out << buf;
+}
+
+}  // namespace vsd::soml::analysis

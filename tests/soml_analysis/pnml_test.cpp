@@ -1,0 +1,254 @@
+// PNML import and export: the MCC nets, round trips, and every kind of bad input with its line:col.
+#include "vsd/soml/analysis/pnml.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "vsd/core/error.hpp"
+#include "vsd/soml/analysis/explorer.hpp"
+
+namespace an = vsd::soml::analysis;
+using an::PtNet;
+
+namespace {
+
+const std::string kData = VSD_SOML_TEST_DATA_DIR;
+const char* const kModels[] = {
+    "ResAllocation-PT-R002C002", "Eratosthenes-PT-010", "TokenRing-PT-005", "Philosophers-PT-000005",
+    "SharedMemory-PT-000005",    "FMS-PT-00002",        "Dekker-PT-010",    "Peterson-PT-2"};
+
+std::string wrap(const std::string& page_content,
+                 const std::string& type = "http://www.pnml.org/version-2009/grammar/ptnet") {
+  return "<?xml version=\"1.0\"?>\n<pnml xmlns=\"http://www.pnml.org/version-2009/grammar/pnml\">\n<net "
+         "id=\"n\" type=\"" +
+         type + "\">\n<page id=\"pg\">\n" + page_content + "</page>\n</net>\n</pnml>\n";
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    an::read_pnml(text, "t.pnml");
+  } catch (const vsd::Error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(Pnml, MccNetsHaveTheCountsOfExpectedTsv) {
+  std::ifstream in(kData + "/expected.tsv");
+  std::string model, header;
+  std::getline(in, header);
+  std::size_t places = 0, transitions = 0, arcs = 0, rows = 0;
+  std::string rest;
+  while (in >> model >> places >> transitions >> arcs) {
+    std::getline(in, rest);
+    SCOPED_TRACE(model);
+    const an::PnmlImport imp = an::read_pnml_file(kData + "/" + model + ".pnml");
+    EXPECT_EQ(imp.net.id(), model);
+    EXPECT_EQ(imp.net.place_count(), places);
+    EXPECT_EQ(imp.net.transition_count(), transitions);
+    EXPECT_EQ(imp.net.arc_count(), arcs);
+    EXPECT_FALSE(imp.net.has_inhibitors());
+    ++rows;
+  }
+  EXPECT_EQ(rows, 8u);
+}
+
+TEST(Pnml, NamesIdsMarkingsAndWeightsAreKept) {
+  const an::PnmlImport imp = an::read_pnml_file(kData + "/FMS-PT-00002.pnml");
+  const PtNet& net = imp.net;
+  EXPECT_EQ(net.name(), "FMS-PT-00002");
+  const auto p = net.find_place("P1");
+  ASSERT_TRUE(p.has_value());
+  EXPECT_EQ(net.places()[*p].name, "P1");
+  EXPECT_EQ(net.places()[*p].initial, 2u);
+  EXPECT_TRUE(net.find_transition("tP1").has_value());
+  EXPECT_FALSE(net.find_place("tP1").has_value());
+  // The arc cId1097071320973282518114 goes P1 -> tP1.
+  const auto& t = net.transitions()[*net.find_transition("tP1")];
+  ASSERT_EQ(t.inputs.size(), 1u);
+  EXPECT_EQ(t.inputs[0].place, *p);
+  EXPECT_EQ(t.inputs[0].id, "cId1097071320973282518114");
+  EXPECT_EQ(t.inputs[0].weight, 1u);
+}
+
+TEST(Pnml, ToolSpecificBlocksAreSkippedWithANote) {
+  const an::PnmlImport imp = an::read_pnml_file(kData + "/Philosophers-PT-000005.pnml");
+  ASSERT_EQ(imp.notes.size(), 2u);  // the NUPN block, and the layout (<graphics>) of 110 elements
+  EXPECT_NE(imp.notes[0].find("Philosophers-PT-000005.pnml:"), std::string::npos);
+  EXPECT_NE(imp.notes[0].find("skipped <toolspecific tool=\"nupn\" version=\"1.1\">"), std::string::npos);
+  EXPECT_NE(imp.notes[1].find("skipped <graphics> (layout) of 110 element(s)"), std::string::npos)
+      << imp.notes[1];
+  // The position is the '<' of the element.
+  std::ifstream in(kData + "/Philosophers-PT-000005.pnml");
+  std::string line;
+  int n = 0, found = 0;
+  std::size_t col = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    if (const auto c = line.find("<toolspecific"); c != std::string::npos) {
+      found = n;
+      col = c + 1;
+    }
+  }
+  EXPECT_NE(imp.notes[0].find(":" + std::to_string(found) + ":" + std::to_string(col) + ":"),
+            std::string::npos)
+      << imp.notes[0];
+}
+
+TEST(Pnml, UnknownElementsAndGraphicsAreReported) {
+  const std::string text = wrap(
+      "<place id=\"p\"><name><text>P</text><graphics><offset x=\"0\" y=\"0\"/></graphics></name>"
+      "<graphics><position x=\"1\" y=\"2\"/></graphics><capacity><text>3</text></capacity></place>\n"
+      "<transition id=\"t\"/>\n<arc id=\"a\" source=\"p\" target=\"t\"/>\n");
+  const an::PnmlImport imp = an::read_pnml(text, "u.pnml");
+  ASSERT_EQ(imp.notes.size(), 2u);
+  EXPECT_NE(imp.notes[0].find("u.pnml:5:"), std::string::npos) << imp.notes[0];
+  EXPECT_NE(imp.notes[0].find("skipped unknown element <capacity>"), std::string::npos);
+  EXPECT_NE(imp.notes[1].find("<graphics>"), std::string::npos) << imp.notes[1];
+  EXPECT_EQ(imp.net.places()[0].name, "P");
+}
+
+TEST(Pnml, MalformedXmlGivesLineAndColumn) {
+  // Line 5 closes </net> while <place> is open.
+  const std::string text =
+      "<?xml version=\"1.0\"?>\n<pnml>\n<net id=\"n\" "
+      "type=\"http://www.pnml.org/version-2009/grammar/ptnet\">\n"
+      "  <page id=\"g\"><place id=\"p\">\n</net>\n</pnml>\n";
+  const std::string e = error_of(text);
+  EXPECT_EQ(e.rfind("t.pnml:5:", 0), 0u) << e;
+  EXPECT_NE(e.find("malformed XML"), std::string::npos) << e;
+  const std::string e2 = error_of("<pnml><net id=\"x\" type=\"y\"");
+  EXPECT_EQ(e2.rfind("t.pnml:1:", 0), 0u) << e2;
+  EXPECT_NE(error_of("").find("t.pnml:1:1:"), std::string::npos);
+}
+
+TEST(Pnml, UnsupportedNetTypesAreRefused) {
+  const std::string e = error_of(wrap("", "http://www.pnml.org/version-2009/grammar/symmetricnet"));
+  EXPECT_EQ(e.rfind("t.pnml:3:1:", 0), 0u) << e;
+  EXPECT_NE(e.find("symmetric net"), std::string::npos) << e;
+  EXPECT_NE(e.find("not supported"), std::string::npos);
+  EXPECT_NE(error_of(wrap("", "http://www.pnml.org/version-2009/grammar/highlevelnet")).find("high-level"),
+            std::string::npos);
+  EXPECT_NE(error_of(wrap("", "")).find("net type '' is not supported"), std::string::npos);
+}
+
+TEST(Pnml, StructuralErrorsNameTheElementAndPosition) {
+  EXPECT_NE(
+      error_of(
+          wrap("<place id=\"p\"/>\n<transition id=\"t\"/>\n<arc id=\"a\" source=\"p\" target=\"nope\"/>\n"))
+          .find("t.pnml:7:1: arc 'a' has unknown target 'nope'"),
+      std::string::npos);
+  EXPECT_NE(
+      error_of(wrap("<place id=\"p\"/>\n<place id=\"q\"/>\n<arc id=\"a\" source=\"p\" target=\"q\"/>\n"))
+          .find("joins two places"),
+      std::string::npos);
+  EXPECT_NE(
+      error_of(wrap("<place id=\"p\"/>\n<transition id=\"p\"/>\n")).find("t.pnml:6:1: duplicate id 'p'"),
+      std::string::npos);
+  EXPECT_NE(error_of(wrap("<place id=\"p\"><initialMarking><text>-1</text></initialMarking></place>\n"))
+                .find("initial marking '-1' is not an integer"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of(wrap("<place id=\"p\"><initialMarking><text>9999999999</text></initialMarking></place>\n"))
+          .find("is not an integer in [0, 2^32-1]"),
+      std::string::npos);
+  EXPECT_NE(error_of(wrap("<place id=\"p\"/><transition id=\"t\"/><arc id=\"a\" source=\"p\" target=\"t\">"
+                          "<inscription><text>0</text></inscription></arc>\n"))
+                .find("arc weight is 0"),
+            std::string::npos);
+  EXPECT_NE(error_of(wrap("<place/>\n")).find("<place> without an id"), std::string::npos);
+  EXPECT_NE(error_of(wrap("<place id=\"p\"/><transition id=\"t\"/><arc id=\"a\" source=\"t\" target=\"p\">"
+                          "<type value=\"inhibitor\"/></arc>\n"))
+                .find("must go from a place to a transition"),
+            std::string::npos);
+  EXPECT_NE(error_of(wrap("<place id=\"p\"/><transition id=\"t\"/><arc id=\"a\" source=\"p\" target=\"t\">"
+                          "<type value=\"reset\"/></arc>\n"))
+                .find("arc type 'reset' is not supported"),
+            std::string::npos);
+  EXPECT_NE(error_of("<foo/>").find("expected <pnml>"), std::string::npos);
+  EXPECT_NE(error_of("<pnml/>").find("holds no <net>"), std::string::npos);
+  EXPECT_NE(error_of("<pnml><net id=\"a\" type=\"x\"/><net id=\"b\" type=\"x\"/></pnml>").find("2 nets"),
+            std::string::npos);
+  EXPECT_THROW(an::read_pnml_file(kData + "/does-not-exist.pnml"), vsd::Error);
+}
+
+TEST(Pnml, ReferenceNodesNestedPagesAndParallelArcs) {
+  const std::string text = wrap(
+      "<place id=\"p\"><initialMarking><text>2</text></initialMarking></place>\n"
+      "<page id=\"inner\"><referencePlace id=\"rp\" ref=\"p\"/><referencePlace id=\"rp2\" ref=\"rp\"/>"
+      "<transition id=\"t\"/><arc id=\"a1\" source=\"rp2\" target=\"t\"/></page>\n"
+      "<arc id=\"a2\" source=\"p\" target=\"t\"/>\n");
+  const an::PnmlImport imp = an::read_pnml(text);
+  ASSERT_EQ(imp.net.transition_count(), 1u);
+  ASSERT_EQ(imp.net.transitions()[0].inputs.size(), 1u);
+  EXPECT_EQ(imp.net.transitions()[0].inputs[0].weight, 2u);  // two parallel arcs of weight 1
+  EXPECT_EQ(imp.net.transitions()[0].inputs[0].id, "a1");
+  ASSERT_EQ(imp.notes.size(), 1u);
+  EXPECT_NE(imp.notes[0].find("arc 'a2' is parallel"), std::string::npos);
+  EXPECT_NE(error_of(wrap("<referencePlace id=\"r\" ref=\"nowhere\"/>\n")).find("reference to unknown place"),
+            std::string::npos);
+  EXPECT_NE(error_of(wrap("<referencePlace id=\"r\" ref=\"s\"/><referencePlace id=\"s\" ref=\"r\"/>\n"))
+                .find("reference cycle"),
+            std::string::npos);
+}
+
+TEST(Pnml, RoundTripOfTheMccNets) {
+  for (const char* model : kModels) {
+    SCOPED_TRACE(model);
+    const an::PnmlImport first = an::read_pnml_file(kData + "/" + model + ".pnml");
+    const std::string written = an::write_pnml(first.net);
+    const an::PnmlImport second = an::read_pnml(written, "written");
+    EXPECT_TRUE(second.notes.empty());
+    EXPECT_EQ(second.net, first.net);  // ids, names, markings, arcs with ids and weights
+    EXPECT_EQ(an::write_pnml(second.net), written);
+  }
+}
+
+TEST(Pnml, RoundTripKeepsWeightsAndInhibitorsAndMakesUpMissingArcIds) {
+  PtNet net("rt", "round trip");
+  const auto p = net.add_place("p", "the place", 5);
+  const auto q = net.add_place("q");
+  const auto t = net.add_transition("t", "fire");
+  net.add_input(t, p, 3, "in");
+  net.add_output(t, q, 2);     // no id: export makes one up
+  net.add_inhibitor(t, q, 4);  // also none
+  const std::string text = an::write_pnml(net);
+  EXPECT_NE(text.find("<type value=\"inhibitor\""), std::string::npos);
+  const an::PnmlImport back = an::read_pnml(text);
+  const PtNet& n2 = back.net;
+  EXPECT_EQ(n2.id(), "rt");
+  EXPECT_EQ(n2.name(), "round trip");
+  EXPECT_EQ(n2.places()[0].name, "the place");
+  EXPECT_EQ(n2.places()[0].initial, 5u);
+  EXPECT_EQ(n2.transitions()[0].name, "fire");
+  EXPECT_EQ(n2.transitions()[0].inputs, (std::vector<an::ArcRef>{{p, 3, "in"}}));
+  ASSERT_EQ(n2.transitions()[0].outputs.size(), 1u);
+  EXPECT_EQ(n2.transitions()[0].outputs[0].weight, 2u);
+  EXPECT_FALSE(n2.transitions()[0].outputs[0].id.empty());
+  ASSERT_EQ(n2.transitions()[0].inhibitors.size(), 1u);
+  EXPECT_EQ(n2.transitions()[0].inhibitors[0].weight, 4u);
+  EXPECT_NE(n2.transitions()[0].outputs[0].id, n2.transitions()[0].inhibitors[0].id);
+  // Same state space both ways.
+  an::ExploreOptions o;
+  o.progress = an::ExploreOptions::Progress::never;
+  const auto r1 = an::explore(net, o);
+  const auto r2 = an::explore(n2, o);
+  EXPECT_EQ(r1.states, r2.states);
+  EXPECT_EQ(r1.edges, r2.edges);
+  EXPECT_EQ(r1.deadlock, r2.deadlock);
+}
+
+TEST(Pnml, WriteAndReadFiles) {
+  const auto dir = std::filesystem::temp_directory_path() / ("vsd_pnml_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const PtNet net = an::read_pnml_file(kData + "/TokenRing-PT-005.pnml").net;
+  an::write_pnml_file(net, dir / "ring.pnml");
+  EXPECT_EQ(an::read_pnml_file(dir / "ring.pnml").net, net);
+  EXPECT_THROW(an::write_pnml_file(net, dir / "missing-dir" / "x.pnml"), vsd::Error);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
