@@ -51,34 +51,50 @@ struct Local {
 };
 
 // The locals of one function, condition, action or arrow condition. Slots of a block are reused after
-// it ends; `max` is the frame size the compiler allocates.
+// it ends; `max` is the frame size the compiler allocates. Each block scope has a hash index, so a
+// function with very many locals checks in linear time.
 struct Frame {
-  std::vector<std::vector<Local>> scopes{1};
+  struct Scope {
+    std::vector<Local> locals;
+    std::unordered_map<std::string, std::size_t> index;
+  };
+  std::vector<Scope> scopes{1};
   int next = 0;
   int max = 0;
 
   void push() { scopes.emplace_back(); }
   void pop() {
-    next -= static_cast<int>(scopes.back().size());
+    next -= static_cast<int>(scopes.back().locals.size());
     scopes.pop_back();
   }
-  const Local* find(std::string_view name) const {
+  const Local* find(const std::string& name) const {
     for (auto s = scopes.rbegin(); s != scopes.rend(); ++s)
-      for (const Local& l : *s)
-        if (l.name == name) return &l;
+      if (auto it = s->index.find(name); it != s->index.end()) return &s->locals[it->second];
     return nullptr;
   }
-  const Local* find_innermost(std::string_view name) const {
-    for (const Local& l : scopes.back())
-      if (l.name == name) return &l;
-    return nullptr;
+  const Local* find_innermost(const std::string& name) const {
+    const Scope& s = scopes.back();
+    auto it = s.index.find(name);
+    return it == s.index.end() ? nullptr : &s.locals[it->second];
   }
   int add(std::string name, Type type, SourceLoc loc) {
-    scopes.back().push_back({std::move(name), type, next, loc});
+    Scope& s = scopes.back();
+    s.index.emplace(name, s.locals.size());  // a duplicate keeps finding the first one
+    s.locals.push_back({std::move(name), type, next, loc});
     max = std::max(max, ++next);
     return next - 1;
   }
 };
+
+// Calls report(i, j) for each name i that equals an earlier name j (enum values, parameters); linear.
+template <class NameOf, class Report>
+void for_each_duplicate(std::size_t n, NameOf name_of, Report report) {
+  std::unordered_map<std::string, std::size_t> first;
+  for (std::size_t i = 0; i < n; ++i) {
+    auto [it, inserted] = first.emplace(name_of(i), i);
+    if (!inserted) report(i, it->second);
+  }
+}
 
 enum class Body { Initializer, Function, Condition, Action, ArrowCondition, Argument };
 
@@ -261,14 +277,13 @@ void CheckerImpl::declare(ScopeDecl& s) {
         break;
       case DeclKind::Enum: {
         auto& e = d.as<EnumDecl>();
-        for (std::size_t i = 0; i < e.values.size(); ++i)
-          for (std::size_t j = 0; j < i; ++j)
-            if (e.values[i] == e.values[j]) {
+        for_each_duplicate(
+            e.values.size(), [&](std::size_t i) { return e.values[i]; },
+            [&](std::size_t i, std::size_t j) {
               diag_.error(e.value_locs[i], "duplicate definition of " + q(e.values[i]) + " in enum " +
                                                q(e.name) + " (first defined at line " +
                                                std::to_string(e.value_locs[j].line) + ")");
-              break;
-            }
+            });
         break;
       }
       default:
@@ -524,11 +539,14 @@ void CheckerImpl::resolve_signatures() {
           p.type = Type::error();
         }
       }
-      for (std::size_t j = 0; j < i; ++j)
-        if (f->params[j].name == p.name)
-          diag_.error(p.loc, "duplicate definition of parameter " + q(p.name) + " (first defined at line " +
-                                 std::to_string(f->params[j].loc.line) + ")");
     }
+    for_each_duplicate(
+        f->params.size(), [&](std::size_t i) { return f->params[i].name; },
+        [&](std::size_t i, std::size_t j) {
+          diag_.error(f->params[i].loc, "duplicate definition of parameter " + q(f->params[i].name) +
+                                            " (first defined at line " +
+                                            std::to_string(f->params[j].loc.line) + ")");
+        });
   }
   for (FunctionDecl* f : functions_) check_override(*f);
   for (PlaceDecl* p : places_) {
@@ -581,12 +599,7 @@ void CheckerImpl::resolve_net(ClassDecl& n) {
   if (n.is_port_net && n.result_type.kind != K::Void && !n.result_type.is_error())
     diag_.error(n.result.loc,
                 "net " + q(n.name) + " has port places, so it substitutes a transition and has no result");
-  for (std::size_t i = 0; i < n.params.size(); ++i)
-    for (std::size_t j = 0; j < i; ++j)
-      if (n.params[j].name == n.params[i].name)
-        diag_.error(n.params[i].loc, "duplicate definition of parameter " + q(n.params[i].name) +
-                                         " (first defined at line " + std::to_string(n.params[j].loc.line) +
-                                         ")");
+  // Duplicate parameter names are reported by declare(): each parameter is a member of the net.
 }
 
 // Resolves the path of an arrow end or a start place; `role` starts the messages ("arrow from").

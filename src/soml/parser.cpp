@@ -140,8 +140,10 @@ std::string_view Decl::kind_name() const noexcept {
 class Parser::DepthGuard {
  public:
   explicit DepthGuard(Parser& p) : p_(p) {
-    if (++p_.depth_ > max_depth)
-      p_.fail(p_.peek(), "nesting is too deep (more than " + std::to_string(max_depth) + " levels)");
+    if (++p_.depth_ > max_depth) {
+      --p_.depth_;  // the destructor of a guard whose constructor throws does not run
+      p_.too_deep(p_.peek());
+    }
   }
   ~DepthGuard() { --p_.depth_; }
   DepthGuard(const DepthGuard&) = delete;
@@ -192,6 +194,27 @@ const Token& Parser::expect(TokenKind k, const char* what) {
 
 void Parser::fail(const Token& at, const std::string& message) {
   diag_.error(at.loc, message);
+  throw Abort{};
+}
+
+// Reports nesting beyond max_depth once, then skips the rest of the deep region (up to the bracket, ';'
+// or end that closes the level where it was found) so that recovery costs one exception, not one per
+// remaining level.
+void Parser::too_deep(const Token& at) {
+  diag_.error(at.loc, "nesting is too deep (more than " + std::to_string(max_depth) + " levels)");
+  int balance = 0;
+  while (!check(TokenKind::Eof)) {
+    const TokenKind k = peek().kind;
+    if (k == TokenKind::LParen || k == TokenKind::LBrace || k == TokenKind::LBracket) {
+      ++balance;
+    } else if (k == TokenKind::RParen || k == TokenKind::RBrace || k == TokenKind::RBracket) {
+      if (balance == 0) break;
+      --balance;
+    } else if (k == TokenKind::Semicolon && balance == 0) {
+      break;
+    }
+    advance();
+  }
   throw Abort{};
 }
 
@@ -271,9 +294,11 @@ Script Parser::parse_script() {
 void Parser::parse_members(ScopeDecl& scope, bool braced) {
   for (;;) {
     if (check(TokenKind::Eof)) {
-      if (braced)
+      // Only the innermost unclosed body is reported: the ones around it end for the same reason.
+      if (braced && !eof_reported_)
         diag_.error(peek().loc, "expected '}' to close " + std::string(scope.kind_name()) + " '" +
                                     scope.name + "', found end of file");
+      eof_reported_ = true;
       return;
     }
     if (check(TokenKind::RBrace)) {
@@ -712,8 +737,10 @@ std::unique_ptr<BlockStmt> Parser::parse_block() {
   for (;;) {
     if (match(TokenKind::RBrace)) return block;
     if (check(TokenKind::Eof)) {
-      diag_.error(peek().loc, "expected '}' to close the block opened at line " +
-                                  std::to_string(open.loc.line) + ", found end of file");
+      if (!eof_reported_)
+        diag_.error(peek().loc, "expected '}' to close the block opened at line " +
+                                    std::to_string(open.loc.line) + ", found end of file");
+      eof_reported_ = true;
       return block;
     }
     const std::size_t before = pos_;
@@ -864,7 +891,7 @@ ExprPtr Parser::parse_prefix() {
     case TokenKind::String: {
       advance();
       auto e = std::make_unique<LiteralExpr>(ExprKind::String, t.loc);
-      e->string_value = t.string_value;
+      e->string_value = decode_string_literal(t.text);
       return e;
     }
     case TokenKind::KwTrue:
@@ -935,8 +962,7 @@ ExprPtr Parser::parse_expr(int min_precedence) {
     if (prec == PrecNone || prec < min_precedence) return left;
     ++depth_;
     ++chain.n;
-    if (depth_ > max_depth)
-      fail(op, "nesting is too deep (more than " + std::to_string(max_depth) + " levels)");
+    if (depth_ > max_depth) too_deep(op);
     advance();
     switch (op.kind) {
       case TokenKind::Equal:

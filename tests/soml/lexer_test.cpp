@@ -53,8 +53,8 @@ TEST(Lexer, ReadsNumbersAndStrings) {
   EXPECT_DOUBLE_EQ(l.tokens[3].float_value, 0.5);
   EXPECT_DOUBLE_EQ(l.tokens[4].float_value, 2e-3);
   EXPECT_EQ(l.tokens[5].kind, TokenKind::Float);
-  EXPECT_EQ(l.tokens[6].string_value, "a\tb\"c\\");
-  EXPECT_EQ(l.tokens[7].string_value, "µm");
+  EXPECT_EQ(vsd::soml::decode_string_literal(l.tokens[6].text), "a\tb\"c\\");
+  EXPECT_EQ(vsd::soml::decode_string_literal(l.tokens[7].text), "µm");
   EXPECT_FALSE(l.diag.has_errors()) << l.diag.format();
 }
 
@@ -99,6 +99,14 @@ TEST(Lexer, RejectsInvalidUtf8AndNulBytes) {
   // The rendering never prints the raw NUL or control bytes.
   EXPECT_EQ(out.find('\0'), std::string::npos);
   EXPECT_EQ(l.tokens.back().kind, TokenKind::Eof);
+}
+
+TEST(Lexer, StringsEndingInABackslashAtTheEndOfTheText) {
+  for (const char* text : {"\"abc\\", "\"\\", "\"", "x = \"a\\\n"}) {
+    Lexed l(text);
+    EXPECT_THAT(l.diag.format(), HasSubstr("unterminated string")) << text;
+    EXPECT_EQ(l.tokens.back().kind, TokenKind::Eof);
+  }
 }
 
 TEST(Diagnostics, FormatShowsTheLineAndACaret) {

@@ -179,6 +179,7 @@ TEST(Parser, DeepNestingIsAnErrorNotACrash) {
     text += open == "{" ? "" : "; }";
     Parsed p(text);
     EXPECT_THAT(p.diag.format(), HasSubstr("nesting is too deep")) << open;
+    EXPECT_EQ(p.diag.error_count(), 1u) << p.diag.format();  // the deep region is skipped, not re-reported
   }
   Parsed unary("int x = " + std::string(100000, '-') + "1;");
   EXPECT_THAT(unary.diag.format(), HasSubstr("nesting is too deep"));
@@ -190,6 +191,7 @@ TEST(Parser, DeepNestingIsAnErrorNotACrash) {
   for (int i = 0; i < 10000; ++i) classes += "class C {";
   Parsed nested_classes(classes);
   EXPECT_THAT(nested_classes.diag.format(), HasSubstr("nesting is too deep"));
+  EXPECT_EQ(nested_classes.diag.error_count(), 2u) << "the depth, and one missing '}' at the end";
   std::string types = "vector<";
   for (int i = 0; i < 10000; ++i) types += "vector<";
   Parsed nested_types(types + "int> x;");

@@ -107,8 +107,13 @@ struct Token {
   std::string_view text;
   std::int64_t int_value = 0;  ///< Int
   double float_value = 0.0;    ///< Float
-  std::string string_value;    ///< String: the value with escapes resolved
+  // A String's value is not stored: tokens stay small (a big script has hundreds of thousands), and
+  // decode_string_literal() makes it from `text` when the parser needs it.
 };
+
+/// @brief The value of a string literal token's text (escapes resolved, invalid bytes dropped; the
+/// lexer has reported any problem already).
+[[nodiscard]] std::string decode_string_literal(std::string_view token_text);
 
 /// @brief Splits a Source into tokens.
 class Lexer {
@@ -131,8 +136,6 @@ class Lexer {
   }
   [[nodiscard]] bool at_end() const noexcept { return pos_ >= text().size(); }
   [[nodiscard]] const std::string& text() const noexcept { return source_.text(); }
-  // Length of a valid UTF-8 sequence at @p at, or 0 when the bytes there are not valid UTF-8.
-  [[nodiscard]] std::size_t utf8_length(std::size_t at) const noexcept;
 
   const Source& source_;
   Diagnostics& diag_;

@@ -44,6 +44,7 @@ class Parser {
   const Token& advance();
   const Token& expect(TokenKind k, const char* what);
   [[noreturn]] void fail(const Token& at, const std::string& message);
+  [[noreturn]] void too_deep(const Token& at);
   void sync_member();
   void sync_statement();
 
@@ -81,6 +82,7 @@ class Parser {
   Diagnostics& diag_;
   std::size_t pos_ = 0;
   int depth_ = 0;
+  bool eof_reported_ = false;  // a missing '}' at the end is reported once, not once per open body
 };
 
 }  // namespace vsd::soml
