@@ -1,6 +1,8 @@
 // The program each consumer project builds (find_package/, add_subdirectory/, fetch_content/): vsd's
-// public headers, an Environment with a Node, and a snapshot round trip through vsd::io.
+// public headers, an Environment with a Node, a snapshot round trip through vsd::io, and a SOML++ script
+// checked by vsd::soml.
 #include <vsd/io.hpp>
+#include <vsd/soml.hpp>
 #include <vsd/vsd.hpp>
 
 int main() {
@@ -11,5 +13,6 @@ int main() {
   state.database().add_child(n);
   auto& copy = env.create_state("copy");
   vsd::io::load_bytes(copy, vsd::io::save_bytes(state));
-  return n.name() == "hello" && copy.equals(state) ? 0 : 1;
+  const auto script = vsd::soml::check_source("consumer.soml", "class A : Node { int x = 1; }");
+  return n.name() == "hello" && copy.equals(state) && script->ok() ? 0 : 1;
 }

@@ -19,6 +19,5 @@ struct Script;
 class Parser;
 struct Type;
 struct Binding;
-class Checker;
 struct CheckResult;
 }  // namespace vsd::soml
