@@ -990,10 +990,36 @@ Type CheckerImpl::check_value(Expr& e, Context& cx) {
   Type t = check_expr(e, cx);
   if (t.is_value()) return t;
   if (t.kind == K::Null) return t;
-  std::string what = t.kind == K::Void ? "has no value (void)" : "is a " + t.name() + ", not a value";
-  if (t.kind == K::Function) what = "is a function; call it with '(...)'";
-  if (t.kind == K::Place && t.decl != nullptr)
-    what = "is place " + q(t.decl->name) + ", not a value (read its tokens with '.count')";
+  std::string what;
+  switch (t.kind) {
+    case K::Void:
+      what = "has no value (void)";
+      break;
+    case K::Function:
+      what = "is a function; call it with '(...)'";
+      break;
+    case K::Place:
+      what = "is place " + q(t.decl->name) + ", not a value (read its tokens with '.count')";
+      break;
+    case K::Transition:
+      what = "is transition " + q(t.decl->name) + ", not a value";
+      break;
+    case K::Net:
+      what = "is net " + q(t.decl->name) + ", not a value (invoke it from a transition)";
+      break;
+    case K::Class: {
+      const bool is_enum = t.enum_decl != nullptr || t.meta != nullptr;
+      const std::string n = t.enum_decl != nullptr ? t.enum_decl->name
+                            : t.meta != nullptr    ? t.meta->name()
+                                                   : t.cls.name();
+      what = is_enum ? "is enum " + q(n) + ", not a value (write " + n + "::Value)"
+                     : "is class " + q(n) + ", not a value";
+      break;
+    }
+    default:
+      what = "is a " + t.name() + ", not a value";
+      break;
+  }
   diag_.error(e.loc, "expression " + what);
   e.type = Type::error();
   return Type::error();

@@ -113,6 +113,8 @@ std::string Type::name() const {
     case Kind::Transition:
       return "transition";
     case Kind::Class:
+      if (enum_decl != nullptr) return "enum " + enum_decl->name;
+      if (meta != nullptr) return "enum " + meta->name();
       return "class " + cls.name();
     case Kind::Net:
       return "net";

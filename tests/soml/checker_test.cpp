@@ -14,6 +14,9 @@ using namespace vsd::soml;
 
 namespace {
 
+enum class TestMode { Slow, Fast };
+VSD_ENUM(TestMode, Slow, Fast)
+
 // A built-in class only this test knows: the checker must find it, its properties and methods, in the
 // registry it is given.
 class TestRobot : public vsd::Node {
@@ -21,6 +24,7 @@ class TestRobot : public vsd::Node {
   VSD_PROPERTY(double, speed, 1.0)
   VSD_PROPERTY(std::int32_t, axes, 6)
   VSD_PROPERTY(std::string, serial, "", vsd::ReadOnly)
+  VSD_PROPERTY(TestMode, mode, TestMode::Slow)
  public:
   double scaled(double f) { return speed() * f; }
   VSD_METHOD(scaled)
@@ -81,6 +85,18 @@ TEST(Checker, ReadOnlyAndWrongMethodArgumentsAreErrors) {
   EXPECT_THAT(out, HasSubstr("argument 1 of method 'scaled' of 'TestRobot' must be 'double', not 'string'"));
   EXPECT_THAT(out, HasSubstr("wrong number of arguments: method 'scaled' of 'TestRobot' takes 1, 0 given"));
   EXPECT_EQ(r->diagnostics.error_count(), 3u);
+}
+
+TEST(Checker, EnumsOfTheRegistryByName) {
+  auto good =
+      check("void f(ref<TestRobot> t) { t.mode = TestMode::Fast; bool slow = t.mode == TestMode::Slow; }");
+  EXPECT_TRUE(good->ok()) << good->diagnostics.format();
+  auto bad = check("void f(ref<TestRobot> t) { t.mode = 1; t.mode = TestMode::Nope; int m = TestMode; }");
+  const std::string out = bad->diagnostics.format();
+  EXPECT_THAT(out, HasSubstr("cannot assign 'int' to 'TestMode'"));
+  EXPECT_THAT(out, HasSubstr("enum 'TestMode' has no value 'Nope'"));
+  EXPECT_THAT(out, HasSubstr("expression is enum 'TestMode', not a value (write TestMode::Value)"));
+  EXPECT_EQ(bad->diagnostics.error_count(), 3u) << out;
 }
 
 TEST(Checker, NumbersLocalsIntoReusedSlots) {
