@@ -1,7 +1,10 @@
 // The program each consumer project builds (find_package/, add_subdirectory/, fetch_content/): vsd's
 // public headers, an Environment with a Node, and a snapshot round trip through vsd::io; with
-// vsd::soml_analysis, a net through PNML and the explorer.
+// vsd::soml, a SOML++ script checked; with vsd::soml_analysis, a net through PNML and the explorer.
 #include <vsd/io.hpp>
+#ifdef CONSUMER_HAS_SOML
+#include <vsd/soml.hpp>
+#endif
 #include <vsd/vsd.hpp>
 #ifdef CONSUMER_HAS_SOML_ANALYSIS
 #include <vsd/soml_analysis.hpp>
@@ -22,6 +25,10 @@ int main() {
   net.add_input(t, p);
   const auto back = vsd::soml::analysis::read_pnml(vsd::soml::analysis::write_pnml(net));
   if (vsd::soml::analysis::explore(back.net).states != 3) return 1;
+#endif
+#ifdef CONSUMER_HAS_SOML
+  const auto script = vsd::soml::check_source("consumer.soml", "class A : Node { int x = 1; }");
+  if (!script->ok()) return 1;
 #endif
   return n.name() == "hello" && copy.equals(state) ? 0 : 1;
 }

@@ -1,0 +1,12 @@
+/** @file
+ *  @brief vsd::soml: the SOML++ language (link vsd::soml). See docs/soml.md.
+ */
+#pragma once
+
+#include "vsd/soml/ast.hpp"
+#include "vsd/soml/checker.hpp"
+#include "vsd/soml/fwd.hpp"
+#include "vsd/soml/lexer.hpp"
+#include "vsd/soml/parser.hpp"
+#include "vsd/soml/source.hpp"
+#include "vsd/soml/types.hpp"
