@@ -12,6 +12,9 @@ PACKAGES=(
   cmake
   g++
   libeigen3-dev
+  # vsd::scene: URDF and mesh loading
+  liburdfdom-dev
+  libassimp-dev
   # tests and benchmarks
   libgtest-dev
   libgmock-dev
