@@ -2,6 +2,7 @@
 #include "vsd/scene/urdf_loader.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstring>
 #include <filesystem>
