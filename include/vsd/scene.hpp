@@ -4,6 +4,7 @@
  */
 #pragma once
 
+#include "vsd/core.hpp"
 #include "vsd/scene/fwd.hpp"
 #include "vsd/scene/geometry.hpp"
 #include "vsd/scene/hull.hpp"
