@@ -152,6 +152,23 @@ TEST_F(Node3DTest, ReparentingMovesTheWorldFrame) {
   EXPECT_GT(a.nodes[7]->world_frame().translation().x(), 90.0);
 }
 
+TEST_F(Node3DTest, DeletingNodesWithCleanCachesIsSafe) {
+  Chain c(s, 12);
+  expect_all_correct(c);
+  // Deleting a middle node deletes its subtree (nothing else holds it); the rest stays correct and clean.
+  const Id leaf_id = c.nodes.back()->id();
+  s.destroy(*c.nodes[6]);
+  EXPECT_EQ(s.find(leaf_id), nullptr);
+  c.nodes.resize(6);
+  c.siblings.resize(7);  // sibling 6 hung off node 5, which survives
+  for (const Node3D* n : c.nodes) EXPECT_TRUE(n->world_frame_clean());
+  expect_all_correct(c);
+  c.nodes[0]->set_frame(step(4, 4));
+  expect_all_correct(c);
+  s.destroy(*c.nodes[0]);
+  EXPECT_EQ(s.size(), 2u);  // the Database and the top-level sibling
+}
+
 TEST_F(Node3DTest, PlainNodesInBetweenAreTransparent) {
   Node3D& top = s.create<Node3D>();
   s.database().add_child(top);

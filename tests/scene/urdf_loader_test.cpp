@@ -132,6 +132,39 @@ TEST_F(UrdfTest, StlAsciiBinaryAndObjGiveTheCube) {
   }
 }
 
+// A COLLADA file (what URDFs use for visual meshes): a tetrahedron in a node moved by 10 along x.
+const char* collada_tetrahedron = R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Z_UP</up_axis></asset>
+  <library_geometries>
+    <geometry id="tet" name="tet"><mesh>
+      <source id="tet-pos"><float_array id="tet-pos-array" count="12">0 0 0 1 0 0 0 1 0 0 0 1</float_array>
+        <technique_common><accessor source="#tet-pos-array" count="4" stride="3">
+          <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+        </accessor></technique_common></source>
+      <vertices id="tet-vtx"><input semantic="POSITION" source="#tet-pos"/></vertices>
+      <triangles count="4"><input semantic="VERTEX" source="#tet-vtx" offset="0"/><p>0 2 1 0 1 3 0 3 2 1 2 3</p></triangles>
+    </mesh></geometry>
+  </library_geometries>
+  <library_visual_scenes>
+    <visual_scene id="scene"><node id="n"><translate>10 0 0</translate><instance_geometry url="#tet"/></node></visual_scene>
+  </library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+)";
+
+TEST_F(UrdfTest, ColladaMeshWithNodeTransform) {
+  TempDir dir;
+  write(dir.path() / "tet.dae", collada_tetrahedron);
+  Geometry& g = s.create<Geometry>();
+  load_mesh(g, dir.path() / "tet.dae");
+  EXPECT_EQ(g.vertices().size(), 4u);
+  EXPECT_EQ(g.facet_count(), 4u);
+  double min_x = 1e9;
+  for (const auto& v : g.vertices()) min_x = std::min(min_x, v.x());
+  EXPECT_NEAR(min_x, 10.0, 1e-9);  // the node's transform is baked in
+}
+
 TEST_F(UrdfTest, BadMeshFilesAreErrorsNamingTheFile) {
   TempDir dir;
   Geometry& g = s.create<Geometry>();
