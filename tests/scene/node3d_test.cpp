@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "vsd/core.hpp"
+#include "vsd/io.hpp"
 #include "vsd/scene.hpp"
 
 namespace vsd::scene {
@@ -167,6 +168,55 @@ TEST_F(Node3DTest, DeletingNodesWithCleanCachesIsSafe) {
   expect_all_correct(c);
   s.destroy(*c.nodes[0]);
   EXPECT_EQ(s.size(), 2u);  // the Database and the top-level sibling
+}
+
+TEST_F(Node3DTest, UndoAndLoadingUnderANodeKeepWorldFramesCurrent) {
+  Chain c(s, 6);
+  expect_all_correct(c);
+  const Eigen::Isometry3d before = c.nodes[5]->world_frame();
+  s.start_recording();
+  c.nodes[2]->set_frame(step(8, 0.9));
+  c.nodes[4]->set_frame(step(-2, 0.1));
+  const Transaction t = s.stop_recording();
+  EXPECT_FALSE(c.nodes[5]->world_frame().isApprox(before));
+  s.apply(t.inverted());  // undo
+  EXPECT_TRUE(c.nodes[5]->world_frame().isApprox(before, 1e-12));
+  expect_all_correct(c);
+  // A subtree saved and loaded under a moved Node3D of the same state hangs below it.
+  const auto bytes = io::save_bytes(*c.nodes[3], io::Format::Binary);
+  Node3D& anchor = s.create<Node3D>();
+  anchor.set_frame(step(50, 0));
+  s.database().add_child(anchor);
+  (void)anchor.world_frame();
+  const io::LoadReport r = io::load_bytes(anchor, bytes);
+  ASSERT_EQ(r.roots.size(), 1u);
+  auto* loaded = r.roots[0]->as<Node3D>();
+  ASSERT_NE(loaded, nullptr);
+  EXPECT_TRUE(loaded->world_frame().isApprox(anchor.frame() * c.nodes[3]->frame(), 1e-12));
+  loaded->visit([&](Node& n) {
+    if (auto* n3 = n.as<Node3D>()) {
+      EXPECT_TRUE(n3->world_frame().isApprox(expected_world(*n3), 1e-12));
+    }
+  });
+}
+
+TEST_F(Node3DTest, DeletedGeometryNullsTheHullsThatShareIt) {
+  Hull& a = s.create<Hull>();
+  Hull& b = s.create<Hull>();
+  s.database().add_child(a);
+  s.database().add_child(b);
+  Geometry& g = s.create<Geometry>();
+  g.set_kind(GeometryKind::Capsule);
+  a.set_geometry(&g);
+  b.set_geometry(&g);
+  int changes = 0;
+  Connection watch = b.on_changed().connect([&](SimStateInstance&, const MetaProperty& p) {
+    if (p.name() == "geometry") ++changes;
+  });
+  s.destroy(g);
+  EXPECT_EQ(a.geometry().get(), nullptr);
+  EXPECT_EQ(b.geometry().get(), nullptr);
+  EXPECT_EQ(changes, 1);  // a collision module following the hull hears of it
 }
 
 TEST_F(Node3DTest, PlainNodesInBetweenAreTransparent) {
