@@ -14,6 +14,9 @@ PACKAGES=(
   libeigen3-dev
   # vsd::soml_analysis: the PNML reader's XML parser (the module is skipped without it)
   libpugixml-dev
+  # vsd::scene: URDF and mesh loading
+  liburdfdom-dev
+  libassimp-dev
   # tests and benchmarks
   libgtest-dev
   libgmock-dev

@@ -1,0 +1,31 @@
+#include "vsd/scene/module.hpp"
+
+#include "vsd/core/registry.hpp"
+#include "vsd/scene/geometry.hpp"
+#include "vsd/scene/hull.hpp"
+#include "vsd/scene/joint.hpp"
+#include "vsd/scene/link.hpp"
+#include "vsd/scene/material.hpp"
+#include "vsd/scene/node3d.hpp"
+#include "vsd/scene/scene.hpp"
+#include "vsd/scene/texture_map.hpp"
+
+namespace vsd::scene {
+
+void Module::register_types(vsd::Registry& registry) {
+  registry.add_type<GeometryKind>();
+  registry.add_type<MapFunction>();
+  registry.add_type<HullRole>();
+  registry.add_type<JointType>();
+  registry.add_type<std::vector<Eigen::Vector2d>>();
+  registry.add<Node3D>();
+  registry.add<Geometry>();
+  registry.add<TextureMap>();
+  registry.add<Material>();
+  registry.add<Hull>();
+  registry.add<Link>();
+  registry.add<Joint>();
+  registry.add<Scene>();
+}
+
+}  // namespace vsd::scene

@@ -1,0 +1,102 @@
+// Node3D world frames: the lazy cache and the per-SimState listeners that keep it honest.
+#include "vsd/scene/node3d.hpp"
+
+#include <mutex>
+#include <unordered_map>
+#include <vector>
+
+#include "vsd/core/sim_state.hpp"
+
+namespace vsd::scene {
+
+namespace {
+
+// One listener set per SimState. The map is keyed by address; an entry whose signal is gone (its SimState
+// was destroyed) is recognised by its dead connection and replaced when the address is reused.
+// Guarded by a mutex because SimStates of different threads share it; a node asks only once (tracked_).
+std::mutex tracking_mutex;
+std::unordered_map<const SimState*, Connection>& tracked_states() {
+  static auto* map = new std::unordered_map<const SimState*, Connection>();  // outlives every static user
+  return *map;
+}
+
+void on_node3d_changed(SimStateInstance& inst, const MetaProperty& p) {
+  // The property objects of subclasses are the base's, but compare the name too for run-time subclasses.
+  if (&p == &Node3D::vsd_prop_frame() || p.name() == "frame")
+    Node3D::invalidate_below(static_cast<Node3D&>(inst));
+}
+
+void on_reparented(vsd::Node& /*parent*/, vsd::Node& child) { Node3D::invalidate_below(child); }
+
+void ensure_tracking(SimState& state) {
+  std::lock_guard lock(tracking_mutex);
+  auto& map = tracked_states();
+  auto it = map.find(&state);
+  if (it != map.end() && it->second.connected()) return;
+  // Listeners that need no context: they live as long as the SimState's signals (release()).
+  state.on_child_added().connect(&on_reparented).release();
+  state.on_child_removed().connect(&on_reparented).release();
+  map[&state] = state.on_property_changed(Node3D::static_meta(), true).connect(&on_node3d_changed);
+}
+
+}  // namespace
+
+Node3D* Node3D::frame_parent() const noexcept {
+  for (vsd::Node* p = parent(); p != nullptr; p = p->parent())
+    if (auto* n = p->as<Node3D>()) return n;
+  return nullptr;
+}
+
+void Node3D::invalidate_below(vsd::Node& node) {
+  // Iterative: trees may be deeper than the stack. A dirty Node3D has only dirty Node3Ds below it (a clean
+  // node's frame parent is always clean), so the walk stops there.
+  std::vector<vsd::Node*> todo{&node};
+  while (!todo.empty()) {
+    vsd::Node* n = todo.back();
+    todo.pop_back();
+    if (auto* n3 = n->as<Node3D>()) {
+      if (!n3->world_clean_) continue;
+      n3->world_clean_ = false;
+    }
+    for (vsd::Node* c : n->children()) todo.push_back(c);
+  }
+}
+
+const Eigen::Isometry3d& Node3D::update_world_frame() const {
+  // The dirty chain from this node up to the first clean ancestor (or the top), then top-down.
+  std::vector<const Node3D*> chain;
+  const Node3D* top_parent = nullptr;
+  for (const Node3D* n = this; n != nullptr; n = n->frame_parent()) {
+    if (n->world_clean_) {
+      top_parent = n;
+      break;
+    }
+    chain.push_back(n);
+  }
+  if (!tracked_) {
+    // Before any cache of this SimState becomes clean, its listeners must exist.
+    ensure_tracking(state());
+    for (const Node3D* n : chain) n->tracked_ = true;
+  }
+  const Eigen::Isometry3d* above = top_parent != nullptr ? &top_parent->world_ : nullptr;
+  for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+    const Node3D& n = **it;
+    if (above != nullptr) {
+      n.world_ = *above * n.frame_;
+    } else {
+      n.world_ = n.frame_;
+    }
+    n.world_.makeAffine();
+    ++n.world_updates_;
+    n.world_clean_ = true;
+    above = &n.world_;
+  }
+  return world_;
+}
+
+void Node3D::set_world_frame(const Eigen::Isometry3d& world) {
+  const Node3D* p = frame_parent();
+  set_frame(p != nullptr ? Eigen::Isometry3d(p->world_frame().inverse() * world) : world);
+}
+
+}  // namespace vsd::scene
