@@ -61,11 +61,16 @@ struct LoadReport {
   Format format = Format::Binary;
   bool subtree = false;
   std::size_t instances = 0;
-  /// The nodes that were top level in the file (the subtree root, or the Database's children), now
-  /// attached to the target.
+  /// The format version of the file.
+  int version = 1;
+  /// The nodes that were top level in the file, now attached to the target: the Database's children in a
+  /// state file (its "top" must list the same nodes), or the nodes "top" names in a subtree file or in a
+  /// state file without a Database.
   std::vector<Node*> roots;
   /// Run-time classes the file defined that this program did not know.
   std::vector<std::string> defined_classes;
+  /// Run-time value types (enums, flags, structs) the file defined that this program did not know.
+  std::vector<std::string> defined_types;
   /// Schema differences found and handled: unknown properties, changed types.
   std::vector<std::string> warnings;
 };
@@ -80,8 +85,8 @@ std::vector<std::uint8_t> save_bytes(const Node& root, Format format = Format::B
 /// @brief Loads a whole-state file (either format) into @p state, which must be empty; ids are kept.
 LoadReport load_bytes(SimState& state, std::span<const std::uint8_t> bytes,
                       std::string_view origin = "snapshot");
-/// @brief Loads a file (either format) under @p parent; instances get fresh ids of @p parent's Environment. The
-/// file's Database stands for @p parent: its children become @p parent's, references to it point at
+/// @brief Loads a file (either format) under @p parent; instances get fresh ids of @p parent's Environment.
+/// The file's Database stands for @p parent: its children become @p parent's, references to it point at
 /// @p parent, and its own values are not copied.
 LoadReport load_bytes(Node& parent, std::span<const std::uint8_t> bytes,
                       std::string_view origin = "snapshot");
