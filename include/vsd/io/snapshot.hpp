@@ -3,17 +3,19 @@
  *  one, as a readable text file or a compact binary snapshot.
  *
  *  What is written is decided by the meta-information: every Savable, non-Transient property of every
- *  instance, references by id, and the definitions of the run-time classes the instances use (so a
- *  program that never defined them can load the file, inspect it and save it again unchanged).
+ *  instance, references by id, and the definitions of the run-time classes and run-time value types
+ *  (EnumBuilder, StructBuilder) the instances use (so a program that never defined them can load the
+ *  file, inspect it and save it again unchanged). Classes are named by their full names ("scene::Hull").
  *
- *  Two formats, one API; a load recognises the format by the file's first bytes:
- *  - Format::Text, "vsd-text" version 1: JSON (RFC 8259), one instance per object and one property per
- *    line so that it diffs well; each value is its type's text form (MetaType::write_text). Errors say
- *    line:col. See docs/file-formats.md.
- *  - Format::Binary, "VSDS" version 1: a class table (name, run-time definition if any, the saved
- *    properties by name and type name), then the instances (id, class, one length-framed value per saved
- *    property in each property type's binary form), then the top-level node ids. Errors say the byte
- *    offset.
+ *  Two formats, one API; a load recognises the format by the file's first bytes. Each has versions 1 and
+ *  2 (2 adds the run-time types); a save writes 2 only when the file carries run-time types:
+ *  - Format::Text, "vsd-text": JSON (RFC 8259), one instance per object and one property per line so
+ *    that it diffs well; each value is its type's text form (MetaType::write_text). Errors say line:col.
+ *    See docs/file-formats.md.
+ *  - Format::Binary, "VSDS": a type table (version 2), a class table (name, run-time definition if any,
+ *    the saved properties by name and type name), then the instances (id, class, one length-framed value
+ *    per saved property in each property type's binary form), then the top-level node ids. Errors say
+ *    the byte offset.
  *
  *  Loading is all or nothing: the file is read and checked into a Transaction bundle, which the target
  *  SimState checks again (ids, classes, values, reference targets, list positions, composite cycles)
