@@ -190,6 +190,20 @@ TEST(RuntimeTypes, RunTimeClassesUseThem) {
               ThrowsMessage<vsd::Error>(HasSubstr("not a run-time type")));
 }
 
+// A registry that goes away takes its run-time classes first, then the types their defaults use.
+TEST(RuntimeTypes, ARegistryOwnsItsTypes) {
+  auto r = std::make_unique<vsd::Registry>();
+  const vsd::MetaType& tag = vsd::StructBuilder("Tag").field<std::string>("s").define(*r);
+  vsd::ClassBuilder("Holder", vsd::Node::static_meta())
+      .property("tag", tag, vsd::Value::from_text(tag, "{\"s\": \"a text too long to be stored inline\"}"))
+      .property("tags", r->get_type("vector<Tag>"),
+                vsd::Value::from_text(r->get_type("vector<Tag>"), "[{\"s\": \"x\"}]"))
+      .define(*r);
+  EXPECT_TRUE(r->owns(tag));
+  EXPECT_FALSE(r->owns(vsd::meta_type<double>()));
+  r.reset();  // (the sanitizers check that nothing is used after it is freed)
+}
+
 TEST(RuntimeTypes, BuildersCheckWhatTheyAreGiven) {
   vsd::Registry r;
   auto error = [](auto&& build) {

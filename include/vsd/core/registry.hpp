@@ -103,8 +103,10 @@ class Registry {
   // Classes with a namespace, by short name (the part after the last "::").
   std::unordered_map<std::string, std::vector<const MetaInstance*>> short_names_;
   std::unordered_map<std::string, const MetaType*> types_;
+  // Reference types and run-time value types. Declared before the classes so that they outlive them: a
+  // run-time class's properties (and their default values) use these types until the class is gone.
+  std::vector<std::unique_ptr<MetaType>> runtime_types_;
   std::vector<std::unique_ptr<MetaInstance>> runtime_classes_;
-  std::vector<std::unique_ptr<MetaType>> runtime_types_;  // reference types and run-time value types
 };
 
 }  // namespace vsd
