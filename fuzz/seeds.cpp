@@ -7,7 +7,8 @@
 
 int main(int argc, char** argv) {
   if (argc != 4) {
-    std::fprintf(stderr, "usage: %s <snapshot corpus dir> <transaction corpus dir> <text corpus dir>\n", argv[0]);
+    std::fprintf(stderr, "usage: %s <snapshot corpus dir> <transaction corpus dir> <text corpus dir>\n",
+                 argv[0]);
     return 2;
   }
   const std::filesystem::path snapshots = argv[1], bundles = argv[2], texts = argv[3];
@@ -23,6 +24,28 @@ int main(int argc, char** argv) {
   vsd::io::write_file_atomically(texts / "model.json", vsd::io::save_bytes(s, vsd::io::Format::Text));
   vsd::io::write_file_atomically(texts / "subtree.json",
                                  vsd::io::save_bytes(*s.database().children()[0], vsd::io::Format::Text));
+  // Files that carry run-time types (version 2): an enum, flags and a struct used by a run-time class.
+  {
+    const vsd::MetaType& shade = vsd::EnumBuilder("FzShade").value("Dark", 0).value("Light", 7).define();
+    const vsd::MetaType& access =
+        vsd::EnumBuilder("FzAccess", vsd::TypeKind::Flags).value("Read", 1).value("Write", 2).define();
+    const vsd::MetaType& tag =
+        vsd::StructBuilder("FzTag").field<std::string>("label").field("shade", shade).define();
+    const vsd::MetaInstance& marker = vsd::ClassBuilder("FzMarker", vsd::Node::static_meta())
+                                          .property("tag", tag)
+                                          .property("tags", vsd::Registry::global().get_type("vector<FzTag>"))
+                                          .property("access", access)
+                                          .define();
+    vsd::Environment typed;
+    auto& m = static_cast<vsd::Node&>(typed.main_state().create(marker));
+    m.set("tag", vsd::Value::from_text(tag, "{\"label\": \"a\", \"shade\": \"Light\"}"));
+    m.set("tags",
+          vsd::Value::from_text(vsd::Registry::global().get_type("vector<FzTag>"), "[{\"label\": \"b\"}]"));
+    typed.main_state().database().add_child(m);
+    vsd::io::write_file_atomically(snapshots / "types.vsds", vsd::io::save_bytes(typed.main_state()));
+    vsd::io::write_file_atomically(texts / "types.json",
+                                   vsd::io::save_bytes(typed.main_state(), vsd::io::Format::Text));
+  }
   // Bundles that fit the fuzzer's base state (same classes, same ids: a fresh Environment builds it).
   vsd::Environment base;
   vsd::SimState& b = base.main_state();

@@ -6,4 +6,6 @@ vsd_add_test_suite(vsd_meta_tests
   core/meta_instance_test.cpp
   core/runtime_class_test.cpp
   core/registry_test.cpp
+  core/class_names_test.cpp
+  core/runtime_type_test.cpp
 )

@@ -26,4 +26,5 @@
 #include "vsd/core/scheduler.hpp"
 #include "vsd/core/sim_state.hpp"
 #include "vsd/core/transaction.hpp"
+#include "vsd/core/type_builder.hpp"
 #include "vsd/core/value.hpp"

@@ -9,6 +9,7 @@
 #include "vsd/core/node.hpp"
 #include "vsd/core/reference.hpp"
 #include "vsd/core/sim_state.hpp"
+#include "vsd/core/type_builder.hpp"
 
 namespace vsd {
 
@@ -74,6 +75,39 @@ void Registry::add(const MetaInstance& cls) {
   add_locked(cls);
 }
 
+namespace {
+// The part of a full class name after the last "::" (the whole name when it has none).
+std::string_view short_name(std::string_view full) {
+  const std::size_t sep = full.rfind("::");
+  return sep == std::string_view::npos ? full : full.substr(sep + 2);
+}
+
+// A full name is "Name" or "ns::Name" (namespaces may nest): no empty part.
+void check_class_name(const std::string& name) {
+  bool bad = name.empty();
+  for (std::size_t from = 0; !bad;) {
+    const std::size_t sep = name.find("::", from);
+    const std::size_t end = sep == std::string::npos ? name.size() : sep;
+    bad = end == from;
+    if (sep == std::string::npos) break;
+    from = sep + 2;
+  }
+  if (bad) detail::throw_error("'" + name + "' is not a class name (Name or namespace::Name)");
+}
+}  // namespace
+
+void Registry::index_locked(const MetaInstance& cls) {
+  const std::string_view s = short_name(cls.name());
+  if (s.size() != cls.name().size()) short_names_[std::string(s)].push_back(&cls);
+}
+
+void Registry::unindex_locked(const MetaInstance& cls) {
+  auto it = short_names_.find(std::string(short_name(cls.name())));
+  if (it == short_names_.end()) return;
+  std::erase(it->second, &cls);
+  if (it->second.empty()) short_names_.erase(it);
+}
+
 void Registry::add_locked(const MetaInstance& cls) {
   if (auto it = classes_.find(cls.name()); it != classes_.end()) {
     if (it->second != &cls)
@@ -81,8 +115,11 @@ void Registry::add_locked(const MetaInstance& cls) {
     return;
   }
   // All or nothing: check every type before anything is registered.
+  check_class_name(cls.name());
   for (const MetaProperty* p : cls.own_properties()) check_type_locked(p->type());
+  short_names_.reserve(short_names_.size() + 1);
   classes_.emplace(cls.name(), &cls);
+  index_locked(cls);
   for (const MetaProperty* p : cls.own_properties()) add_type_locked(p->type());
 }
 
@@ -114,6 +151,26 @@ void Registry::add_type_locked(const MetaType& type) {
 
 const MetaInstance* Registry::find_class(std::string_view name) const {
   std::shared_lock lock(mutex_);
+  return find_class_locked(name);
+}
+
+const MetaInstance* Registry::find_class_locked(std::string_view name) const {
+  if (auto it = classes_.find(std::string(name)); it != classes_.end()) return it->second;
+  if (name.find("::") != std::string_view::npos) return nullptr;  // a full name: no other way to find it
+  auto it = short_names_.find(std::string(name));
+  if (it == short_names_.end()) return nullptr;
+  if (it->second.size() == 1) return it->second.front();
+  std::vector<std::string> names;
+  for (const MetaInstance* c : it->second) names.push_back("'" + c->name() + "'");
+  std::sort(names.begin(), names.end());
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  detail::throw_error("class name '" + std::string(name) + "' is ambiguous: it may be " + list +
+                      " (use the full name)");
+}
+
+const MetaInstance* Registry::find_class_exact(std::string_view name) const {
+  std::shared_lock lock(mutex_);
   auto it = classes_.find(std::string(name));
   return it == classes_.end() ? nullptr : it->second;
 }
@@ -141,6 +198,18 @@ const MetaType& Registry::get_type(std::string_view name) {
       const auto cls = name.substr(prefix.size(), name.size() - prefix.size() - 1);
       return reference_type(kind, get_class(cls));
     }
+  }
+  constexpr std::string_view vector_prefix = "vector<";
+  if (name.size() > vector_prefix.size() + 1 && name.substr(0, vector_prefix.size()) == vector_prefix &&
+      name.back() == '>') {
+    const MetaType* element = nullptr;
+    try {
+      element = &get_type(name.substr(vector_prefix.size(), name.size() - vector_prefix.size() - 1));
+    } catch (const Error&) {
+    }
+    // Only a run-time element: a C++ element's vector is the C++ type, registered with its class.
+    if (element != nullptr && element->cpp_tag() == nullptr && !element->is_reference())
+      return vector_type(*element);
   }
   detail::throw_error("unknown type '" + std::string(name) + "'");
 }
@@ -197,15 +266,18 @@ const MetaInstance& Registry::define(std::unique_ptr<MetaInstance> cls) {
   std::unique_lock lock(mutex_);
   if (classes_.count(cls->name()) != 0)
     detail::throw_error("class name '" + cls->name() + "' is already registered");
+  check_class_name(cls->name());
   // A base must outlive its subclasses: a built-in class (never destroyed) or one of this registry's.
   if (const MetaInstance* base = cls->base(); base != nullptr && base->is_runtime() && !owns_locked(*base))
     detail::throw_error("run-time class '" + cls->name() + "' derives from run-time class '" + base->name() +
                         "' of another registry; define both in the same registry");
   for (const MetaProperty* p : cls->own_properties()) check_type_locked(p->type());
   runtime_classes_.reserve(runtime_classes_.size() + 1);  // nothing below may fail half way
+  short_names_.reserve(short_names_.size() + 1);
   cls->link_to_base();
   const MetaInstance& ref = *cls;
   classes_.emplace(ref.name(), &ref);
+  index_locked(ref);
   for (const MetaProperty* p : ref.own_properties()) add_type_locked(p->type());
   runtime_classes_.push_back(std::move(cls));
   return ref;
@@ -240,7 +312,97 @@ void Registry::undefine(const MetaInstance& cls) {
   });
   std::erase_if(runtime_types_, [&](const auto& t) { return t->target() == &cls; });
   classes_.erase(cls.name());
+  unindex_locked(cls);
   runtime_classes_.erase(it);  // ~MetaInstance unlinks it from its base
+}
+
+}  // namespace vsd
+
+namespace vsd {
+
+namespace {
+// True when values of @p t contain values of @p part (through struct fields and vector elements).
+bool uses(const MetaType& t, const MetaType& part) {
+  if (&t == &part) return true;
+  if (t.element() != nullptr && uses(*t.element(), part)) return true;
+  for (const auto& f : t.fields())
+    if (uses(*f.type, part)) return true;
+  return false;
+}
+// A vector (of vectors ...) of @p part, which get_type made on demand.
+bool vector_of(const MetaType& t, const MetaType& part) {
+  if (t.kind() != TypeKind::Vector || t.cpp_tag() != nullptr) return false;
+  return t.element() == &part || vector_of(*t.element(), part);
+}
+}  // namespace
+
+const MetaType& Registry::define(std::unique_ptr<MetaType> type) {
+  std::unique_lock lock(mutex_);
+  if (type->is_reference()) detail::throw_error("define: reference types are made by the Registry itself");
+  if (type->name().empty()) detail::throw_error("define: a type needs a name");
+  if (types_.count(type->name()) != 0)
+    detail::throw_error("type name '" + type->name() + "' is already registered for another type");
+  if (type->element() != nullptr) check_type_locked(*type->element());
+  for (const auto& f : type->fields()) check_type_locked(*f.type);
+  runtime_types_.reserve(runtime_types_.size() + 1);  // nothing below may fail half way
+  const MetaType& ref = *type;
+  add_type_locked(ref);  // with the types of its fields or elements, so that files find them by name
+  runtime_types_.push_back(std::move(type));
+  return ref;
+}
+
+bool Registry::owns(const MetaType& type) const {
+  std::shared_lock lock(mutex_);
+  return !type.is_reference() && std::any_of(runtime_types_.begin(), runtime_types_.end(),
+                                             [&](const auto& t) { return t.get() == &type; });
+}
+
+const MetaType& Registry::vector_type(const MetaType& element) {
+  const std::string name = "vector<" + element.name() + ">";
+  {
+    std::shared_lock lock(mutex_);
+    if (auto it = types_.find(name); it != types_.end()) return *it->second;
+  }
+  if (element.cpp_tag() != nullptr)
+    detail::throw_error("unknown type '" + name +
+                        "': the vector of a C++ type is known once a class uses it");
+  auto t = detail::make_runtime_vector(element);
+  std::unique_lock lock(mutex_);
+  if (auto it = types_.find(name); it != types_.end()) return *it->second;  // made meanwhile
+  runtime_types_.reserve(runtime_types_.size() + 1);
+  const MetaType& ref = *t;
+  types_.emplace(name, &ref);
+  runtime_types_.push_back(std::move(t));
+  return ref;
+}
+
+void Registry::undefine(const MetaType& type) {
+  std::unique_lock lock(mutex_);
+  auto owned = [&](const MetaType& t) {
+    return std::any_of(runtime_types_.begin(), runtime_types_.end(),
+                       [&](const auto& p) { return p.get() == &t; });
+  };
+  if (type.is_reference() || !owned(type))
+    detail::throw_error("type '" + type.name() + "' is not a run-time type of this registry");
+  for (const auto& [name, cls] : classes_)
+    for (const MetaProperty* p : cls->own_properties())
+      if (uses(p->type(), type))
+        detail::throw_error("type '" + type.name() + "' is still used by property '" + cls->name() +
+                            "::" + p->name() + "'");
+  std::vector<const MetaType*> vectors;
+  for (const auto& [name, t] : types_) {
+    if (t == &type) continue;
+    if (vector_of(*t, type)) {
+      vectors.push_back(t);
+    } else if (t->kind() != TypeKind::Vector && uses(*t, type)) {  // (a vector of a user: that user is named)
+      detail::throw_error("type '" + type.name() + "' is still used by type '" + t->name() + "'");
+    }
+  }
+  vectors.push_back(&type);
+  for (const MetaType* t : vectors) types_.erase(t->name());
+  std::erase_if(runtime_types_, [&](const auto& p) {
+    return std::find(vectors.begin(), vectors.end(), p.get()) != vectors.end();
+  });
 }
 
 }  // namespace vsd

@@ -9,7 +9,12 @@ namespace vsd::io::detail {
 namespace {
 
 constexpr std::uint8_t magic[4] = {'V', 'S', 'D', 'S'};
-constexpr std::uint8_t format_version = 1;
+constexpr std::uint8_t format_version = 2;  // 2 adds the type table; files without run-time types stay 1
+
+// Kinds of run-time types in the type table.
+constexpr std::uint8_t type_enum = 0;
+constexpr std::uint8_t type_flags = 1;
+constexpr std::uint8_t type_struct = 2;
 void write_framed(ByteWriter& w, const std::vector<std::uint8_t>& value) {
   w.fixed(static_cast<std::uint32_t>(value.size()));
   w.raw(value.data(), value.size());
@@ -46,6 +51,26 @@ void write_class(ByteWriter& w, const MetaInstance& c) {
   }
 }
 
+void write_type(ByteWriter& w, const MetaType& t) {
+  w.string(t.name());
+  if (t.kind() == TypeKind::Struct) {
+    w.u8(type_struct);
+    w.varint(t.fields().size());
+    for (const auto& f : t.fields()) {
+      w.string(f.name);
+      w.string(f.type->name());
+    }
+    return;
+  }
+  w.u8(t.kind() == TypeKind::Flags ? type_flags : type_enum);
+  w.string((t.is_unsigned() ? "uint" : "int") + std::to_string(t.size() * 8));
+  w.varint(t.enum_values().size());
+  for (const auto& v : t.enum_values()) {
+    w.string(v.name);
+    w.fixed(v.value);
+  }
+}
+
 // ---- reading ----------------------------------------------------------------------------------------------
 
 class BinaryReader final : public LoadModel {
@@ -73,11 +98,17 @@ class BinaryReader final : public LoadModel {
     in_.raw(head, 4);
     if (!std::equal(head, head + 4, magic)) fail_at(0, "not a vsd snapshot (no VSDS header)");
     const std::uint8_t version = in_.u8();
-    if (version != format_version)
-      fail_at(4, "snapshot format version " + std::to_string(version) + " is not supported (this is " +
-                     std::to_string(format_version) + ")");
+    if (version < 1 || version > format_version)
+      fail_at(4, "snapshot format version " + std::to_string(version) +
+                     " is not supported (this reads 1 to " + std::to_string(format_version) + ")");
+    version_ = version;
     kind_ = in_.u8();
-    if (kind_ != kind_state && kind_ != kind_subtree) fail_at(5, "unknown snapshot kind " + std::to_string(kind_));
+    if (kind_ != kind_state && kind_ != kind_subtree)
+      fail_at(5, "unknown snapshot kind " + std::to_string(kind_));
+    if (version >= 2) {
+      const std::size_t ntypes = in_.size_prefix(3);
+      for (std::size_t i = 0; i < ntypes; ++i) read_type();
+    }
     const std::size_t nclasses = in_.size_prefix(2);
     for (std::size_t i = 0; i < nclasses; ++i) read_class();
     const std::size_t ninstances = in_.size_prefix(2);
@@ -88,6 +119,8 @@ class BinaryReader final : public LoadModel {
     for (const ClassEntry& c : classes_) widest = std::max(widest, c.slots.size());
     values_.reserve(std::min(ninstances * widest, in_.remaining() / 4));
     for (std::size_t i = 0; i < ninstances; ++i) read_instance();
+    has_top_ = true;
+    top_at_ = in_.position();
     const std::size_t ntop = in_.size_prefix(1);
     for (std::size_t i = 0; i < ntop; ++i) {
       top_offsets_.push_back(in_.position());
@@ -96,6 +129,35 @@ class BinaryReader final : public LoadModel {
     if (!in_.at_end())
       fail_at(in_.position(), std::to_string(in_.remaining()) + " unexpected bytes after the snapshot");
     finish();
+  }
+
+  void read_type() {
+    const std::size_t at = in_.position();
+    TypeDefinition def;
+    def.name = in_.string();
+    const std::size_t kind_at = in_.position();
+    const std::uint8_t kind = in_.u8();
+    if (kind == type_struct) {
+      def.kind = TypeKind::Struct;
+      const std::size_t n = in_.size_prefix(2);
+      for (std::size_t i = 0; i < n; ++i) {
+        std::string name = in_.string();
+        const std::size_t type_at = in_.position();
+        def.fields.emplace_back(std::move(name), &type_named(type_at, in_.string_view()));
+      }
+    } else if (kind == type_enum || kind == type_flags) {
+      def.kind = kind == type_flags ? TypeKind::Flags : TypeKind::Enum;
+      const std::size_t type_at = in_.position();
+      def.underlying = &type_named(type_at, in_.string_view());
+      const std::size_t n = in_.size_prefix(9);
+      for (std::size_t i = 0; i < n; ++i) {
+        std::string name = in_.string();
+        def.values.push_back({std::move(name), in_.fixed<std::int64_t>()});
+      }
+    } else {
+      fail_at(kind_at, "unknown kind " + std::to_string(kind) + " of type '" + def.name + "'");
+    }
+    resolve_type(at, def);
   }
 
   void read_class() {
@@ -133,7 +195,8 @@ class BinaryReader final : public LoadModel {
 
   std::span<const std::uint8_t> read_frame() {
     const auto n = in_.fixed<std::uint32_t>();
-    if (n > in_.remaining()) in_.fail("a value of " + std::to_string(n) + " bytes runs past the end of the file");
+    if (n > in_.remaining())
+      in_.fail("a value of " + std::to_string(n) + " bytes runs past the end of the file");
     return {in_.skip(n), n};
   }
 
@@ -162,7 +225,8 @@ class BinaryReader final : public LoadModel {
   }
 
   // Decodes one framed value of @p type (no references) into @p out, checking it is exactly one value.
-  void decode_into(std::size_t frame_at, const MetaType& type, std::span<const std::uint8_t> frame, Value& out) {
+  void decode_into(std::size_t frame_at, const MetaType& type, std::span<const std::uint8_t> frame,
+                   Value& out) {
     ByteReader r(frame.data(), frame.size());
     try {
       type.read_bytes(out.data(), r, nullptr);
@@ -242,8 +306,13 @@ std::vector<std::uint8_t> write_binary(SaveSet& set) {
   std::vector<std::uint8_t> out;
   ByteWriter w(out);
   for (const std::uint8_t b : magic) w.u8(b);  // (w.raw into the empty vector trips a GCC 12 false positive)
-  w.u8(format_version);
+  const int version = format_version_for(set);
+  w.u8(static_cast<std::uint8_t>(version));
   w.u8(set.kind());
+  if (version >= 2) {
+    w.varint(set.types().size());
+    for (const MetaType* t : set.types()) write_type(w, *t);
+  }
   w.varint(set.classes().size());
   for (const MetaInstance* c : set.classes()) write_class(w, *c);
   w.varint(set.members().size());

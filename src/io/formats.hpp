@@ -22,6 +22,10 @@ class SaveSet {
   [[nodiscard]] const std::vector<const SimStateInstance*>& members() const noexcept { return members_; }
   [[nodiscard]] const std::vector<const MetaInstance*>& classes() const noexcept { return classes_; }
   [[nodiscard]] std::size_t class_index(const MetaInstance& c) const { return index_.at(&c); }
+  /// The run-time value types (enums, flags, structs) the classes use, each after the types it holds:
+  /// a file carries their definitions before the classes. Vectors of them are not listed (their names say
+  /// what they are), nor are C++ types (the reading program has them).
+  [[nodiscard]] const std::vector<const MetaType*>& types() const noexcept { return types_; }
   [[nodiscard]] std::uint8_t kind() const noexcept { return kind_; }
   [[nodiscard]] const std::vector<Id>& top() const noexcept { return top_; }
 
@@ -32,6 +36,7 @@ class SaveSet {
 
  private:
   void add_class(const MetaInstance& c);
+  void add_type(const MetaType& t);
 
   std::vector<const SimStateInstance*> members_;
   std::unordered_set<const SimStateInstance*> member_set_;
@@ -40,7 +45,13 @@ class SaveSet {
   SaveReport* report_;
   std::vector<const MetaInstance*> classes_;
   std::unordered_map<const MetaInstance*, std::size_t> index_;
+  std::vector<const MetaType*> types_;
+  std::unordered_set<const MetaType*> type_set_;
 };
+
+/// The format version a writer writes: the first one (1) unless the file carries run-time types (2),
+/// so that files without them stay readable by older programs.
+inline int format_version_for(const SaveSet& set) { return set.types().empty() ? 1 : 2; }
 
 std::vector<std::uint8_t> write_binary(SaveSet& set);
 std::vector<std::uint8_t> write_text(SaveSet& set);

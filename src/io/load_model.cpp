@@ -17,21 +17,94 @@ LoadModel::~LoadModel() {
     } catch (const Error&) {  // still in use elsewhere: keep it
     }
   }
+  for (auto it = defined_types_.rbegin(); it != defined_types_.rend();
+       ++it) {  // after the classes using them
+    try {
+      registry_.undefine(**it);
+    } catch (const Error&) {
+    }
+  }
+}
+
+namespace {
+// True when the program's type @p t is what @p def describes (same values, same text and binary forms).
+bool matches(const MetaType& t, const TypeDefinition& def) {
+  if (t.kind() != def.kind) return false;
+  if (def.kind == TypeKind::Struct) {
+    if (t.fields().size() != def.fields.size()) return false;
+    for (std::size_t i = 0; i < def.fields.size(); ++i)
+      if (t.fields()[i].name != def.fields[i].first ||
+          !vsd::detail::same_definition(*t.fields()[i].type, *def.fields[i].second))
+        return false;
+    return true;
+  }
+  const bool is_unsigned =
+      def.underlying != nullptr ? def.underlying->is_unsigned() : def.kind == TypeKind::Flags;
+  const std::size_t size = def.underlying != nullptr ? def.underlying->size() : 4;
+  if (t.size() != size || t.is_unsigned() != is_unsigned || t.enum_values().size() != def.values.size())
+    return false;
+  for (const auto& v : def.values) {
+    std::int64_t value = 0;
+    if (!t.enum_value(v.name, value) || value != v.value) return false;
+  }
+  return true;
+}
+}  // namespace
+
+const MetaType& LoadModel::resolve_type(std::size_t at, const TypeDefinition& def) {
+  if (const MetaType* known = registry_.find_type(def.name)) {
+    if (!matches(*known, def))
+      fail_at(at, "type '" + def.name + "' of the file clashes with this program's type '" + def.name +
+                      "', which is defined differently");
+    return *known;
+  }
+  try {
+    const MetaType* t = nullptr;
+    if (def.kind == TypeKind::Struct) {
+      StructBuilder b(def.name);
+      for (const auto& [name, type] : def.fields) b.field(name, *type);
+      t = &b.define(registry_);
+    } else {
+      EnumBuilder b(def.name, def.kind);
+      if (def.underlying != nullptr) b.underlying(*def.underlying);
+      for (const auto& v : def.values) b.value(v.name, v.value);
+      t = &b.define(registry_);
+    }
+    defined_types_.push_back(t);
+    return *t;
+  } catch (const Error& e) {
+    fail_at(at, "cannot define type '" + def.name + "': " + e.what());
+  }
 }
 
 const MetaType& LoadModel::type_named(std::size_t at, std::string_view name) {
   try {
     return registry_.get_type(name);  // makes reference types of known classes on demand
-  } catch (const Error&) {
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    if (what.find("ambiguous") != std::string::npos) fail_at(at, "type '" + std::string(name) + "': " + what);
     fail_at(at, "unknown type '" + std::string(name) + "'");
   }
 }
 
 const MetaInstance& LoadModel::resolve_class(std::size_t at, const std::string& name,
                                              const ClassDefinition* def) {
-  if (const MetaInstance* known = registry_.find_class(name)) return *known;
+  // Files carry full names. A class the file defines is found by that name only; one it merely uses may
+  // be given by its short name (hand-written files), unless that is ambiguous.
+  const MetaInstance* known = nullptr;
+  try {
+    known = def != nullptr ? registry_.find_class_exact(name) : registry_.find_class(name);
+  } catch (const Error& e) {
+    fail_at(at, e.what());
+  }
+  if (known != nullptr) return *known;
   if (def == nullptr) fail_at(at, "unknown class '" + name + "' (and the file does not define it)");
-  const MetaInstance* base = registry_.find_class(def->base);
+  const MetaInstance* base = nullptr;
+  try {
+    base = registry_.find_class(def->base);
+  } catch (const Error& e) {
+    fail_at(at, e.what());
+  }
   if (base == nullptr) fail_at(at, "class '" + name + "' derives from unknown class '" + def->base + "'");
   ClassBuilder builder(name, *base);
   for (const auto& p : def->properties) builder.property(p.name, *p.type, p.default_value, p.flags);
@@ -86,7 +159,8 @@ std::span<const std::uint8_t> LoadModel::own(std::span<const std::uint8_t> bytes
 void LoadModel::finish() {
   for (std::size_t i = 0; i < instances_.size(); ++i) {
     const SavedInstance& x = instances_[i];
-    if (!by_id_.insert(x.id, i + 1)) fail_at(x.offset, "instance #" + std::to_string(x.id) + " appears twice");
+    if (!by_id_.insert(x.id, i + 1))
+      fail_at(x.offset, "instance #" + std::to_string(x.id) + " appears twice");
     const MetaInstance& cls = *x.entry->cls;
     if (cls.is_abstract()) fail_at(x.offset, "class '" + cls.name() + "' is abstract: it has no instances");
     if (cls.is_a(Database::static_meta())) {  // a state file's root; it stands for the target's Database
@@ -94,13 +168,6 @@ void LoadModel::finish() {
         fail_at(x.offset, "a Database is a state's root: a file holds at most one, in a whole state");
       file_root_ = &x;
     }
-  }
-  for (std::size_t i = 0; i < top_.size(); ++i) {
-    const SavedInstance* top = find(top_[i]);
-    if (top == nullptr)
-      fail_at(top_offsets_[i], "top-level node #" + std::to_string(top_[i]) + " is not in the file");
-    if (!top->entry->cls->is_a(Node::static_meta()))
-      fail_at(top_offsets_[i], "top-level #" + std::to_string(top_[i]) + " is not a Node");
   }
   for (const SavedInstance& x : instances_)
     for (const SavedValue& v : values_of(x))
@@ -114,10 +181,61 @@ void LoadModel::finish() {
         const MetaInstance& found = *it->entry->cls;
         if (!found.is_a(target))
           fail_at(v.offset, "#" + std::to_string(x.id) + "." + v.slot->prop->name() + " names #" +
-                                std::to_string(id) + ", a '" + found.name() + "', which is not a '" + target.name() +
-                                "'");
+                                std::to_string(id) + ", a '" + found.name() + "', which is not a '" +
+                                target.name() + "'");
       }
   check_composite_cycles();
+  check_top();
+}
+
+namespace {
+std::string id_list(std::span<const Id> ids) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < ids.size(); ++i) out += (i == 0 ? "#" : ", #") + std::to_string(ids[i]);
+  return out + "]";
+}
+}  // namespace
+
+// The top-level nodes. A state file with a Database: they are its children, and "top" (redundant) must
+// list exactly those. Otherwise (a subtree, or a state file without a Database) "top" names them: each
+// once, a Node of the file that no other instance of the file holds compositely, since a load attaches it.
+void LoadModel::check_top() {
+  std::unordered_map<Id, std::size_t> listed;  // top-level id -> index in top_
+  for (std::size_t i = 0; i < top_.size(); ++i) {
+    const SavedInstance* top = find(top_[i]);
+    if (top == nullptr)
+      fail_at(top_offsets_[i], "top-level node #" + std::to_string(top_[i]) + " is not in the file");
+    if (!top->entry->cls->is_a(Node::static_meta()))
+      fail_at(top_offsets_[i], "top-level #" + std::to_string(top_[i]) + " is not a Node");
+    if (!listed.emplace(top_[i], i).second)
+      fail_at(top_offsets_[i], "top-level node #" + std::to_string(top_[i]) + " is listed twice");
+  }
+  if (kind_ == kind_state && file_root_ != nullptr) {
+    std::span<const Id> children;
+    for (const SavedValue& v : values_of(*file_root_))
+      if (v.slot->prop == &Node::vsd_prop_children()) children = ids_of(v);
+    roots_.assign(children.begin(), children.end());
+    if (!has_top_) return;
+    for (std::size_t i = 0; i < std::max(top_.size(), children.size()); ++i) {
+      if (i < top_.size() && i < children.size() && top_[i] == children[i]) continue;
+      fail_at(i < top_.size() ? top_offsets_[i] : top_at_,
+              "\"top\" " + id_list(top_) + " is not what the Database #" + std::to_string(file_root_->id) +
+                  " holds as its children " + id_list(children));
+    }
+    return;
+  }
+  if (kind_ == kind_subtree && top_.empty()) fail_at(top_at_, "a subtree file names its root in \"top\"");
+  roots_ = top_;
+  if (listed.empty()) return;
+  for (const SavedInstance& x : instances_)
+    for (const SavedValue& v : values_of(x)) {
+      if (!v.slot->prop->type().is_composite()) continue;
+      for (Id id : ids_of(v))
+        if (listed.count(id) != 0)
+          fail_at(v.offset, "top-level node #" + std::to_string(id) + " is held by #" + std::to_string(x.id) +
+                                "." + v.slot->prop->name() +
+                                ": a load attaches it, so nothing in the file may hold it");
+    }
 }
 
 // Composite references must form a forest: a depth-first walk that meets an instance still on its path has
@@ -172,6 +290,8 @@ LoadReport LoadModel::summary() const {
   report.subtree = kind_ == kind_subtree;
   report.instances = instances_.size() - (file_root_ != nullptr ? 1 : 0);  // the Database is not added
   for (const MetaInstance* c : defined_) report.defined_classes.push_back(c->name());
+  for (const MetaType* t : defined_types_) report.defined_types.push_back(t->name());
+  report.version = version_;
   report.warnings = warnings_;
   return report;
 }
@@ -197,7 +317,8 @@ LoadReport LoadModel::apply(SimState& state, Node* parent) {
       continue;
     }
     if (whole) {
-      if (state.find(x.id) != nullptr) fail_at(x.offset, "instance #" + std::to_string(x.id) + " already exists");
+      if (state.find(x.id) != nullptr)
+        fail_at(x.offset, "instance #" + std::to_string(x.id) + " already exists");
       env.reserve_ids_through(x.id);
     } else {
       map.insert(x.id, env.next_id());
@@ -233,14 +354,8 @@ LoadReport LoadModel::apply(SimState& state, Node* parent) {
       ++ops;
     }
   }
-  std::vector<Id> tops;
   for (const SavedInstance& x : instances_) {
-    if (&x == saved_root && !whole) {  // under a node: the Database's children become top level
-      for (const SavedValue& v : values_of(x))
-        if (v.slot->prop == &Node::vsd_prop_children())
-          for (Id id : ids_of(v)) tops.push_back(id);
-      continue;
-    }
+    if (&x == saved_root && !whole) continue;  // under a node: the Database's children are roots_
     for (const SavedValue& v : values_of(x)) {
       if (v.slot->prop == nullptr || !v.slot->prop->type().is_reference() || v.slot->prop->has(Transient))
         continue;
@@ -260,29 +375,31 @@ LoadReport LoadModel::apply(SimState& state, Node* parent) {
       }
     }
   }
-  if (kind_ == kind_subtree || !whole) {
-    if (kind_ == kind_subtree) tops = top_;
+  // The top-level nodes are attached, except in a whole-state load of a file with a Database: that restores
+  // the Database's own children list above.
+  if (!whole || saved_root == nullptr) {
     Node& into = whole ? state.database() : *parent;
     std::size_t at = into.children().size();
-    for (Id id : tops) {
-      vsd::detail::write_list(bundle, Transaction::Op::Insert, into.id(), Node::vsd_prop_children().name(), at++,
-                              mapped(id));
+    for (Id id : roots_) {
+      vsd::detail::write_list(bundle, Transaction::Op::Insert, into.id(), Node::vsd_prop_children().name(),
+                              at++, mapped(id));
       ++ops;
     }
-  } else {
-    tops = top_;
   }
   try {
     vsd::detail::apply_checked_values(state, vsd::detail::make_transaction(std::move(bundle), ops));
   } catch (const Error& e) {
-    throw Error(std::string(origin_) + ": the file does not fit SimState '" + state.name() + "': " + e.what());
+    throw Error(std::string(origin_) + ": the file does not fit SimState '" + state.name() +
+                "': " + e.what());
   }
   committed_ = true;
   report.subtree = kind_ == kind_subtree;
   report.instances = instances_.size() - (saved_root != nullptr ? 1 : 0);
-  for (Id id : tops)
+  for (Id id : roots_)
     if (Node* n = state.find<Node>(mapped(id))) report.roots.push_back(n);
   for (const MetaInstance* c : defined_) report.defined_classes.push_back(c->name());
+  for (const MetaType* t : defined_types_) report.defined_types.push_back(t->name());
+  report.version = version_;
   report.warnings = warnings_;
   return report;
 }

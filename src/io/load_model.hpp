@@ -10,8 +10,8 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <memory>
 #include <deque>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -71,6 +71,15 @@ struct ClassDefinition {
   std::vector<Property> properties;
 };
 
+/// A run-time value type (enum, flags or struct) as a file carries it.
+struct TypeDefinition {
+  std::string name;
+  TypeKind kind = TypeKind::Enum;
+  const MetaType* underlying = nullptr;  // enums and flags; null: the builder's default
+  std::vector<MetaType::EnumValue> values;
+  std::vector<std::pair<std::string, const MetaType*>> fields;  // structs
+};
+
 class LoadModel {
  public:
   LoadModel(Registry& registry, std::string_view origin) : registry_(registry), origin_(origin) {}
@@ -88,8 +97,14 @@ class LoadModel {
   /// The origin and the position @p at in the format's terms ("file: byte 12", "file:3:14").
   [[nodiscard]] virtual std::string where(std::size_t at) const = 0;
   /// Throws vsd::Error naming where(at) and @p what.
-  [[noreturn]] void fail_at(std::size_t at, const std::string& what) const { throw Error(where(at) + ": " + what); }
+  [[noreturn]] void fail_at(std::size_t at, const std::string& what) const {
+    throw Error(where(at) + ": " + what);
+  }
 
+  /// The type @p def describes: the program's own when it has one of that name and the same definition,
+  /// else defined from @p def (removed again if the load fails). A type of that name that differs is an
+  /// error at @p at.
+  const MetaType& resolve_type(std::size_t at, const TypeDefinition& def);
   /// The class named @p name, defined from @p def when this program does not know it (def may be null).
   const MetaInstance& resolve_class(std::size_t at, const std::string& name, const ClassDefinition* def);
   /// How a saved property @p prop of type @p type_name (empty: unknown) of @p cls maps to today's class;
@@ -114,12 +129,17 @@ class LoadModel {
   Registry& registry_;
   std::string_view origin_;
   std::uint8_t kind_ = kind_state;
+  int version_ = 1;
   std::deque<ClassEntry> classes_;  // a deque: entries never move while instances point at them
   std::vector<SavedInstance> instances_;
   std::vector<SavedValue> values_;  // of all instances, in file order
   std::vector<Id> ids_;             // reference targets of all values
+  // "top" as the file gives it: the subtree's roots, or a state's top-level nodes (checked against what
+  // its Database holds). has_top_ is false for a text file without "top"; top_at_ is where it starts.
   std::vector<Id> top_;
   std::vector<std::size_t> top_offsets_;
+  bool has_top_ = false;
+  std::size_t top_at_ = 0;
   std::vector<std::string> warnings_;
 
  private:
@@ -131,9 +151,15 @@ class LoadModel {
     return i == 0 ? nullptr : &instances_[i - 1];
   }
 
-  vsd::detail::FlatIdMap<std::size_t> by_id_;
-  const SavedInstance* file_root_ = nullptr;  // a state file's Database  // id -> index in instances_ + 1 (0: none)
+  void check_top();
+
+  vsd::detail::FlatIdMap<std::size_t> by_id_;  // id -> index in instances_ + 1 (0: none)
+  const SavedInstance* file_root_ = nullptr;   // a state file's Database
+  // The top-level nodes as finish() derived them: the Database's children in a state file that has one,
+  // else "top". A load attaches them (or, as a whole state with a Database, restores them as its children).
+  std::vector<Id> roots_;
   std::vector<const MetaInstance*> defined_;
+  std::vector<const MetaType*> defined_types_;
   bool committed_ = false;
 };
 

@@ -25,6 +25,19 @@ void SaveSet::add_class(const MetaInstance& c) {
   if (c.is_runtime()) add_class(*c.base());  // a run-time base is defined before its subclasses
   index_.emplace(&c, classes_.size());
   classes_.push_back(&c);
+  if (c.is_runtime())  // its definition names the types of all its own properties
+    for (const MetaProperty* p : c.own_properties()) add_type(p->type());
+}
+
+void SaveSet::add_type(const MetaType& t) {
+  if (t.is_reference() || t.cpp_tag() != nullptr || type_set_.count(&t) != 0) return;
+  if (t.kind() == TypeKind::Vector) {  // "vector<E>": made from its element by name
+    add_type(*t.element());
+    return;
+  }
+  for (const auto& f : t.fields()) add_type(*f.type);  // what a struct holds is defined first
+  type_set_.insert(&t);
+  types_.push_back(&t);
 }
 
 Id SaveSet::member_id(const SimStateInstance* t) {
@@ -91,7 +104,8 @@ LoadReport load_into(SimState& state, Node* parent, std::span<const std::uint8_t
 
 Format format_for(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext == ".json" ? Format::Text : Format::Binary;
 }
 
@@ -102,7 +116,8 @@ Format format_of(std::span<const std::uint8_t> bytes, std::string_view origin) {
     return Format::Binary;
   // Text: JSON, after an optional UTF-8 byte order mark and blanks, starts with '{'.
   std::size_t i = bytes.size() >= 3 && bytes[0] == 0xEF && bytes[1] == 0xBB && bytes[2] == 0xBF ? 3 : 0;
-  while (i < bytes.size() && (bytes[i] == ' ' || bytes[i] == '\t' || bytes[i] == '\n' || bytes[i] == '\r')) ++i;
+  while (i < bytes.size() && (bytes[i] == ' ' || bytes[i] == '\t' || bytes[i] == '\n' || bytes[i] == '\r'))
+    ++i;
   if (i < bytes.size() && bytes[i] == '{') return Format::Text;
   throw Error(std::string(origin) +
               ": byte 0: not a vsd file: neither a binary snapshot (\"VSDS\") nor a text file (JSON, '{')");
@@ -153,7 +168,9 @@ SaveReport save(const SimState& state, const std::filesystem::path& path) {
   return save(state, path, format_for(path));
 }
 
-SaveReport save(const Node& root, const std::filesystem::path& path) { return save(root, path, format_for(path)); }
+SaveReport save(const Node& root, const std::filesystem::path& path) {
+  return save(root, path, format_for(path));
+}
 
 LoadReport load(SimState& state, const std::filesystem::path& path) {
   return load_bytes(state, read_file(path), path.string());

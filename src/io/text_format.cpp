@@ -18,7 +18,7 @@ namespace vsd::io::detail {
 namespace {
 
 constexpr std::string_view format_name = "vsd-text";
-constexpr int format_version = 1;
+constexpr int format_version = 2;  // 2 adds "types"; files without run-time types are still written as 1
 
 // ---- property flags as names ------------------------------------------------------------------------------
 
@@ -61,6 +61,42 @@ void write_key(std::string& out, std::string_view indent, std::string_view key) 
   out += indent;
   write_quoted(out, key);
   out += ": ";
+}
+
+// A run-time type on one line: {"type": "Color", "kind": "enum", "underlying": "int32", "values": [["Red",
+// 0]]} or {"type": "Tag", "kind": "struct", "fields": [["label", "string"], ["color", "Color"]]}.
+void write_type(std::string& out, const MetaType& t) {
+  out += "    {";
+  write_key(out, "", "type");
+  write_quoted(out, t.name());
+  write_key(out, ", ", "kind");
+  if (t.kind() == TypeKind::Struct) {
+    out += "\"struct\"";
+    write_key(out, ", ", "fields");
+    out.push_back('[');
+    for (std::size_t i = 0; i < t.fields().size(); ++i) {
+      out += i == 0 ? "[" : ", [";
+      write_quoted(out, t.fields()[i].name);
+      out += ", ";
+      write_quoted(out, t.fields()[i].type->name());
+      out.push_back(']');
+    }
+    out += "]}";
+    return;
+  }
+  out += t.kind() == TypeKind::Flags ? "\"flags\"" : "\"enum\"";
+  write_key(out, ", ", "underlying");
+  write_quoted(out, (t.is_unsigned() ? "uint" : "int") + std::to_string(t.size() * 8));
+  write_key(out, ", ", "values");
+  out.push_back('[');
+  for (std::size_t i = 0; i < t.enum_values().size(); ++i) {
+    out += i == 0 ? "[" : ", [";
+    write_quoted(out, t.enum_values()[i].name);
+    out += ", ";
+    out += std::to_string(t.enum_values()[i].value);
+    out.push_back(']');
+  }
+  out += "]}";
 }
 
 void write_class(std::string& out, const MetaInstance& c) {
@@ -120,11 +156,20 @@ std::vector<std::uint8_t> write_text(SaveSet& set) {
   write_quoted(out, format_name);
   out += ",\n";
   write_key(out, "  ", "version");
-  out += std::to_string(format_version);
+  out += std::to_string(format_version_for(set));
   out += ",\n";
   write_key(out, "  ", "kind");
   out += set.kind() == kind_state ? "\"state\"" : "\"subtree\"";
   out += ",\n";
+  if (!set.types().empty()) {
+    write_key(out, "  ", "types");
+    out += "[\n";
+    for (std::size_t i = 0; i < set.types().size(); ++i) {
+      write_type(out, *set.types()[i]);
+      out += i + 1 < set.types().size() ? ",\n" : "\n";
+    }
+    out += "  ],\n";
+  }
   write_key(out, "  ", "classes");
   out += "[\n";
   for (std::size_t i = 0; i < set.classes().size(); ++i) {
@@ -195,9 +240,9 @@ class TextSnapshotReader final : public LoadModel {
     // The top level. Members are read where they stand when what they need is known (the format and
     // version before anything, the classes before the instances); a file that orders them otherwise is
     // read in two passes: such members are skipped, remembered, and read at the end.
-    std::optional<std::size_t> classes_at, instances_at;
+    std::optional<std::size_t> types_at, classes_at, instances_at;
     bool has_format = false, has_version = false, has_kind = false, has_top = false;
-    bool classes_read = false, instances_read = false;
+    bool types_read = false, classes_read = false, instances_read = false;
     in_.expect('{');
     if (!in_.accept('}')) {
       do {
@@ -217,22 +262,31 @@ class TextSnapshotReader final : public LoadModel {
         } else if (key == "version") {
           once(has_version);
           const std::int64_t version = in_.integer();
-          if (version != format_version)
-            fail_at(at, "format version " + std::to_string(version) + " is not supported (this is " +
+          if (version < 1 || version > format_version)
+            fail_at(at, "format version " + std::to_string(version) + " is not supported (this reads 1 to " +
                             std::to_string(format_version) + ")");
+          version_ = static_cast<int>(version);
         } else if (key == "kind") {
           once(has_kind);
           read_kind(at);
         } else if (key == "top") {
           once(has_top);
           read_top();
-        } else if (key == "classes" || key == "instances") {
-          std::optional<std::size_t>& slot = key == "classes" ? classes_at : instances_at;
+        } else if (key == "types" || key == "classes" || key == "instances") {
+          std::optional<std::size_t>& slot = key == "types"     ? types_at
+                                             : key == "classes" ? classes_at
+                                                                : instances_at;
           if (slot) fail_at(key_at, "'" + key + "' is given twice");
           slot = at;
-          const bool ready = has_format && has_version && (key == "classes" || classes_read);
+          // Classes need the types before them (a version 1 file has none), instances the classes.
+          const bool ready = has_format && has_version &&
+                             (key == "types" || (key == "classes" && (types_read || version_ < 2)) ||
+                              (key == "instances" && classes_read));
           if (!ready) {
             in_.skip_value();
+          } else if (key == "types") {
+            read_types(at);
+            types_read = true;
           } else if (key == "classes") {
             read_classes(at);
             classes_read = true;
@@ -251,6 +305,7 @@ class TextSnapshotReader final : public LoadModel {
     const std::size_t end = in_.position();
     if (!has_format) fail_at(0, "not a vsd text file (no \"format\": \"vsd-text\")");
     if (!has_version) fail_at(0, "the file names no format \"version\"");
+    if (types_at && !types_read) read_types(*types_at);
     if (classes_at && !classes_read) read_classes(*classes_at);
     if (instances_at && !instances_read) read_instances(*instances_at);
     in_.seek(end);
@@ -266,7 +321,7 @@ class TextSnapshotReader final : public LoadModel {
     std::vector<std::string> saved_names, type_names;
     std::vector<std::size_t> type_at;
     std::unordered_map<std::string, std::size_t> file_types;  // property -> index in the vectors above
-    std::vector<std::string> reported;  // unknown keys already warned about
+    std::vector<std::string> reported;                        // unknown keys already warned about
     // Per slot: the class's property (kept even when the slot drops its values), the name the file uses,
     // and where values are parsed (reset to the default each time).
     std::vector<const MetaProperty*> props;
@@ -355,7 +410,8 @@ class TextSnapshotReader final : public LoadModel {
         if (f.name == name) flags = flags | f.flag, found = true;
       unsigned n = 0;
       if (!found && name.substr(0, 4) == "User" && name.size() > 4 &&
-          std::from_chars(name.data() + 4, name.data() + name.size(), n).ptr == name.data() + name.size() && n < 16)
+          std::from_chars(name.data() + 4, name.data() + name.size(), n).ptr == name.data() + name.size() &&
+          n < 16)
         flags = flags | UserFlag(n), found = true;
       if (!found) fail_at(at, "unknown property flag '" + std::string(name) + "'");
     }
@@ -373,12 +429,77 @@ class TextSnapshotReader final : public LoadModel {
   }
 
   void read_top() {
+    has_top_ = true;
+    top_at_ = in_.token_start();
     read_array([&] {
       top_offsets_.push_back(in_.token_start());
       const Id id = read_id();
       if (id == null_id) fail_at(top_offsets_.back(), "a top-level node cannot be null");
       top_.push_back(id);
     });
+  }
+
+  // ---- run-time types ----
+
+  void read_types(std::size_t at) {
+    in_.seek(at);
+    read_array([&] { read_type(); });
+  }
+
+  void read_type() {
+    const std::size_t at = in_.token_start();
+    TypeDefinition def;
+    std::optional<std::string> name, kind;
+    std::size_t kind_at = at;
+    std::optional<std::size_t> values_at, fields_at;
+    read_object([&](const std::string& key, std::size_t key_at) {
+      if (key == "type") {
+        name = read_string("a type name");
+      } else if (key == "kind") {
+        kind_at = in_.token_start();
+        kind = read_string("a kind of type");
+      } else if (key == "underlying") {
+        const std::size_t type_at = in_.token_start();
+        def.underlying = &type_named(type_at, read_string("an integer type name"));
+      } else if (key == "values") {
+        values_at = in_.token_start();
+        read_array([&] {
+          TextReader::Nest nest(in_);
+          in_.expect('[');
+          std::string value_name = read_string("a value name");
+          in_.expect(',');
+          def.values.push_back({std::move(value_name), in_.integer()});
+          in_.expect(']');
+        });
+      } else if (key == "fields") {
+        fields_at = in_.token_start();
+        read_array([&] {
+          TextReader::Nest nest(in_);
+          in_.expect('[');
+          std::string field_name = read_string("a field name");
+          in_.expect(',');
+          const std::size_t type_at = in_.token_start();
+          def.fields.emplace_back(std::move(field_name), &type_named(type_at, read_string("a type name")));
+          in_.expect(']');
+        });
+      } else {
+        warnings_.push_back(where(key_at) + ": unknown member '" + key + "' in a type is ignored");
+        in_.skip_value();
+      }
+    });
+    if (!name || !kind) fail_at(at, "a type needs a \"type\" name and a \"kind\"");
+    def.name = *name;
+    if (*kind == "struct") {
+      def.kind = TypeKind::Struct;
+      if (values_at) fail_at(*values_at, "struct '" + def.name + "' has fields, not values");
+      if (def.underlying != nullptr) fail_at(at, "struct '" + def.name + "' has no underlying type");
+    } else if (*kind == "enum" || *kind == "flags") {
+      def.kind = *kind == "enum" ? TypeKind::Enum : TypeKind::Flags;
+      if (fields_at) fail_at(*fields_at, *kind + " '" + def.name + "' has values, not fields");
+    } else {
+      fail_at(kind_at, "unknown kind of type '" + *kind + "' (enum, flags or struct)");
+    }
+    resolve_type(at, def);
   }
 
   // ---- classes ----
@@ -412,7 +533,8 @@ class TextSnapshotReader final : public LoadModel {
           saved.emplace_back(prop, read_string("a type name"));
         });
       } else {
-        fail_at(key_at, "unknown member '" + key + "' in a class");
+        warnings_.push_back(where(key_at) + ": unknown member '" + key + "' in a class is ignored");
+        in_.skip_value();
       }
     });
     if (!name) fail_at(at, "a class needs a \"class\" name");
@@ -450,7 +572,9 @@ class TextSnapshotReader final : public LoadModel {
         default_at = in_.token_start();
         in_.skip_value();  // read once the type is known
       } else {
-        fail_at(key_at, "unknown member '" + key + "' in a property definition");
+        warnings_.push_back(where(key_at) + ": unknown member '" + key +
+                            "' in a property definition is ignored");
+        in_.skip_value();
       }
     });
     if (!name || type == nullptr) fail_at(at, "a property definition needs a \"name\" and a \"type\"");

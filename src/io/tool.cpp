@@ -5,8 +5,8 @@
 #include <map>
 #include <optional>
 #include <stdexcept>
-#include <unordered_set>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "vsd/io/file.hpp"
@@ -16,7 +16,8 @@ namespace vsd::io {
 
 namespace {
 
-constexpr std::string_view usage = R"(vsd-io: convert, inspect and check vsd files (binary snapshots and vsd-text JSON)
+constexpr std::string_view usage =
+    R"(vsd-io: convert, inspect and check vsd files (binary snapshots and vsd-text JSON)
 
 Usage:
   vsd-io convert <in> <out> [--to text|binary]
@@ -130,7 +131,8 @@ int convert(std::span<const std::string_view> args, std::ostream& out, std::ostr
     if (args[i] == "--to") {
       if (i + 1 == args.size()) throw std::invalid_argument("--to needs 'text' or 'binary'");
       const std::string_view f = args[++i];
-      if (f != "text" && f != "binary") throw std::invalid_argument("--to needs 'text' or 'binary', not '" + std::string(f) + "'");
+      if (f != "text" && f != "binary")
+        throw std::invalid_argument("--to needs 'text' or 'binary', not '" + std::string(f) + "'");
       to = f == "text" ? Format::Text : Format::Binary;
     } else if (args[i].substr(0, 1) == "-") {
       throw std::invalid_argument("convert: unknown option '" + std::string(args[i]) + "'");
@@ -176,13 +178,19 @@ int info(std::span<const std::string_view> args, std::ostream& out, std::ostream
   auto l = load_file(args[0]);
   const LoadReport& r = l->report;
   out << "file:      " << args[0] << '\n'
-      << "format:    " << (r.format == Format::Text ? "text (vsd-text 1)" : "binary (VSDS 1)") << '\n'
+      << "format:    " << (r.format == Format::Text ? "text (vsd-text " : "binary (VSDS ") << r.version
+      << ")\n"
       << "kind:      " << (r.subtree ? "subtree" : "state") << '\n'
       << "instances: " << r.instances << '\n';
   std::map<std::string, std::size_t> per_class;
   for (const SimStateInstance* x : l->env.main_state().instances())
     if (r.subtree || x != &l->env.main_state().database()) ++per_class[x->meta().name()];
   for (const auto& [name, n] : per_class) out << "  " << n << " " << name << '\n';
+  if (!r.defined_types.empty()) {
+    out << "run-time types defined by the file:";
+    for (const std::string& t : r.defined_types) out << ' ' << t;
+    out << '\n';
+  }
   if (!r.defined_classes.empty()) {
     out << "run-time classes defined by the file:";
     for (const std::string& c : r.defined_classes) out << ' ' << c;
@@ -197,7 +205,8 @@ int check(std::span<const std::string_view> args, std::ostream& out, std::ostrea
   auto l = load_file(args[0]);
   print_warnings(l->report, err);
   out << args[0] << ": ok, " << l->report.instances << " instances"
-      << (l->report.warnings.empty() ? "" : " (" + std::to_string(l->report.warnings.size()) + " warnings)") << '\n';
+      << (l->report.warnings.empty() ? "" : " (" + std::to_string(l->report.warnings.size()) + " warnings)")
+      << '\n';
   return 0;
 }
 

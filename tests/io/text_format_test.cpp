@@ -230,8 +230,8 @@ TEST_F(BadText, CompositeCyclesAreRejected) {
 TEST_F(BadText, HeaderAndVersion) {
   EXPECT_THAT(load_error("{\"version\": 1}"), HasSubstr("not a vsd text file"));
   EXPECT_THAT(load_error("{\"format\": \"other\", \"version\": 1}"), HasSubstr("model.json:1:12: not a vsd text file"));
-  EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"version\": 2}"),
-              HasSubstr("model.json:1:35: format version 2 is not supported"));
+  EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"version\": 3}"),
+              HasSubstr("model.json:1:35: format version 3 is not supported (this reads 1 to 2)"));
   EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"version\": 1, \"kind\": \"all\"}"), HasSubstr("unknown kind"));
   EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"format\": \"vsd-text\"}"), HasSubstr("given twice"));
   EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"version\": 1} trailing"), HasSubstr("model.json:1:"));

@@ -29,6 +29,7 @@
 #include <new>
 #include <string_view>
 
+#include "vsd/core/detail/class_name.hpp"
 #include "vsd/core/flags.hpp"
 #include "vsd/core/instance.hpp"
 #include "vsd/core/list_editor.hpp"
@@ -67,27 +68,41 @@ void declare_property(MetaInstance& m, std::size_t slot, const char* name, std::
 
 }  // namespace vsd::detail
 
-#define VSD_DETAIL_INSTANCE(Name, Base, construct)                                                           \
- public:                                                                                                     \
-  using vsd_self = Name;                                                                                     \
-  using vsd_base = Base;                                                                                     \
-  static constexpr std::string_view vsd_class_name = #Name;                                                  \
-  /** @brief The MetaInstance of this class. */                                                              \
-  static const ::vsd::MetaInstance& static_meta() {                                                          \
-    /* Never destroyed: class descriptors outlive every static that might still use them. */                 \
-    static const ::vsd::MetaInstance& meta =                                                                 \
-        *new ::vsd::MetaInstance(#Name, &Base::static_meta(), sizeof(Name), alignof(Name), construct,        \
-                                 [](::vsd::MetaInstance& m) { vsd_register(m, ::vsd::detail::Slot<0>{}); }); \
-    return meta;                                                                                             \
-  }                                                                                                          \
-                                                                                                             \
- private:                                                                                                    \
-  static constexpr int vsd_counter_base = __COUNTER__;                                                       \
-  template <int N>                                                                                           \
-  static void vsd_register(::vsd::MetaInstance&, ::vsd::detail::Slot<N>) {}                                  \
-  [[maybe_unused]] static inline const bool vsd_registered_ = ::vsd::detail::auto_register(static_meta());   \
-                                                                                                             \
+#define VSD_DETAIL_INSTANCE(Name, Base, construct)                                                         \
+ public:                                                                                                   \
+  using vsd_self = Name;                                                                                   \
+  using vsd_base = Base;                                                                                   \
+  static constexpr std::string_view vsd_class_name = #Name;                                                \
+  /* Its only associated namespace is the class's own: see VSD_CLASS_NAMESPACE. */                         \
+  struct vsd_tag {};                                                                                       \
+  /** @brief The MetaInstance of this class. */                                                            \
+  static const ::vsd::MetaInstance& static_meta() {                                                        \
+    /* Never destroyed: class descriptors outlive every static that might still use them. */               \
+    static const ::vsd::MetaInstance& meta = *new ::vsd::MetaInstance(                                     \
+        ::vsd::detail::class_name<Name>(), &Base::static_meta(), sizeof(Name), alignof(Name), construct,   \
+        [](::vsd::MetaInstance& m) { vsd_register(m, ::vsd::detail::Slot<0>{}); });                        \
+    return meta;                                                                                           \
+  }                                                                                                        \
+                                                                                                           \
+ private:                                                                                                  \
+  static constexpr int vsd_counter_base = __COUNTER__;                                                     \
+  template <int N>                                                                                         \
+  static void vsd_register(::vsd::MetaInstance&, ::vsd::detail::Slot<N>) {}                                \
+  [[maybe_unused]] static inline const bool vsd_registered_ = ::vsd::detail::auto_register(static_meta()); \
+                                                                                                           \
  public:
+
+/// @brief Declares the namespace of the vsd classes of the enclosing C++ namespace: a class declared
+/// there with VSD_INSTANCE(Node3D, ...) is named "scene::Node3D" (in files, bundles and the Registry).
+/// Write it once, at namespace scope, in a header that the classes' headers include:
+/// `namespace vsd::scene { VSD_CLASS_NAMESPACE("scene") }`. It applies to classes declared directly in
+/// that C++ namespace (not in namespaces nested in it, nor to subclasses declared elsewhere); classes of a
+/// namespace that declares none keep their plain names, as vsd's own classes (Node, Database, ...) do.
+#define VSD_CLASS_NAMESPACE(ns)                                                         \
+  template <class VsdTag>                                                               \
+  [[maybe_unused]] constexpr ::std::string_view vsd_class_namespace(VsdTag*) noexcept { \
+    return ns;                                                                          \
+  }
 
 /// @brief Opens the declaration of a vsd class @p Name deriving from @p Base (instances can be created).
 #define VSD_INSTANCE(Name, Base) VSD_DETAIL_INSTANCE(Name, Base, &::vsd::detail::construct_instance<Name>)

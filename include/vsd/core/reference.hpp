@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "vsd/core/config.hpp"
+#include "vsd/core/detail/class_name.hpp"
 #include "vsd/core/meta_type.hpp"
 
 namespace vsd {
@@ -229,7 +230,7 @@ extern const TypeOps ref_list_ops;
 
 template <class R, class T>
 MetaType make_ref_type(std::string_view prefix, TypeKind kind) {
-  MetaType t(std::string(prefix) + "<" + std::string(T::vsd_class_name) + ">", kind, sizeof(R), alignof(R),
+  MetaType t(std::string(prefix) + "<" + class_name<T>() + ">", kind, sizeof(R), alignof(R),
              kind == TypeKind::Ref || kind == TypeKind::SharedRef ? ref_ops : ref_list_ops);
   t.set_target(+[]() -> const MetaInstance& { return T::static_meta(); });
   t.set_cpp_tag(tag_of<R>());

@@ -3,17 +3,19 @@
  *  one, as a readable text file or a compact binary snapshot.
  *
  *  What is written is decided by the meta-information: every Savable, non-Transient property of every
- *  instance, references by id, and the definitions of the run-time classes the instances use (so a
- *  program that never defined them can load the file, inspect it and save it again unchanged).
+ *  instance, references by id, and the definitions of the run-time classes and run-time value types
+ *  (EnumBuilder, StructBuilder) the instances use (so a program that never defined them can load the
+ *  file, inspect it and save it again unchanged). Classes are named by their full names ("scene::Hull").
  *
- *  Two formats, one API; a load recognises the format by the file's first bytes:
- *  - Format::Text, "vsd-text" version 1: JSON (RFC 8259), one instance per object and one property per
- *    line so that it diffs well; each value is its type's text form (MetaType::write_text). Errors say
- *    line:col. See docs/file-formats.md.
- *  - Format::Binary, "VSDS" version 1: a class table (name, run-time definition if any, the saved
- *    properties by name and type name), then the instances (id, class, one length-framed value per saved
- *    property in each property type's binary form), then the top-level node ids. Errors say the byte
- *    offset.
+ *  Two formats, one API; a load recognises the format by the file's first bytes. Each has versions 1 and
+ *  2 (2 adds the run-time types); a save writes 2 only when the file carries run-time types:
+ *  - Format::Text, "vsd-text": JSON (RFC 8259), one instance per object and one property per line so
+ *    that it diffs well; each value is its type's text form (MetaType::write_text). Errors say line:col.
+ *    See docs/file-formats.md.
+ *  - Format::Binary, "VSDS": a type table (version 2), a class table (name, run-time definition if any,
+ *    the saved properties by name and type name), then the instances (id, class, one length-framed value
+ *    per saved property in each property type's binary form), then the top-level node ids. Errors say
+ *    the byte offset.
  *
  *  Loading is all or nothing: the file is read and checked into a Transaction bundle, which the target
  *  SimState checks again (ids, classes, values, reference targets, list positions, composite cycles)
@@ -61,11 +63,16 @@ struct LoadReport {
   Format format = Format::Binary;
   bool subtree = false;
   std::size_t instances = 0;
-  /// The nodes that were top level in the file (the subtree root, or the Database's children), now
-  /// attached to the target.
+  /// The format version of the file.
+  int version = 1;
+  /// The nodes that were top level in the file, now attached to the target: the Database's children in a
+  /// state file (its "top" must list the same nodes), or the nodes "top" names in a subtree file or in a
+  /// state file without a Database.
   std::vector<Node*> roots;
   /// Run-time classes the file defined that this program did not know.
   std::vector<std::string> defined_classes;
+  /// Run-time value types (enums, flags, structs) the file defined that this program did not know.
+  std::vector<std::string> defined_types;
   /// Schema differences found and handled: unknown properties, changed types.
   std::vector<std::string> warnings;
 };
@@ -80,8 +87,8 @@ std::vector<std::uint8_t> save_bytes(const Node& root, Format format = Format::B
 /// @brief Loads a whole-state file (either format) into @p state, which must be empty; ids are kept.
 LoadReport load_bytes(SimState& state, std::span<const std::uint8_t> bytes,
                       std::string_view origin = "snapshot");
-/// @brief Loads a file (either format) under @p parent; instances get fresh ids of @p parent's Environment. The
-/// file's Database stands for @p parent: its children become @p parent's, references to it point at
+/// @brief Loads a file (either format) under @p parent; instances get fresh ids of @p parent's Environment.
+/// The file's Database stands for @p parent: its children become @p parent's, references to it point at
 /// @p parent, and its own values are not copied.
 LoadReport load_bytes(Node& parent, std::span<const std::uint8_t> bytes,
                       std::string_view origin = "snapshot");
