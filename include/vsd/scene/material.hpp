@@ -7,6 +7,7 @@
 
 #include "vsd/core/meta_type_eigen.hpp"
 #include "vsd/core/named_model_instance.hpp"
+#include "vsd/scene/namespace.hpp"
 
 namespace vsd::scene {
 

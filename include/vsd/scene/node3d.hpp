@@ -26,6 +26,7 @@
 
 #include "vsd/core/meta_type_eigen.hpp"
 #include "vsd/core/node.hpp"
+#include "vsd/scene/namespace.hpp"
 
 namespace vsd::scene {
 

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "vsd/core/named_model_instance.hpp"
+#include "vsd/scene/namespace.hpp"
 
 namespace vsd::scene {
 
