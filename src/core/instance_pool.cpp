@@ -51,15 +51,12 @@ void* InstancePool::refill(const MetaInstance& cls) {
 }
 
 void InstancePool::reserve(const MetaInstance& cls, std::size_t count) {
+  // Room comes in chunks of at most chunk_bytes_cap, not in one block for all: chunks that size come
+  // from (and go back to) the allocator's heap, where one huge block would be fresh pages from the
+  // kernel, faulted in one by one, on every load.
   PerClass& c = per_class(cls);
-  std::size_t have = static_cast<std::size_t>(c.end - c.next) / c.stride;
-  for (void* p = c.free; p != nullptr && have < count; ++have) {
-    VSD_POOL_UNPOISON(p, sizeof(void*));
-    void* next = *static_cast<void**>(p);
-    VSD_POOL_POISON(p, sizeof(void*));
-    p = next;
-  }
-  if (have < count) add_chunk(c, count - have);
+  const std::size_t cap = std::max<std::size_t>(1, chunk_bytes_cap / c.stride);
+  c.chunk = std::max(c.chunk, std::min(count, cap));
 }
 
 void InstancePool::release() noexcept {

@@ -66,7 +66,8 @@ class InstancePool {
     VSD_POOL_POISON(p, c.stride);
   }
 
-  /// Reserves room for @p count more instances of @p cls in one chunk (a loader that knows its count).
+  /// Prepares for @p count more instances of @p cls (a loader that knows its count): the next chunks
+  /// are made as big as the pool allows.
   void reserve(const MetaInstance& cls, std::size_t count);
 
   /// Frees every chunk. Only when no instance lives in the pool any more.
