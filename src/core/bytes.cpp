@@ -10,7 +10,7 @@ namespace vsd {
 static_assert(std::endian::native == std::endian::little,
               "vsd's binary encoding assumes a little-endian host");
 
-std::uint64_t ByteReader::varint() {
+std::uint64_t ByteReader::varint_long() {
   std::uint64_t v = 0;
   for (int shift = 0; shift < 64; shift += 7) {
     const std::uint8_t b = u8();
@@ -20,22 +20,9 @@ std::uint64_t ByteReader::varint() {
   fail("varint longer than 10 bytes");
 }
 
-std::size_t ByteReader::size_prefix(std::size_t min_element_bytes) {
-  const std::size_t at = pos_;
-  const std::uint64_t n = varint();
-  if (min_element_bytes == 0) min_element_bytes = 1;
-  if (n > remaining() / min_element_bytes) {
-    pos_ = at;
-    fail("size " + std::to_string(n) + " exceeds the " + std::to_string(remaining()) + " bytes that remain");
-  }
-  return static_cast<std::size_t>(n);
-}
-
-std::string_view ByteReader::string_view() {
-  const std::size_t n = size_prefix(1);
-  std::string_view s(reinterpret_cast<const char*>(data_ + pos_), n);
-  pos_ += n;
-  return s;
+void ByteReader::size_too_big(std::size_t at, std::uint64_t n) {
+  pos_ = at;
+  fail("size " + std::to_string(n) + " exceeds the " + std::to_string(remaining()) + " bytes that remain");
 }
 
 std::string ByteReader::string() { return std::string(string_view()); }

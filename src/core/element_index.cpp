@@ -39,20 +39,6 @@ ElementIndex::InstanceSignal& ElementIndex::on_deleted(const MetaInstance& m, bo
   return *slot;
 }
 
-void ElementIndex::add(SimStateInstance& i) {
-  auto& items = bucket(i.meta()).items;
-  i.index_pos_ = static_cast<std::uint32_t>(items.size());
-  items.push_back(&i);
-}
-
-void ElementIndex::remove(SimStateInstance& i) noexcept {
-  auto& items = buckets_[i.meta().index()].items;
-  SimStateInstance* last = items.back();
-  items[i.index_pos_] = last;  // swap-remove keeps every operation O(1)
-  last->index_pos_ = i.index_pos_;
-  items.pop_back();
-}
-
 std::vector<ElementIndex::InstanceSignal*> ElementIndex::listeners(const SimStateInstance& i, bool created) {
   // Collected before emitting: a listener may define a class and grow the bucket table.
   std::vector<InstanceSignal*> out;

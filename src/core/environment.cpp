@@ -41,11 +41,18 @@ std::vector<SimState*> Environment::states() const {
 
 Id Environment::next_id() noexcept { return next_id_.fetch_add(1, std::memory_order_relaxed); }
 
+Id Environment::next_ids(std::size_t count) noexcept {
+  return next_id_.fetch_add(count, std::memory_order_relaxed);
+}
+
 void Environment::reserve_ids_through(Id id) noexcept {
   if ((id >> 48) != site_) return;  // another site's ids never meet ours
   Id current = next_id_.load(std::memory_order_relaxed);
+  if (current > id) return;
   while (current <= id && !next_id_.compare_exchange_weak(current, id + 1, std::memory_order_relaxed)) {
   }
+  // Blocks of ids that SimStates took earlier may hold the ids just reserved: make them take new ones.
+  id_generation_.fetch_add(1, std::memory_order_release);
 }
 
 Module* Environment::find_module(std::type_index t) const noexcept {

@@ -210,17 +210,22 @@ SimStateInstance* MetaInstance::construct(void* memory) const {
     void* at = static_cast<char*>(memory) + p->offset();
     p->type().ops().bind(p->type(), at, obj, p);
   }
-  live_.fetch_add(1, std::memory_order_relaxed);
+  // Only run-time classes are counted: an atomic add costs more than the rest of a pooled create.
+  if (runtime_) live_.fetch_add(1, std::memory_order_relaxed);
   return obj;
 }
 
-void MetaInstance::destroy(SimStateInstance* obj) const noexcept {
+void MetaInstance::destruct(SimStateInstance* obj) const noexcept {
   for (const MetaInstance* m = this; m != nullptr && m->runtime_; m = m->base_)
     for (std::size_t i = m->own_props_.size(); i-- > 0;)
       m->own_props_[i]->type().destroy(reinterpret_cast<char*>(obj) + m->own_props_[i]->offset());
   obj->~SimStateInstance();
+  if (runtime_) live_.fetch_sub(1, std::memory_order_relaxed);
+}
+
+void MetaInstance::destroy(SimStateInstance* obj) const noexcept {
+  destruct(obj);
   ::operator delete(static_cast<void*>(obj), std::align_val_t(align_));
-  live_.fetch_sub(1, std::memory_order_relaxed);
 }
 
 // ---- ClassBuilder -----------------------------------------------------------------------------------------

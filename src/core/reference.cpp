@@ -41,6 +41,26 @@ struct RefAccess {
 
   // True when @p t holds @p h through a chain of composite references (so h -> t would close a cycle).
   static bool composite_ancestor(const SimStateInstance& t, const SimStateInstance& h) {
+    // Fast path, no allocation: in a tree every instance has at most one composite holder, so the walk
+    // is a chain up to a root. The general walk below takes over at the first instance held twice.
+    // (Bounded, so that even a broken invariant could never make it loop.)
+    const SimStateInstance* x = &h;
+    for (int steps = 0; steps < 256; ++steps) {
+      if (x == &t) return true;
+      const SimStateInstance* up = nullptr;
+      bool branches = false;
+      for (const RefLink* l = x->composite_head_; l != nullptr; l = l->next) {
+        if (l->holder == nullptr) continue;
+        if (up != nullptr && up != l->holder) {
+          branches = true;
+          break;
+        }
+        up = l->holder;
+      }
+      if (branches) break;
+      if (up == nullptr) return false;
+      x = up;
+    }
     std::vector<const SimStateInstance*> todo{&h}, seen;
     while (!todo.empty()) {
       const SimStateInstance* x = todo.back();

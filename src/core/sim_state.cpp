@@ -36,9 +36,10 @@ SimState::~SimState() {
     while (x->composite_head_ != nullptr) x->composite_head_->drop();
     while (x->shared_head_ != nullptr) x->shared_head_->drop();
   });
-  by_id_.for_each([](Id, SimStateInstance* x) { x->meta().destroy(x); });
+  by_id_.for_each([](Id, SimStateInstance* x) { x->meta().destruct(x); });
   by_id_.clear();
   free_graveyard();
+  // pool_ frees the memory of them all when it dies.
 }
 
 void SimState::free_graveyard() noexcept {
@@ -47,37 +48,64 @@ void SimState::free_graveyard() noexcept {
     graveyard_.pop_back();
     while (x->composite_head_ != nullptr) x->composite_head_->drop();  // free references still held
     while (x->shared_head_ != nullptr) x->shared_head_->drop();
-    x->meta().destroy(x);
+    free_instance(*x);
   }
 }
 
-SimStateInstance& SimState::make(const MetaInstance& cls, Id id) {
+inline Id SimState::fresh_id() noexcept {
+  if (VSD_UNLIKELY(id_next_ == id_end_ || id_generation_ != env_->id_generation())) take_ids();
+  return id_next_++;
+}
+
+void SimState::take_ids() noexcept {
+  // The generation is read before the block is taken: a reservation in between only makes the next
+  // create take yet another block.
+  id_generation_ = env_->id_generation();
+  id_next_ = env_->next_ids(id_block);
+  id_end_ = id_next_ + id_block;
+}
+
+void SimState::check_class(const MetaInstance& cls) {
   if (!cls.is_a(SimStateInstance::static_meta()))
     detail::throw_error("class '" + cls.name() + "' is not a SimStateInstance and cannot live in a SimState");
   if (cls.is_abstract())
     detail::throw_error("class '" + cls.name() + "' is abstract and cannot be instantiated");
   if (root_ != nullptr && cls.is_a(Database::static_meta()))
     detail::throw_error("SimState '" + name_ + "' already has its Database");
-  if (by_id_.contains(id))
+  // The answer depends on the class alone once the Database exists; class indexes are never reused.
+  if (root_ != nullptr) checked_class_ = cls.index();
+}
+
+SimStateInstance& SimState::make(const MetaInstance& cls, Id id) {
+  if (cls.index() != checked_class_) check_class(cls);
+  SimStateInstance** slot = by_id_.try_insert(id);
+  if (slot == nullptr)
     detail::throw_error("SimState '" + name_ + "' already has an instance #" + std::to_string(id));
-  void* memory = ::operator new(cls.size(), std::align_val_t(cls.alignment()));
   SimStateInstance* obj = nullptr;
   try {
-    obj = cls.construct(memory);
+    void* memory = pool_.allocate(cls);
+    try {
+      obj = cls.construct(memory);
+    } catch (...) {
+      pool_.deallocate(cls, memory);
+      throw;
+    }
   } catch (...) {
-    ::operator delete(memory, std::align_val_t(cls.alignment()));
+    by_id_.erase(id);
     throw;
   }
+  *slot = obj;
   obj->state_ = this;
   obj->id_ = id;
   obj->life_ = SimStateInstance::floating_bit;
   obj->watch_ = state_watch_ ? SimStateInstance::state_watch : 0;
-  by_id_.insert(id, obj);
   index_.add(*obj);
   return *obj;
 }
 
 void SimState::finish_create(SimStateInstance& inst) {
+  // Nobody to tell and nothing to record: no dispatch either (nothing can be deleted meanwhile).
+  if (!recording_ && !created_.has_listeners() && !index_.has_signals()) return;
   Dispatch d(*this);
   if (recording_) {
     detail::write_lifecycle(recorded_, Transaction::Op::Create, inst);
@@ -88,12 +116,14 @@ void SimState::finish_create(SimStateInstance& inst) {
 }
 
 SimStateInstance& SimState::create(const MetaInstance& cls) {
-  Dispatch d(*this);  // an instance deleted by a creation listener stays allocated until the check below
-  SimStateInstance& inst = make(cls, env_->next_id());
-  finish_create(inst);
-  if (VSD_UNLIKELY(inst.is_being_deleted()))
-    detail::throw_error("the new instance #" + std::to_string(inst.id()) + " of class '" + cls.name() +
-                        "' was deleted by a listener of its creation");
+  SimStateInstance& inst = make(cls, fresh_id());
+  if (recording_ || created_.has_listeners() || index_.has_signals()) {
+    Dispatch d(*this);  // an instance deleted by a creation listener stays allocated until the check below
+    finish_create(inst);
+    if (VSD_UNLIKELY(inst.is_being_deleted()))
+      detail::throw_error("the new instance #" + std::to_string(inst.id()) + " of class '" + cls.name() +
+                          "' was deleted by a listener of its creation");
+  }
   return inst;
 }
 
@@ -123,6 +153,16 @@ void SimState::destroy(SimStateInstance& x) {
                         "', not '" + name_ + "'");
   if (&x == root_) detail::throw_error("the Database of SimState '" + name_ + "' cannot be deleted");
   if (x.is_being_deleted()) return;
+  if (dispatching_ == 0 && stands_alone(x)) {
+    // No step of the deletion can call out (nobody listens, nothing is recorded, x holds and is held by
+    // nothing) and no dispatch is running: x goes at once, without a dispatch and the graveyard.
+    x.life_ |= SimStateInstance::dying_bit;
+    by_id_.erase(x.id_);
+    index_.remove(x);
+    if (!instance_signals_.empty()) instance_signals_.erase(&x);
+    free_instance(x);
+    return;
+  }
   Dispatch d(*this);
   x.life_ |= SimStateInstance::dying_bit;
   deleted_.emit(x);
@@ -131,7 +171,8 @@ void SimState::destroy(SimStateInstance& x) {
   while (x.composite_head_ != nullptr) detach_link(*x.composite_head_);
   // 2. Release what x holds; composite targets that nothing else holds go with it.
   const auto refs = x.meta().reference_properties();
-  for (auto it = refs.rbegin(); it != refs.rend(); ++it) clear_reference(x, **it);
+  for (auto it = refs.rbegin(); it != refs.rend(); ++it)
+    if (!holds_nothing(x, **it)) clear_reference(x, **it);
   // 3. Null shared references to x; their holders are told through their change signals.
   while (x.shared_head_ != nullptr) detach_link(*x.shared_head_);
   if (recording_) {
@@ -142,6 +183,26 @@ void SimState::destroy(SimStateInstance& x) {
   index_.remove(x);
   if (!instance_signals_.empty()) instance_signals_.erase(&x);
   graveyard_.push_back(&x);
+}
+
+bool SimState::stands_alone(const SimStateInstance& x) const noexcept {
+  if (recording_ || deleted_.has_listeners() || index_.has_signals()) return false;
+  if (x.composite_head_ != nullptr || x.shared_head_ != nullptr) return false;
+  for (const MetaProperty* p : x.meta().reference_properties())
+    if (!holds_nothing(x, *p)) return false;
+  return true;
+}
+
+void SimState::free_instance(SimStateInstance& x) noexcept {
+  const MetaInstance& cls = x.meta();
+  cls.destruct(&x);
+  pool_.deallocate(cls, &x);
+}
+
+bool SimState::holds_nothing(const SimStateInstance& inst, const MetaProperty& p) noexcept {
+  const void* at = p.address(inst);
+  return p.type().is_ref_list() ? static_cast<const RefListBase*>(at)->empty()
+                                : static_cast<const RefBase*>(at)->get() == nullptr;
 }
 
 void SimState::detach_link(detail::RefLink& link) {

@@ -295,6 +295,7 @@ class Applier {
       TxParser parser(t_);
       for (std::size_t i = 0; parser.next(op); ++i) check(op, i);
     }
+    reserve();
     ++s_.applying_;
     struct Done {
       SimState& s;
@@ -338,6 +339,28 @@ class Applier {
     return c;
   }
 
+  // A big bundle (a load) makes room for its instances at once: the id map, the element index and the
+  // instance memory of the state grow once instead of step by step. Creates that the bundle deletes
+  // again are counted too; their room stays for later instances.
+  void count_create(const MetaInstance& cls) {
+    ++creates_;
+    if (!per_class_.empty() && per_class_.back().first == &cls) {
+      ++per_class_.back().second;
+      return;
+    }
+    for (auto& [c, n] : per_class_)
+      if (c == &cls) {
+        ++n;
+        return;
+      }
+    per_class_.emplace_back(&cls, 1);
+  }
+  void reserve() {
+    if (creates_ < 64) return;  // not worth it for small bundles
+    s_.by_id_.reserve(s_.by_id_.size() + creates_);
+    for (const auto& [cls, n] : per_class_) s_.reserve_instances(*cls, n);
+  }
+
   // ---- the model used by the dry run ----
   const MetaInstance* class_of(Id id) const {
     if (id == null_id || deleted_.contains(id)) return nullptr;
@@ -347,8 +370,13 @@ class Applier {
   }
   std::vector<Id>& list_model(Id holder, const MetaProperty& p) {
     auto key = std::make_pair(holder, &p);
+    // A bundle fills one list after the other: remember the last one (map nodes never move).
+    if (last_list_ != nullptr && last_list_key_ == key) return *last_list_;
     auto it = lists_.find(key);
-    if (it != lists_.end()) return it->second;
+    if (it != lists_.end()) {
+      last_list_key_ = key;
+      return *(last_list_ = &it->second);
+    }
     std::vector<Id> ids;
     if (!created_.contains(holder)) {
       if (const SimStateInstance* x = s_.find(holder)) {
@@ -357,12 +385,16 @@ class Applier {
           if (!deleted_.contains(list.at(i)->id())) ids.push_back(list.at(i)->id());
       }
     }
-    return lists_.emplace(key, std::move(ids)).first->second;
+    last_list_key_ = key;
+    return *(last_list_ = &lists_.emplace(key, std::move(ids)).first->second);
   }
   const MetaProperty& property_of(const TxOp& op, std::size_t n, const MetaInstance& cls) const {
-    const MetaProperty* p = cls.find_property(op.name);
-    if (p == nullptr)
-      fail(op, n, "class '" + cls.name() + "' has no property '" + std::string(op.name) + "'");
+    return property_named(op, n, cls, op.name);
+  }
+  const MetaProperty& property_named(const TxOp& op, std::size_t n, const MetaInstance& cls,
+                                     std::string_view name) const {
+    const MetaProperty* p = cls.find_property(name);
+    if (p == nullptr) fail(op, n, "class '" + cls.name() + "' has no property '" + std::string(name) + "'");
     return *p;
   }
   void check_target(const TxOp& op, std::size_t n, Id id, const MetaType& t) const {
@@ -416,14 +448,13 @@ class Applier {
             (!created_.contains(op.id) && !deleted_.contains(op.id) && s_.by_id_.contains(op.id)))
           fail(op, n, "instance #" + std::to_string(op.id) + " already exists");
         for (const auto& [name, bytes] : op.values) {
-          TxOp sub = op;
-          sub.name = name;
-          const MetaProperty& p = property_of(sub, n, *cls);
+          const MetaProperty& p = property_named(op, n, *cls, name);
           if (!carried_in_payload(p)) fail(op, n, "property '" + p.name() + "' cannot be part of a create");
           check_value(op, n, p, bytes);
         }
         deleted_.erase(op.id);
         created_.assign(op.id, cls);
+        count_create(*cls);
         break;
       }
       case Transaction::Op::Delete: {
@@ -629,9 +660,13 @@ class Applier {
   const Transaction& t_;
   bool values_checked_;
   const MetaInstance* last_class_ = nullptr;
+  std::size_t creates_ = 0;
+  std::vector<std::pair<const MetaInstance*, std::size_t>> per_class_;  // creates by class
   FlatIdMap<const MetaInstance*> created_;
   FlatIdMap<bool> deleted_;
   std::map<std::pair<Id, const MetaProperty*>, std::vector<Id>> lists_;
+  std::pair<Id, const MetaProperty*> last_list_key_{null_id, nullptr};
+  std::vector<Id>* last_list_ = nullptr;  // lists_[last_list_key_]
   std::map<std::pair<Id, const MetaProperty*>, Id> singles_;
   FlatIdMap<Id> added_first_;                           // child -> first composite holder gained
   std::unordered_map<Id, std::vector<Id>> added_more_;  // child -> further composite holders gained

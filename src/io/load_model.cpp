@@ -309,6 +309,7 @@ LoadReport LoadModel::apply(SimState& state, Node* parent) {
   // A whole-state load keeps every id but the Database's: no map needed.
   vsd::detail::FlatIdMap<Id> map;
   const SavedInstance* saved_root = file_root_;
+  Id highest = null_id;  // reserved once: each reservation makes the SimStates drop their blocks of ids
   for (const SavedInstance& x : instances_) {
     if (&x == saved_root) {
       // Loaded under a node, the file's Database *is* that node: its children become the node's, and
@@ -317,13 +318,14 @@ LoadReport LoadModel::apply(SimState& state, Node* parent) {
       continue;
     }
     if (whole) {
-      if (state.find(x.id) != nullptr)
-        fail_at(x.offset, "instance #" + std::to_string(x.id) + " already exists");
-      env.reserve_ids_through(x.id);
+      if (state.find(x.id) != nullptr) fail_at(x.offset, "instance #" + std::to_string(x.id) + " already exists");
+      // (Ids of other sites never meet ours.)
+      if ((x.id >> 48) == env.site()) highest = std::max(highest, x.id);
     } else {
       map.insert(x.id, env.next_id());
     }
   }
+  if (highest != null_id) env.reserve_ids_through(highest);
   const Id file_database = saved_root != nullptr ? saved_root->id : null_id;
   auto mapped = [&](Id id) {
     if (id == null_id) return null_id;

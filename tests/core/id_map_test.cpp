@@ -49,4 +49,32 @@ TEST(IdMap, EraseOfAMissingIdChangesNothing) {
   EXPECT_EQ(map.find(5), nullptr);
 }
 
+TEST(IdMap, TryInsertChecksAndInsertsInOneProbe) {
+  vsd::detail::IdMap map;
+  vsd::SimStateInstance** slot = map.try_insert(42);
+  ASSERT_NE(slot, nullptr);
+  EXPECT_EQ(*slot, nullptr) << "a new entry starts empty";
+  *slot = fake(42);
+  EXPECT_EQ(map.find(42), fake(42));
+  EXPECT_EQ(map.try_insert(42), nullptr) << "a present id is refused";
+  EXPECT_EQ(map.find(42), fake(42)) << "and left as it was";
+  EXPECT_EQ(map.size(), 1u);
+}
+
+TEST(IdMap, ReserveKeepsEntriesAndStopsGrowth) {
+  vsd::detail::IdMap map;
+  for (vsd::Id id = 1; id <= 100; ++id) map.insert(id, fake(id));
+  map.reserve(100000);
+  EXPECT_EQ(map.size(), 100u);
+  for (vsd::Id id = 1; id <= 100; ++id) ASSERT_EQ(map.find(id), fake(id));
+  // Entries up to the reserved count land without a rehash: the table (and so a slot) stays put.
+  vsd::SimStateInstance** first = map.try_insert(1000);
+  ASSERT_NE(first, nullptr);
+  *first = fake(1000);
+  for (vsd::Id id = 101; id < 50000; ++id) map.insert(id, fake(id));
+  EXPECT_EQ(*first, fake(1000));
+  map.reserve(10);  // never shrinks
+  EXPECT_EQ(map.find(49999), fake(49999));
+}
+
 }  // namespace

@@ -69,11 +69,26 @@ class ByteReader {
     pos_ += sizeof(T);
     return v;
   }
-  std::uint64_t varint();
+  std::uint64_t varint() {
+    // Most varints of a file are one byte (sizes, small ids, enum values): no loop for them.
+    if (VSD_LIKELY(pos_ < size_) && data_[pos_] < 0x80) return data_[pos_++];
+    return varint_long();
+  }
   /// @brief A size that announces @p min_element_bytes per element: rejects sizes the data cannot hold.
-  std::size_t size_prefix(std::size_t min_element_bytes = 1);
+  std::size_t size_prefix(std::size_t min_element_bytes = 1) {
+    const std::size_t at = pos_;
+    const std::uint64_t n = varint();
+    if (VSD_UNLIKELY(min_element_bytes <= 1 ? n > remaining() : n > remaining() / min_element_bytes))
+      size_too_big(at, n);
+    return static_cast<std::size_t>(n);
+  }
   std::string string();
-  std::string_view string_view();
+  std::string_view string_view() {
+    const std::size_t n = size_prefix(1);
+    std::string_view s(reinterpret_cast<const char*>(data_ + pos_), n);
+    pos_ += n;
+    return s;
+  }
   void raw(void* p, std::size_t n) {
     need(n);
     if (n != 0) std::memcpy(p, data_ + pos_, n);  // p may be null when n is 0 (an empty vector)
@@ -98,6 +113,8 @@ class ByteReader {
   void need(std::size_t n) const {
     if (VSD_UNLIKELY(n > size_ - pos_)) fail("truncated data");
   }
+  std::uint64_t varint_long();
+  [[noreturn]] void size_too_big(std::size_t at, std::uint64_t n);
   const std::uint8_t* data_;
   std::size_t size_;
   std::size_t pos_ = 0;

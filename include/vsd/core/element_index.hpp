@@ -56,8 +56,25 @@ class ElementIndex {
     std::unique_ptr<InstanceSignal> created_exact, created_tree, deleted_exact, deleted_tree;
   };
   Bucket& bucket(const MetaInstance& m);
-  void add(SimStateInstance& i);
-  void remove(SimStateInstance& i) noexcept;
+  [[nodiscard]] bool has_signals() const noexcept { return signals_ != 0; }
+  void add(SimStateInstance& i) {
+    const std::size_t k = i.meta().index();
+    auto& items = (VSD_LIKELY(k < buckets_.size()) ? buckets_[k] : bucket(i.meta())).items;
+    i.index_pos_ = static_cast<std::uint32_t>(items.size());
+    items.push_back(&i);
+  }
+  void remove(SimStateInstance& i) noexcept {
+    auto& items = buckets_[i.meta().index()].items;
+    SimStateInstance* last = items.back();
+    items[i.index_pos_] = last;  // swap-remove keeps every operation O(1)
+    last->index_pos_ = i.index_pos_;
+    items.pop_back();
+  }
+  /// Makes room for @p count more instances of exactly @p m.
+  void reserve(const MetaInstance& m, std::size_t count) {
+    auto& items = bucket(m).items;
+    items.reserve(items.size() + count);
+  }
   std::vector<InstanceSignal*> listeners(const SimStateInstance& i, bool created);
   void emit_created(SimStateInstance& i);
   void emit_deleted(SimStateInstance& i);

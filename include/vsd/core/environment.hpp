@@ -42,6 +42,14 @@ class Environment : public Instance {
   [[nodiscard]] std::vector<SimState*> states() const;
   /// @brief A fresh id, unique in this environment. Thread-safe.
   [[nodiscard]] Id next_id() noexcept;
+  /// @brief @p count consecutive fresh ids, unique in this environment; returns the first. Thread-safe.
+  /// A SimState takes its ids in such blocks, so that creating an instance costs no atomic operation.
+  [[nodiscard]] Id next_ids(std::size_t count) noexcept;
+  /// @brief Changes whenever reserve_ids_through() moves the id counter: a block of ids taken before
+  /// may then hold ids that arrived from outside, and its holder must take a new one. Thread-safe.
+  [[nodiscard]] std::uint64_t id_generation() const noexcept {
+    return id_generation_.load(std::memory_order_acquire);
+  }
   /// @brief Makes sure next_id() never hands out @p id or a smaller id of this site (instances that
   /// arrive with their ids, e.g. from a file, keep them). Thread-safe.
   void reserve_ids_through(Id id) noexcept;
@@ -79,6 +87,7 @@ class Environment : public Instance {
   Registry* registry_;
   std::uint16_t site_;
   std::atomic<std::uint64_t> next_id_{2};  // 1 is every SimState's Database
+  std::atomic<std::uint64_t> id_generation_{0};
   std::vector<std::unique_ptr<SimState>> states_;
   std::vector<std::pair<std::type_index, std::unique_ptr<Module>>> modules_;
   Scheduler scheduler_;

@@ -157,9 +157,15 @@ class MetaInstance {
 
   /// @brief Makes an instance in @p memory (size() bytes, alignment() aligned). Used by SimState.
   SimStateInstance* construct(void* memory) const;
-  /// @brief Destroys an instance made by construct() and frees its memory.
+  /// @brief Destroys an instance made by construct() and frees its memory (`::operator delete` with
+  /// alignment()).
   void destroy(SimStateInstance* obj) const noexcept;
-  /// @brief Number of live instances of exactly this class, in all SimStates.
+  /// @brief Destroys an instance made by construct() and leaves its memory to the caller (a SimState
+  /// reuses it for its next instance of this class).
+  void destruct(SimStateInstance* obj) const noexcept;
+  /// @brief Number of live instances of exactly this class, in all SimStates. Counted for run-time
+  /// classes only (Registry::undefine needs the count); a built-in class, which is never undefined,
+  /// reports 0, so that its instances are made and deleted without an atomic operation.
   [[nodiscard]] std::size_t live_instances() const noexcept { return live_.load(std::memory_order_relaxed); }
 
   // ---- building (declaration macros, ClassBuilder) ----

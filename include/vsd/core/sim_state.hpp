@@ -9,6 +9,12 @@
  *  released, or until the SimState is destroyed. Deleting an instance deletes the composite subtree that
  *  nothing else holds, nulls every shared reference to it (signalling the holders), and is recorded as
  *  the sequence of those steps, so that a replica applying the bundle ends equal to the source.
+ *
+ *  Memory: a SimState keeps the memory of its deleted instances and reuses it for its next instances of
+ *  the same class (detail::InstancePool); it goes back to the system when the SimState is destroyed.
+ *  An instance deleted while a signal is being dispatched stays allocated until the outermost dispatch
+ *  ends. Ids are taken from the Environment in blocks (Environment::next_ids), so they are unique in the
+ *  Environment but not consecutive across SimStates.
  */
 #pragma once
 
@@ -22,6 +28,7 @@
 #include "vsd/core/database.hpp"
 #include "vsd/core/declare.hpp"
 #include "vsd/core/detail/id_map.hpp"
+#include "vsd/core/detail/instance_pool.hpp"
 #include "vsd/core/element_index.hpp"
 #include "vsd/core/transaction.hpp"
 
@@ -119,10 +126,22 @@ class SimState : public Instance {
   friend class detail::Applier;
 
   SimStateInstance& make(const MetaInstance& cls, Id id);
+  void check_class(const MetaInstance& cls);  // may cls live here? (throws when not)
+  void reserve_instances(const MetaInstance& cls, std::size_t count) {  // room for count more of cls
+    index_.reserve(cls, count);
+    pool_.reserve(cls, count);
+  }
+  /// The next id of the block this state took from its Environment (see Environment::next_ids).
+  Id fresh_id() noexcept;
+  void take_ids() noexcept;
+  static constexpr std::size_t id_block = 64;
   void finish_create(SimStateInstance& inst);
   void released(SimStateInstance& inst);  // last composite reference went away
   void detach_link(detail::RefLink& link);
   void clear_reference(SimStateInstance& inst, const MetaProperty& p);
+  static bool holds_nothing(const SimStateInstance& inst, const MetaProperty& p) noexcept;
+  bool stands_alone(const SimStateInstance& x) const noexcept;  // can x be freed without telling anyone?
+  void free_instance(SimStateInstance& x) noexcept;             // destructors, then back to the pool
   void enable_state_watch();
   static void watch_hook(void* state);
   bool state_watch_wanted() const noexcept;
@@ -136,6 +155,7 @@ class SimState : public Instance {
 
   Environment* env_;
   std::string name_;
+  detail::InstancePool pool_;  // the memory of the instances; declared first, so it dies last
   Database* root_ = nullptr;
   detail::IdMap by_id_;
   ElementIndex index_;
@@ -154,6 +174,10 @@ class SimState : public Instance {
   int applying_ = 0;
   bool recording_ = false;
   bool state_watch_ = false;
+  Id id_next_ = null_id;  // ids of the current block: [id_next_, id_end_)
+  Id id_end_ = null_id;
+  std::uint64_t id_generation_ = 0;
+  std::size_t checked_class_ = static_cast<std::size_t>(-1);  // index of the last class make() accepted
 };
 
 }  // namespace vsd

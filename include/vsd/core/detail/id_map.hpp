@@ -51,6 +51,27 @@ class FlatIdMap {
       if (e.id == id) return false;
     }
   }
+  /// Inserts @p id with an empty value and returns where its value goes (valid until the next insert),
+  /// or nullptr (changing nothing) when @p id is present: one probe for a check and an insert.
+  V* try_insert(Id id) {
+    VSD_ASSERT(id != null_id, "id 0 cannot be a key");
+    if ((size_ + 1) * 2 > table_.size()) grow();
+    for (std::size_t i = slot(id);; i = (i + 1) & mask_) {
+      Entry& e = table_[i];
+      if (e.id == null_id) {
+        e = Entry{id, V{}};
+        ++size_;
+        return &e.value;
+      }
+      if (e.id == id) return nullptr;
+    }
+  }
+  /// Makes room for @p count entries in all, so that inserting them does not grow the table.
+  void reserve(std::size_t count) {
+    std::size_t want = 16;
+    while (want < count * 2) want *= 2;
+    if (want > table_.size()) rehash(want);
+  }
   /// Inserts or overwrites.
   void assign(Id id, V value) {
     if (V* v = get(id)) {
@@ -112,10 +133,11 @@ class FlatIdMap {
     const std::uint64_t site = id >> 48;
     return static_cast<std::size_t>(id ^ (site * 0x9E3779B97F4A7C15ULL)) & mask_;
   }
-  void grow() {
+  void grow() { rehash(table_.empty() ? 16 : table_.size() * 2); }
+  void rehash(std::size_t capacity) {
     std::vector<Entry> old;
     old.swap(table_);
-    table_.assign(old.empty() ? 16 : old.size() * 2, Entry{});
+    table_.assign(capacity, Entry{});
     mask_ = table_.size() - 1;
     size_ = 0;
     for (const Entry& e : old)
