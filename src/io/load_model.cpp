@@ -128,6 +128,15 @@ Slot LoadModel::make_slot(std::size_t at, const MetaInstance& cls, std::string_v
     if (!type_name.empty()) s.file_type = registry_.find_type(type_name);  // may be unknown
     return s;
   }
+  if (!s.prop->has(Savable) || s.prop->has(Transient)) {
+    // A load gives exactly what a save writes: values of a property this program does not save (a file
+    // made elsewhere, or by hand) are dropped, so that saving the loaded state loses nothing it holds.
+    warnings_.push_back("property '" + cls.name() + "::" + s.prop->name() +
+                        "' is not saved by this program (not Savable, or Transient): its values are dropped");
+    if (!type_name.empty()) s.file_type = registry_.find_type(type_name);  // may be unknown
+    s.prop = nullptr;
+    return s;
+  }
   if (type_name.empty()) {  // the file does not say: read as today's type
     s.file_type = &s.prop->type();
     return s;
@@ -318,7 +327,8 @@ LoadReport LoadModel::apply(SimState& state, Node* parent) {
       continue;
     }
     if (whole) {
-      if (state.find(x.id) != nullptr) fail_at(x.offset, "instance #" + std::to_string(x.id) + " already exists");
+      if (state.find(x.id) != nullptr)
+        fail_at(x.offset, "instance #" + std::to_string(x.id) + " already exists");
       // (Ids of other sites never meet ours.)
       if ((x.id >> 48) == env.site()) highest = std::max(highest, x.id);
     } else {

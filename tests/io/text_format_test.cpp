@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <sstream>
 
@@ -37,7 +38,8 @@ void build_golden_model(vsd::SimState& s) {
   rich.set_mode(vsd_test::IoMode::Fault);
   rich.set_caps(static_cast<vsd_test::IoCaps>(1 | 8 | 16));
   rich.set_step({"first", {1.5, -2, 0.25F}, vsd_test::IoMode::Run, {{1, 2, 3}}});
-  rich.set_plan({{"a", {}, vsd_test::IoMode::Idle, {}}, {"b", {0, 1, 0}, static_cast<vsd_test::IoMode>(3), {}}});
+  rich.set_plan(
+      {{"a", {}, vsd_test::IoMode::Idle, {}}, {"b", {0, 1, 0}, static_cast<vsd_test::IoMode>(3), {}}});
   rich.set_tags({"x", "", "tab\there"});
   rich.set_small(-128);
   rich.set_big(18446744073709551615ULL);
@@ -58,7 +60,8 @@ TEST(TextFormat, GoldenFileIsStable) {
   vsd::Environment env;
   build_golden_model(env.main_state());
   const std::string text = text_of(vsd::io::save_bytes(env.main_state(), Format::Text));
-  if (std::getenv("VSD_UPDATE_GOLDEN") != nullptr) vsd::io::write_file_atomically(golden_path("model.json"), bytes_of(text));
+  if (std::getenv("VSD_UPDATE_GOLDEN") != nullptr)
+    vsd::io::write_file_atomically(golden_path("model.json"), bytes_of(text));
   EXPECT_EQ(text, read_golden("model.json"));
   // And it loads back into the same model.
   vsd::Environment other;
@@ -85,6 +88,33 @@ TEST(TextFormat, HandWrittenFilesLoad) {
   EXPECT_EQ(rich->caps(), static_cast<vsd_test::IoCaps>(3));
   EXPECT_EQ(rich->step().pose.y, 4);
   EXPECT_TRUE(report.warnings.empty()) << report.warnings.front();
+}
+
+TEST(TextFormat, ValuesOfPropertiesThatAreNotSavedAreDroppedWithAWarning) {
+  // Found by the snapshot fuzzer: a file may carry values of a property this program does not save
+  // (Transient, or not Savable). Loading them would make "save what was loaded" lose them; they are
+  // dropped, so a load gives exactly what a save writes.
+  const std::string file = R"({"format": "vsd-text", "version": 1, "kind": "state",
+    "classes": [{"class": "TRobot", "saved": {"speed": "double", "cache": "string"}}],
+    "instances": [
+      {"@id": 1, "@class": "Database", "children": ["@2"]},
+      {"@id": 2, "@class": "TRobot", "speed": 3, "cache": "from the file"}
+    ],
+    "top": ["@2"]})";
+  vsd::Environment env;
+  vsd::SimState& state = env.main_state();
+  const auto report = vsd::io::load_bytes(state, bytes_of(file), "hand.json");
+  ASSERT_EQ(report.roots.size(), 1u);
+  auto& robot = dynamic_cast<vsd_test::TRobot&>(*report.roots[0]);
+  EXPECT_EQ(robot.speed(), 3.0);
+  EXPECT_EQ(robot.cache(), "") << "a Transient property keeps its default";
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_THAT(report.warnings[0], HasSubstr("'cache'"));
+  EXPECT_THAT(report.warnings[0], HasSubstr("dropped"));
+  vsd::SimState& again = env.create_state("again");
+  (void)vsd::io::load_bytes(again, vsd::io::save_bytes(state, Format::Binary), "resaved");
+  std::string difference;
+  EXPECT_TRUE(again.equals(state, &difference)) << difference;
 }
 
 // ---- every kind of value, both formats ----
@@ -132,7 +162,8 @@ TEST_P(RichRandomModels, RoundTripToEqualStates) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Seeds, RichRandomModels,
-                         testing::Combine(testing::Values(21u, 22u, 23u), testing::Values(Format::Binary, Format::Text)),
+                         testing::Combine(testing::Values(21u, 22u, 23u),
+                                          testing::Values(Format::Binary, Format::Text)),
                          [](const auto& info) {
                            return (std::get<1>(info.param) == Format::Text ? "Text" : "Binary") +
                                   std::to_string(std::get<0>(info.param));
@@ -193,9 +224,11 @@ TEST_F(BadText, CorruptionNeverCrashesOrHalfLoads) {
 TEST_F(BadText, WrongTypesSayWhereAndWhat) {
   EXPECT_EQ(load_error(robot_file("  \"speed\": \"fast\"")),
             "model.json:4:12: expected a number, found the string \"fast\"");
-  EXPECT_THAT(load_error(robot_file("  \"axes\": 1.5")), HasSubstr("model.json:4:11: '1.5' is not an integer"));
+  EXPECT_THAT(load_error(robot_file("  \"axes\": 1.5")),
+              HasSubstr("model.json:4:11: '1.5' is not an integer"));
   EXPECT_THAT(load_error(robot_file("  \"axes\": 99999999999")), HasSubstr("model.json:4:11:"));
-  EXPECT_THAT(load_error(robot_file("  \"joints\": [1, true]")), HasSubstr("model.json:4:17: 'true' is not a number"));
+  EXPECT_THAT(load_error(robot_file("  \"joints\": [1, true]")),
+              HasSubstr("model.json:4:17: 'true' is not a number"));
   EXPECT_THAT(load_error(robot_file("  \"frame\": {\"translation\": [1, 2]}")), HasSubstr("model.json:4:"));
   EXPECT_THAT(load_error(robot_file("  \"target\": 5")), HasSubstr("model.json:4:13: expected a reference"));
   EXPECT_THAT(load_error(robot_file("  \"watched\": [null]")),
@@ -206,16 +239,19 @@ TEST_F(BadText, WrongTypesSayWhereAndWhat) {
 TEST_F(BadText, DanglingReferencesAndIds) {
   EXPECT_THAT(load_error(robot_file("  \"target\": \"@77\"")),
               HasSubstr("model.json:4:13: dangling reference: #5.target names #77"));
-  EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"version\": 1, \"instances\": [{\"@class\": \"Node\"}]}"),
-              HasSubstr("model.json:1:52: an instance needs an \"@id\""));
+  EXPECT_THAT(
+      load_error("{\"format\": \"vsd-text\", \"version\": 1, \"instances\": [{\"@class\": \"Node\"}]}"),
+      HasSubstr("model.json:1:52: an instance needs an \"@id\""));
   EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"version\": 1, \"instances\": [{\"@id\": 3}]}"),
               HasSubstr("names no \"@class\""));
-  EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"version\": 1, \"instances\": [{\"@id\": 3, \"@class\": "
-                         "\"Node\"}, {\"@id\": 3, \"@class\": \"Node\"}]}"),
-              HasSubstr("instance #3 appears twice"));
-  EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"version\": 1, \"instances\": [{\"@id\": 3, \"@class\": "
-                         "\"Nope\"}]}"),
-              HasSubstr("model.json:1:73: unknown class 'Nope'"));
+  EXPECT_THAT(
+      load_error("{\"format\": \"vsd-text\", \"version\": 1, \"instances\": [{\"@id\": 3, \"@class\": "
+                 "\"Node\"}, {\"@id\": 3, \"@class\": \"Node\"}]}"),
+      HasSubstr("instance #3 appears twice"));
+  EXPECT_THAT(
+      load_error("{\"format\": \"vsd-text\", \"version\": 1, \"instances\": [{\"@id\": 3, \"@class\": "
+                 "\"Nope\"}]}"),
+      HasSubstr("model.json:1:73: unknown class 'Nope'"));
 }
 
 TEST_F(BadText, CompositeCyclesAreRejected) {
@@ -229,10 +265,12 @@ TEST_F(BadText, CompositeCyclesAreRejected) {
 
 TEST_F(BadText, HeaderAndVersion) {
   EXPECT_THAT(load_error("{\"version\": 1}"), HasSubstr("not a vsd text file"));
-  EXPECT_THAT(load_error("{\"format\": \"other\", \"version\": 1}"), HasSubstr("model.json:1:12: not a vsd text file"));
+  EXPECT_THAT(load_error("{\"format\": \"other\", \"version\": 1}"),
+              HasSubstr("model.json:1:12: not a vsd text file"));
   EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"version\": 3}"),
               HasSubstr("model.json:1:35: format version 3 is not supported (this reads 1 to 2)"));
-  EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"version\": 1, \"kind\": \"all\"}"), HasSubstr("unknown kind"));
+  EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"version\": 1, \"kind\": \"all\"}"),
+              HasSubstr("unknown kind"));
   EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"format\": \"vsd-text\"}"), HasSubstr("given twice"));
   EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"version\": 1} trailing"), HasSubstr("model.json:1:"));
   EXPECT_THAT(load_error("[1, 2]"), HasSubstr("not a vsd file"));
@@ -251,12 +289,14 @@ TEST_F(BadText, DeepNestingIsAnErrorNotACrash) {
 
 TEST_F(BadText, UnknownMembersAndPropertiesAreReported) {
   std::vector<std::string> warnings;
-  const std::string file = "{\"format\": \"vsd-text\", \"version\": 1, \"comment\": {\"any\": [1, \"x\"]},\n"
-                           "\"instances\": [{\"@id\": 2, \"@class\": \"Node\", \"colour\": \"red\"},\n"
-                           "{\"@id\": 3, \"@class\": \"Node\", \"colour\": \"blue\"}]}";
+  const std::string file =
+      "{\"format\": \"vsd-text\", \"version\": 1, \"comment\": {\"any\": [1, \"x\"]},\n"
+      "\"instances\": [{\"@id\": 2, \"@class\": \"Node\", \"colour\": \"red\"},\n"
+      "{\"@id\": 3, \"@class\": \"Node\", \"colour\": \"blue\"}]}";
   EXPECT_EQ(load_error(file, &warnings), "<loaded>");
-  EXPECT_THAT(warnings, testing::ElementsAre(HasSubstr("model.json:1:38: unknown member 'comment'"),
-                                             HasSubstr("model.json:2:44: class 'Node' has no saved property 'colour'")));
+  EXPECT_THAT(warnings, testing::ElementsAre(
+                            HasSubstr("model.json:1:38: unknown member 'comment'"),
+                            HasSubstr("model.json:2:44: class 'Node' has no saved property 'colour'")));
 }
 
 TEST_F(BadText, StringsWithOddBytesRoundTrip) {
@@ -291,16 +331,25 @@ namespace {
 // Shapes a transaction may hold but a model may not: a child twice in one list, a node under two
 // parents, an abstract class, a Database inside a subtree. Each loads consistently or is rejected whole.
 TEST(TextFormat, OddShapesLoadConsistentlyOrNotAtAll) {
-  const std::string head = "{\"format\": \"vsd-text\", \"version\": 1, \"kind\": \"subtree\", \"instances\": [\n";
+  const std::string head =
+      "{\"format\": \"vsd-text\", \"version\": 1, \"kind\": \"subtree\", \"instances\": [\n";
   const std::string files[] = {
-      head + "{\"@id\": 2, \"@class\": \"Node\", \"children\": [\"@3\", \"@3\"]}, {\"@id\": 3, \"@class\": \"Node\"}], "
-             "\"top\": [\"@2\"]}",
-      head + "{\"@id\": 2, \"@class\": \"Node\", \"children\": [\"@3\", \"@4\"]}, {\"@id\": 3, \"@class\": \"Node\"}, "
-             "{\"@id\": 4, \"@class\": \"Node\", \"children\": [\"@3\"]}], \"top\": [\"@2\"]}",
-      head + "{\"@id\": 2, \"@class\": \"Node\", \"extensions\": [\"@3\"]}, {\"@id\": 3, \"@class\": \"Extension\"}], "
-             "\"top\": [\"@2\"]}",
-      head + "{\"@id\": 2, \"@class\": \"Node\", \"children\": [\"@3\"]}, {\"@id\": 3, \"@class\": \"Database\"}], "
-             "\"top\": [\"@2\"]}",
+      head +
+          "{\"@id\": 2, \"@class\": \"Node\", \"children\": [\"@3\", \"@3\"]}, {\"@id\": 3, \"@class\": "
+          "\"Node\"}], "
+          "\"top\": [\"@2\"]}",
+      head +
+          "{\"@id\": 2, \"@class\": \"Node\", \"children\": [\"@3\", \"@4\"]}, {\"@id\": 3, \"@class\": "
+          "\"Node\"}, "
+          "{\"@id\": 4, \"@class\": \"Node\", \"children\": [\"@3\"]}], \"top\": [\"@2\"]}",
+      head +
+          "{\"@id\": 2, \"@class\": \"Node\", \"extensions\": [\"@3\"]}, {\"@id\": 3, \"@class\": "
+          "\"Extension\"}], "
+          "\"top\": [\"@2\"]}",
+      head +
+          "{\"@id\": 2, \"@class\": \"Node\", \"children\": [\"@3\"]}, {\"@id\": 3, \"@class\": "
+          "\"Database\"}], "
+          "\"top\": [\"@2\"]}",
       head + "{\"@id\": 2, \"@class\": \"Node\", \"children\": [\"@2\"]}], \"top\": [\"@2\"]}",
       head + "{\"@id\": 2, \"@class\": \"Node\"}], \"top\": [\"@2\", \"@2\"]}",
   };
@@ -325,11 +374,14 @@ TEST(TextFormat, OddShapesLoadConsistentlyOrNotAtAll) {
 }
 
 TEST(TextFormat, AbstractClassesHaveNoInstances) {
-  const vsd::MetaInstance& shape = vsd::ClassBuilder("IoAbstractShape", vsd::Node::static_meta()).set_abstract(true).define();
-  const std::string file = "{\"format\": \"vsd-text\", \"version\": 1, \"kind\": \"subtree\",\n"
-                           "\"instances\": [{\"@id\": 2, \"@class\": \"IoAbstractShape\"}], \"top\": [\"@2\"]}";
-  EXPECT_THAT([&] { vsd::io::check_bytes(bytes_of(file), "odd.json"); },
-              testing::ThrowsMessage<vsd::Error>(HasSubstr("odd.json:2:15: class 'IoAbstractShape' is abstract")));
+  const vsd::MetaInstance& shape =
+      vsd::ClassBuilder("IoAbstractShape", vsd::Node::static_meta()).set_abstract(true).define();
+  const std::string file =
+      "{\"format\": \"vsd-text\", \"version\": 1, \"kind\": \"subtree\",\n"
+      "\"instances\": [{\"@id\": 2, \"@class\": \"IoAbstractShape\"}], \"top\": [\"@2\"]}";
+  EXPECT_THAT(
+      [&] { vsd::io::check_bytes(bytes_of(file), "odd.json"); },
+      testing::ThrowsMessage<vsd::Error>(HasSubstr("odd.json:2:15: class 'IoAbstractShape' is abstract")));
   vsd::Registry::global().undefine(shape);
 }
 
@@ -363,10 +415,11 @@ namespace {
 // A property the class no longer has may be of a type the program no longer has either: its values
 // are dropped with a warning; a type the program does not know for a property it has is an error there.
 TEST(TextFormat, DroppedPropertiesOfUnknownTypes) {
-  const std::string file = "{\"format\": \"vsd-text\", \"version\": 1, \"kind\": \"subtree\", \"classes\": [\n"
-                           "{\"class\": \"TTool\", \"saved\": {\"length\": \"double\", \"grip\": \"OldGrip\"}}],\n"
-                           "\"instances\": [{\"@id\": 2, \"@class\": \"TTool\", \"length\": 3, \"grip\": {\"any\": [1]}}],\n"
-                           "\"top\": [\"@2\"]}";
+  const std::string file =
+      "{\"format\": \"vsd-text\", \"version\": 1, \"kind\": \"subtree\", \"classes\": [\n"
+      "{\"class\": \"TTool\", \"saved\": {\"length\": \"double\", \"grip\": \"OldGrip\"}}],\n"
+      "\"instances\": [{\"@id\": 2, \"@class\": \"TTool\", \"length\": 3, \"grip\": {\"any\": [1]}}],\n"
+      "\"top\": [\"@2\"]}";
   vsd::Environment env;
   const auto report = vsd::io::load_bytes(env.main_state(), bytes_of(file), "old.json");
   EXPECT_THAT(report.warnings, testing::ElementsAre(HasSubstr("no property 'grip'")));
@@ -377,4 +430,24 @@ TEST(TextFormat, DroppedPropertiesOfUnknownTypes) {
               testing::ThrowsMessage<vsd::Error>(HasSubstr("old.json:2:40: unknown type 'Double2'")));
 }
 
+}  // namespace
+
+namespace {
+TEST(BinaryFormat, ValuesOfPropertiesThatAreNotSavedAreDroppedWithAWarning) {
+  // The snapshot fuzzer's find: a file defining run-time class FzMarker whose 'access' is not Savable, yet
+  // listing it among the saved properties with a value. The value is dropped, so resaving loses nothing.
+  std::ifstream in(golden_path("fuzz-not-savable.vsds"), std::ios::binary);
+  const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), {});
+  ASSERT_FALSE(bytes.empty());
+  vsd::Registry registry;  // the file's classes and types stay with this test
+  vsd::Environment env(0, registry);
+  vsd::SimState& state = env.main_state();
+  const auto report = vsd::io::load_bytes(state, bytes, "fuzz-not-savable.vsds");
+  EXPECT_THAT(testing::PrintToString(report.warnings),
+              HasSubstr("FzMarker::access' is not saved by this program"));
+  vsd::SimState& again = env.create_state("again");
+  (void)vsd::io::load_bytes(again, vsd::io::save_bytes(state), "resaved");
+  std::string difference;
+  EXPECT_TRUE(again.equals(state, &difference)) << difference;
+}
 }  // namespace
