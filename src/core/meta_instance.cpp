@@ -237,8 +237,23 @@ ClassBuilder::ClassBuilder(std::string name, const MetaInstance& base)
                         "' needs a base derived from SimStateInstance, not '" + base.name() + "'");
 }
 
+namespace {
+// Property names are identifiers: they are JSON keys and script names, and never collide with the
+// "@id"/"@class" members of a saved instance.
+void check_property_name(const std::string& cls, const std::string& name) {
+  auto head = [](char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || c == '_'; };
+  bool ok = !name.empty() && head(name[0]);
+  for (std::size_t i = 1; ok && i < name.size(); ++i)
+    ok = head(name[i]) || (name[i] >= '0' && name[i] <= '9');
+  if (!ok)
+    detail::throw_error("class '" + cls + "': '" + name +
+                        "' is not a property name (letters, digits and '_', not starting with a digit)");
+}
+}  // namespace
+
 ClassBuilder& ClassBuilder::property(std::string name, const MetaType& type, Value default_value,
                                      PropertyFlags flags) {
+  check_property_name(meta_->name(), name);
   if (default_value.empty()) {
     default_value = Value(type);
   } else if (default_value.type() != &type) {
@@ -266,6 +281,7 @@ ClassBuilder& ClassBuilder::method(std::string name, std::vector<const MetaType*
 }
 
 ClassBuilder& ClassBuilder::alias(std::string old_name) {
+  check_property_name(meta_->name(), old_name);
   if (meta_->own_props_.empty()) detail::throw_error("alias '" + old_name + "' given before any property");
   meta_->own_props_.back()->add_alias(std::move(old_name));
   return *this;

@@ -106,10 +106,10 @@ const MetaInstance& LoadModel::resolve_class(std::size_t at, const std::string& 
     fail_at(at, e.what());
   }
   if (base == nullptr) fail_at(at, "class '" + name + "' derives from unknown class '" + def->base + "'");
-  ClassBuilder builder(name, *base);
-  for (const auto& p : def->properties) builder.property(p.name, *p.type, p.default_value, p.flags);
-  builder.set_abstract(def->abstract);
   try {
+    ClassBuilder builder(name, *base);
+    for (const auto& p : def->properties) builder.property(p.name, *p.type, p.default_value, p.flags);
+    builder.set_abstract(def->abstract);
     const MetaInstance& cls = builder.define(registry_);
     defined_.push_back(&cls);
     return cls;

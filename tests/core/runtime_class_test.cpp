@@ -313,6 +313,23 @@ TEST(RuntimeClass, MethodBoundToALambda) {
   EXPECT_THAT(error_of([&] { (void)x.call("fly"); }), HasSubstr("'fly'"));
 }
 
+TEST(RuntimeClass, PropertyNamesAreIdentifiers) {
+  for (const char* bad : {"", "@class", "1st", "a b", "x-y", "caf\xC3\xA9"}) {
+    EXPECT_THAT(
+        [&] { (void)vsd::ClassBuilder("RcBadName_Class", vsd::Node::static_meta()).property<int>(bad, 1); },
+        testing::ThrowsMessage<vsd::Error>(testing::HasSubstr("is not a property name")))
+        << bad;
+  }
+  EXPECT_THAT(
+      [&] {
+        (void)vsd::ClassBuilder("RcBadName_Class", vsd::Node::static_meta())
+            .property<int>("ok_1", 1)
+            .alias("@id");
+      },
+      testing::ThrowsMessage<vsd::Error>(testing::HasSubstr("is not a property name")));
+  EXPECT_EQ(vsd::Registry::global().find_class("RcBadName_Class"), nullptr);
+}
+
 TEST(RuntimeClass, MethodWithoutBodyIsRejected) {
   EXPECT_THROW((void)vsd::ClassBuilder("RcNoBody_Class", vsd::Node::static_meta())
                    .method("nothing", {}, nullptr, vsd::MetaMethod::Invoker{}),

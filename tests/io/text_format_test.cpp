@@ -451,3 +451,25 @@ TEST(BinaryFormat, ValuesOfPropertiesThatAreNotSavedAreDroppedWithAWarning) {
   EXPECT_TRUE(again.equals(state, &difference)) << difference;
 }
 }  // namespace
+
+namespace {
+TEST(TextFormat, APropertyNamedLikeAnInstanceMemberIsRejected) {
+  // The text fuzzer's find: a run-time class with a property named "@class" loaded, and its instances
+  // were then saved with "@class" twice. Property names are identifiers now; the file is an error.
+  std::ifstream in(golden_path("fuzz-bad-property-name.json"), std::ios::binary);
+  const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), {});
+  ASSERT_FALSE(bytes.empty());
+  vsd::Registry registry;
+  vsd::Environment env(0, registry);
+  std::string error = "<no error>";
+  try {
+    (void)vsd::io::load_bytes(env.main_state(), bytes, "fuzz-bad-property-name.json");
+  } catch (const vsd::Error& e) {
+    error = e.what();
+  }
+  EXPECT_THAT(error, MatchesRegex("fuzz-bad-property-name\\.json:[0-9]+:[0-9]+: .*"));
+  EXPECT_THAT(error, HasSubstr("'@class' is not a property name"));
+  EXPECT_EQ(env.main_state().size(), 1u);
+  EXPECT_EQ(registry.find_class("FzMarker"), nullptr) << "a failed load leaves no class behind";
+}
+}  // namespace
