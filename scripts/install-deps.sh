@@ -12,6 +12,8 @@ PACKAGES=(
   cmake
   g++
   libeigen3-dev
+  # compiler cache: .ci/run's five builds (and the packaging tests' builds of vsd) reuse identical objects
+  ccache
   # vsd::soml_analysis: the PNML reader's XML parser (the module is skipped without it)
   libpugixml-dev
   # vsd::scene: URDF and mesh loading
