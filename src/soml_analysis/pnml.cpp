@@ -12,6 +12,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "text_file.hpp"
 #include "vsd/core/error.hpp"
 
 namespace vsd::soml::analysis {
@@ -97,10 +98,10 @@ class Reader {
     return where_offset(n.type() == pugi::node_element && o > 0 ? o - 1 : o);
   }
   [[noreturn]] void fail_at(std::size_t offset, const std::string& msg) const {
-    detail::throw_error(where_offset(offset) + ": " + msg);
+    vsd::detail::throw_error(where_offset(offset) + ": " + msg);
   }
   [[noreturn]] void fail(const pugi::xml_node& n, const std::string& msg) const {
-    detail::throw_error(where(n) + ": " + msg);
+    vsd::detail::throw_error(where(n) + ": " + msg);
   }
   void note(const pugi::xml_node& n, const std::string& msg) { out_.notes.push_back(where(n) + ": " + msg); }
 
@@ -324,13 +325,7 @@ void add_text(pugi::xml_node parent, const char* label, const std::string& text)
 PnmlImport read_pnml(std::string_view text, std::string_view source) { return Reader(text, source).run(); }
 
 PnmlImport read_pnml_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) detail::throw_error(path.string() + ": cannot open the file for reading");
-  std::ostringstream buf;
-  buf << in.rdbuf();
-  if (in.bad()) detail::throw_error(path.string() + ": read error");
-  const std::string text = std::move(buf).str();
-  return read_pnml(text, path.string());
+  return read_pnml(detail::read_text_file(path), path.string());
 }
 
 std::string write_pnml(const PtNet& net) {
@@ -390,12 +385,7 @@ std::string write_pnml(const PtNet& net) {
 }
 
 void write_pnml_file(const PtNet& net, const std::filesystem::path& path) {
-  const std::string text = write_pnml(net);
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) detail::throw_error(path.string() + ": cannot open the file for writing");
-  out.write(text.data(), static_cast<std::streamsize>(text.size()));
-  out.close();
-  if (!out) detail::throw_error(path.string() + ": write error");
+  detail::write_text_file(path, write_pnml(net));
 }
 
 }  // namespace vsd::soml::analysis

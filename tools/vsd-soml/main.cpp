@@ -1,5 +1,5 @@
-// vsd-soml: the command-line tool for nets (`vsd-soml --help`). For now it analyses PNML place/transition
-// nets; SOML++ files come with the SOML++ module.
+// vsd-soml: the command-line tool for nets (`vsd-soml --help`): state-space analysis of PNML and SOML++
+// nets, and conversion between the two.
 #include <cstring>
 #include <exception>
 #include <filesystem>
@@ -18,6 +18,7 @@ namespace an = vsd::soml::analysis;
 
 constexpr const char* kUsage =
     "Usage: vsd-soml analyze FILE [--json] [--threads N] [--limit-mem SIZE] [--progress | --no-progress]\n"
+    "       vsd-soml convert IN OUT\n"
     "       vsd-soml --help\n"
     "\n"
     "analyze  Explores the state space of the net in FILE and prints a summary: reachable markings\n"
@@ -25,9 +26,10 @@ constexpr const char* kUsage =
     "         Model Checking Contest counts them), most tokens in one place and in one marking, whether a\n"
     "         dead marking is reachable with a shortest firing sequence to one, and boundedness (an\n"
     "         unbounded net is reported as such, not explored forever).\n"
-    "         FILE is a PNML place/transition net (ISO/IEC 15909-2, .pnml); tool-specific blocks are\n"
-    "         skipped with a note on stderr. SOML++ files are not supported yet: they come with the\n"
-    "         SOML++ module (as does `vsd-soml convert` between PNML and SOML++).\n"
+    "         FILE is a PNML place/transition net (ISO/IEC 15909-2, .pnml; tool-specific blocks are\n"
+    "         skipped with a note on stderr) or a SOML++ script (.soml) whose objects' places hold black\n"
+    "         tokens (conditions, object tokens, communication arrows, substitution and invocation are\n"
+    "         refused with their positions; actions that change no marking are ignored with a note).\n"
     "  --json            one JSON object on stdout: {\"states\", \"edges\", \"deadlock\", "
     "\"max_tokens_place\",\n"
     "                    \"max_tokens_marking\", \"status\", \"bounded\", \"dead_trace\", ...}\n"
@@ -36,6 +38,10 @@ constexpr const char* kUsage =
     "                    (default: three quarters of the available memory)\n"
     "  --progress        always write a progress line on stderr (default: only when stderr is a terminal)\n"
     "  --no-progress     never write it\n"
+    "\n"
+    "convert  Converts the net in IN to OUT; the formats follow the extensions (.pnml or .xml: PNML,\n"
+    "         anything else: SOML++). PNML ids that are not SOML++ identifiers are renamed (a note on\n"
+    "         stderr; the original id stays in a comment).\n"
     "\n"
     "Exit status: 0 analysed (bounded or unbounded), 1 the file is bad or the memory limit was reached,\n"
     "2 usage error.\n";
@@ -46,14 +52,59 @@ int usage_error(const std::string& msg) {
   return 2;
 }
 
-bool looks_like_pnml(const std::filesystem::path& path) {
+bool has_pnml_extension(const std::filesystem::path& path) {
   const std::string ext = path.extension().string();
-  if (ext == ".pnml" || ext == ".xml" || ext == ".PNML") return true;
+  return ext == ".pnml" || ext == ".xml" || ext == ".PNML" || ext == ".XML";
+}
+
+bool looks_like_pnml(const std::filesystem::path& path) {
+  if (has_pnml_extension(path)) return true;
   std::ifstream in(path, std::ios::binary);
   char ch = 0;
   while (in.get(ch))
     if (!std::isspace(static_cast<unsigned char>(ch))) return ch == '<';
   return false;
+}
+
+struct Net {
+  an::PtNet net;
+  std::vector<std::string> notes;
+};
+
+// A PNML or SOML++ file as a net; its notes go to stderr.
+Net read_net(const std::filesystem::path& file) {
+  Net n;
+  if (looks_like_pnml(file)) {
+    an::PnmlImport i = an::read_pnml_file(file);
+    n = {std::move(i.net), std::move(i.notes)};
+  } else {
+    an::SomlNetImport i = an::read_soml_net_file(file);
+    n = {std::move(i.net), std::move(i.notes)};
+  }
+  for (const auto& note : n.notes) std::cerr << "note: " << note << "\n";
+  return n;
+}
+
+int convert(const std::vector<std::string_view>& args) {
+  std::vector<std::string> files;
+  for (const std::string_view a : args) {
+    if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option '" + std::string(a) + "'");
+    files.emplace_back(a);
+  }
+  if (files.size() != 2) throw std::invalid_argument("convert takes IN and OUT");
+  if (!std::filesystem::exists(files[0])) {
+    std::cerr << "vsd-soml: " << files[0] << ": no such file\n";
+    return 1;
+  }
+  const Net in = read_net(files[0]);
+  if (has_pnml_extension(files[1])) {
+    an::write_pnml_file(in.net, files[1]);
+  } else {
+    std::vector<std::string> renamed;
+    an::write_soml_file(in.net, files[1], &renamed);
+    for (const auto& r : renamed) std::cerr << "note: " << r << "\n";
+  }
+  return 0;
 }
 
 int analyze(const std::vector<std::string_view>& args) {
@@ -98,13 +149,7 @@ int analyze(const std::vector<std::string_view>& args) {
     std::cerr << "vsd-soml: " << file << ": no such file\n";
     return 1;
   }
-  if (!looks_like_pnml(file)) {
-    std::cerr << "vsd-soml: " << file
-              << ": not a PNML file; SOML++ files are not supported yet (they come with the SOML++ module)\n";
-    return 1;
-  }
-  const an::PnmlImport imported = an::read_pnml_file(file);
-  for (const auto& n : imported.notes) std::cerr << "note: " << n << "\n";
+  const Net imported = read_net(file);
   const an::ExploreResult r = an::explore(imported.net, options);
   if (json)
     an::write_json(std::cout, imported.net, r);
@@ -128,8 +173,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (args[0] == "analyze") return analyze(std::vector<std::string_view>(args.begin() + 1, args.end()));
-    if (args[0] == "convert")
-      return usage_error("convert (PNML <-> SOML++) comes with the SOML++ module and is not in this build");
+    if (args[0] == "convert") return convert(std::vector<std::string_view>(args.begin() + 1, args.end()));
     return usage_error("unknown command '" + std::string(args[0]) + "'");
   } catch (const std::invalid_argument& e) {
     return usage_error(e.what());
