@@ -93,6 +93,76 @@ struct Layout {
   }
 };
 
+// The net compiled against one Layout: what firing a transition does to the words of a packed marking,
+// and, for one bit per place, its enabling test as word masks. Both skip unpacking the marking.
+struct PackedNet {
+  struct WordOp {  // word = word - sub + add: the transition's token changes in this word, all fields at once
+    std::uint32_t word;
+    std::uint64_t add, sub;
+  };
+  struct WordTest {  // one bit per place: enabled when (word & need) == need and (word & forbid) == 0
+    std::uint32_t word;
+    std::uint64_t need, forbid;
+  };
+  std::vector<std::uint32_t> op_begin, test_begin;  // size transitions + 1
+  std::vector<WordOp> ops;
+  std::vector<WordTest> tests;
+  std::vector<std::uint8_t> never;  // one bit per place: needs two or more tokens from a place
+
+  PackedNet(const Compiled& c, const PtNet& net, const Layout& L) {
+    const std::uint32_t per_word_mask = (1u << L.shift) - 1;
+    auto word_of = [&](std::uint32_t p) { return p >> L.shift; };
+    auto off_of = [&](std::uint32_t p) { return (p & per_word_mask) * L.bits; };
+    never.assign(c.transitions, 0);
+    for (std::uint32_t t = 0; t < c.transitions; ++t) {
+      op_begin.push_back(static_cast<std::uint32_t>(ops.size()));
+      for (std::uint32_t i = c.delta_begin[t]; i < c.delta_begin[t + 1]; ++i) {
+        const auto& d = c.delta[i];
+        const std::uint32_t w = word_of(d.place);
+        auto it = std::find_if(ops.begin() + op_begin[t], ops.end(), [&](const WordOp& o) { return o.word == w; });
+        if (it == ops.end()) it = ops.insert(ops.end(), WordOp{w, 0, 0});
+        const auto magnitude = static_cast<std::uint64_t>(d.delta < 0 ? -d.delta : d.delta);
+        (d.delta < 0 ? it->sub : it->add) += magnitude << off_of(d.place);
+      }
+      test_begin.push_back(static_cast<std::uint32_t>(tests.size()));
+      if (L.bits != 1) continue;
+      auto test_for = [&](std::uint32_t p) -> WordTest& {
+        const std::uint32_t w = word_of(p);
+        auto it = std::find_if(tests.begin() + test_begin[t], tests.end(),
+                               [&](const WordTest& x) { return x.word == w; });
+        if (it == tests.end()) it = tests.insert(tests.end(), WordTest{w, 0, 0});
+        return *it;
+      };
+      const Transition& tr = net.transitions()[t];
+      for (const auto& a : tr.inputs) {
+        if (a.weight > 1) never[t] = 1;  // a one-bit place never holds two tokens
+        test_for(a.place).need |= std::uint64_t{1} << off_of(a.place);
+      }
+      for (const auto& a : tr.inhibitors)
+        if (a.weight == 1) test_for(a.place).forbid |= std::uint64_t{1} << off_of(a.place);
+      // (an inhibitor of weight 2 or more is always satisfied by a one-bit place)
+    }
+    op_begin.push_back(static_cast<std::uint32_t>(ops.size()));
+    test_begin.push_back(static_cast<std::uint32_t>(tests.size()));
+  }
+
+  bool enabled(std::uint32_t t, const std::uint64_t* m) const {
+    if (never[t]) return false;
+    for (std::uint32_t i = test_begin[t]; i < test_begin[t + 1]; ++i) {
+      const WordTest& x = tests[i];
+      if ((m[x.word] & x.need) != x.need || (m[x.word] & x.forbid) != 0) return false;
+    }
+    return true;
+  }
+  // Only where no field can overflow (the net's bounds fit the fields), and t is enabled (no underflow).
+  void fire(std::uint32_t t, std::uint64_t* m) const {
+    for (std::uint32_t i = op_begin[t]; i < op_begin[t + 1]; ++i) {
+      const WordOp& o = ops[i];
+      m[o.word] = m[o.word] - o.sub + o.add;
+    }
+  }
+};
+
 std::uint64_t hash_words(const std::uint64_t* w, std::uint32_t n) {
   std::uint64_t h = 0x243F6A8885A308D3ull ^ n;
   for (std::uint32_t i = 0; i < n; ++i) {
@@ -335,6 +405,13 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
   const std::uint32_t P = c_.places;
   const Layout L = layout_;
   const bool check_cover = !bounds_.has_value();
+  // Fast paths on the packed words: enabling by masks with one bit per place; firing by word arithmetic
+  // when the structural bounds fit the fields (no field can overflow into its neighbour). Where both
+  // hold, a frontier state is never unpacked.
+  const PackedNet pk(c_, net_, L);
+  const bool use_masks = L.bits == 1;
+  const bool use_ops = !check_cover;
+  const bool unpack_states = !(use_masks && use_ops);
 
   {  // the initial marking
     std::vector<std::uint64_t> m0(L.words, 0);
@@ -391,17 +468,25 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
         for (std::uint64_t s64 = first; s64 < last; ++s64) {
           const auto s = static_cast<std::uint32_t>(s64);
           const std::uint64_t* rec = record(s);
-          L.unpack(rec, P, m);
-          std::uint64_t sum = 0;
-          for (std::uint32_t p = 0; p < P; ++p) {
-            sum += m[p];
-            st.max_place = std::max(st.max_place, m[p]);
+          if (unpack_states) {
+            L.unpack(rec, P, m);
+            std::uint64_t sum = 0;
+            for (std::uint32_t p = 0; p < P; ++p) {
+              sum += m[p];
+              st.max_place = std::max(st.max_place, m[p]);
+            }
+            st.max_sum = std::max(st.max_sum, sum);
+          } else {  // one bit per place: the tokens are the set bits
+            std::uint64_t sum = 0;
+            for (std::uint32_t w = 0; w < L.words; ++w) sum += static_cast<std::uint64_t>(std::popcount(rec[w]));
+            st.max_sum = std::max(st.max_sum, sum);
+            if (sum != 0) st.max_place = std::max(st.max_place, 1u);
           }
-          st.max_sum = std::max(st.max_sum, sum);
+          auto enabled = [&](std::uint32_t t) { return use_masks ? pk.enabled(t, rec) : c_.enabled(t, m); };
           std::uint64_t* en = cur_enabled_.data() + (s64 - lo) * tw_;
           if (s == 0) {
             for (std::uint32_t t = 0; t < c_.transitions; ++t)
-              if (c_.enabled(t, m)) en[t >> 6] |= std::uint64_t{1} << (t & 63);
+              if (enabled(t)) en[t >> 6] |= std::uint64_t{1} << (t & 63);
           } else {
             // Incremental enabling: the parent's set, with the transitions reading a changed place retested.
             const std::uint32_t par = static_cast<std::uint32_t>(rec[L.words] >> 32);
@@ -410,7 +495,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
             for (std::uint32_t i = c_.aff_begin[ft]; i < c_.aff_begin[ft + 1]; ++i) {
               const std::uint32_t u = c_.aff[i];
               const std::uint64_t bit = std::uint64_t{1} << (u & 63);
-              if (c_.enabled(u, m))
+              if (enabled(u))
                 en[u >> 6] |= bit;
               else
                 en[u >> 6] &= ~bit;
@@ -432,14 +517,18 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
               bitsw &= bitsw - 1;
               std::uint64_t* out = ch.markings.data() + k * L.words;
               for (std::uint32_t w = 0; w < L.words; ++w) out[w] = rec[w];
-              for (std::uint32_t i = c_.delta_begin[t]; i < c_.delta_begin[t + 1]; ++i) {
-                const auto& d = c_.delta[i];
-                const std::int64_t v = static_cast<std::int64_t>(m[d.place]) + d.delta;
-                if (static_cast<std::uint64_t>(v) > L.mask) {
-                  st.overflow = true;
-                  stop.store(true, std::memory_order_relaxed);
+              if (use_ops) {
+                pk.fire(t, out);
+              } else {
+                for (std::uint32_t i = c_.delta_begin[t]; i < c_.delta_begin[t + 1]; ++i) {
+                  const auto& d = c_.delta[i];
+                  const std::int64_t v = static_cast<std::int64_t>(m[d.place]) + d.delta;
+                  if (static_cast<std::uint64_t>(v) > L.mask) {
+                    st.overflow = true;
+                    stop.store(true, std::memory_order_relaxed);
+                  }
+                  L.set(out, d.place, static_cast<std::uint64_t>(v) & L.mask);
                 }
-                L.set(out, d.place, static_cast<std::uint64_t>(v) & L.mask);
               }
               ch.hashes[k] = hash_words(out, L.words);
               ch.parents[k] = s;
