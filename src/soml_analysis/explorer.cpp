@@ -569,9 +569,12 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     // ---- phase B: look up / insert into the shards ----------------------------------------------------
     std::size_t candidates = 0;
     for (std::size_t ci = 0; ci < nchunks; ++ci) candidates += chunks_[ci].hashes.size();
-    const unsigned bworkers = candidates > 4096 ? threads_ : 1u;
+    const unsigned bworkers = candidates > 4096 ? std::min<unsigned>(threads_, kShards) : 1u;
+    // Worker w owns the shards s with owner(s) == w: a range of shards each, found by a multiply and a
+    // shift (a division per candidate would cost more than the rest of a probe).
+    auto owner = [bworkers](std::size_t shard) { return static_cast<unsigned>((shard * bworkers) >> kShardBits); };
     run_workers(bworkers, [&](unsigned wi) {
-      // Worker wi owns shards with (shard % bworkers == wi); it reads every candidate's hash in order.
+      // Worker wi reads every candidate's hash in order and takes those of its shards.
       constexpr std::size_t kAhead = 8;  // the table probes are cache misses: prefetch a few candidates ahead
       for (std::size_t ci = 0; ci < nchunks; ++ci) {
         Chunk& ch = chunks_[ci];
@@ -580,12 +583,12 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
           if (i + kAhead < count) {
             const std::uint64_t ha = ch.hashes[i + kAhead];
             const Shard& sa = shards_[ha >> (64 - kShardBits)];
-            if ((ha >> (64 - kShardBits)) % bworkers == wi)
+            if (owner(ha >> (64 - kShardBits)) == wi)
               __builtin_prefetch(sa.slots.data() + ((ha & 0x7FFFFFFFull) & (sa.slots.size() - 1)));
           }
           const std::uint64_t h = ch.hashes[i];
           const std::size_t si = h >> (64 - kShardBits);
-          if (si % bworkers != wi) continue;
+          if (owner(si) != wi) continue;
           Shard& sh = shards_[si];
           const std::uint64_t frag = h & 0x7FFFFFFFull;
           const std::uint64_t* mk = ch.markings.data() + i * L.words;
@@ -635,7 +638,8 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
 
     // ---- phase D: pending entries become state indices ----------------------------------------------
     run_workers(bworkers, [&](unsigned wi) {
-      for (std::size_t si = wi; si < kShards; si += bworkers) {
+      for (std::size_t si = 0; si < kShards; ++si) {
+        if (owner(si) != wi) continue;
         Shard& sh = shards_[si];
         const std::size_t mask = sh.slots.size() - 1;
         for (std::size_t k = 0; k < sh.pending.size(); ++k) {
