@@ -626,6 +626,13 @@ Place* Program::place(std::string_view name, const Node* owner) const {
   return nullptr;
 }
 
+std::vector<Place*> Program::places() const {
+  std::vector<Place*> all;
+  for (const NetInst* n : impl_->net_order_)
+    if (impl_->state_.find(n->owner) != nullptr) all.insert(all.end(), n->places.begin(), n->places.end());
+  return all;
+}
+
 const MetaInstance* Program::script_class(std::string_view name) const {
   for (const auto& [decl, ci] : impl_->class_info_)
     if (decl->name == name && decl->kind != DeclKind::Script) return ci->meta;

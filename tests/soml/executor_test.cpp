@@ -249,3 +249,43 @@ arrow t -> b;
 }
 
 }  // namespace
+
+#if VSD_SOML_TEST_IO
+#include "vsd/io/snapshot.hpp"
+
+namespace {
+
+TEST_F(Exec, MarkingsMidRunAreSavedAndLoadedByVsdIo) {
+  Program& p = load(R"(
+class Job : Node { int done = 0; start line.queue; }
+object line {
+  place<Job> queue;
+  place<Job> finished;
+  place credits = 2;
+  transition work { do { mark.done = 1; } }
+  arrow queue -> work;
+  arrow credits -> work;
+  arrow work -> finished;
+}
+object j1 : Job;
+object j2 : Job;
+object j3 : Job;
+)");
+  EXPECT_EQ(p.run_until_quiet(), 2u);
+  for (auto format : {vsd::io::Format::Text, vsd::io::Format::Binary}) {
+    const auto bytes = vsd::io::save_bytes(env.main_state(), format);
+    vsd::SimState& copy = env.create_state(format == vsd::io::Format::Text ? "text copy" : "binary copy");
+    vsd::io::load_bytes(copy, bytes);
+    std::string diff;
+    EXPECT_TRUE(copy.equals(env.main_state(), &diff)) << diff;
+    // The loaded places hold the same marking.
+    const auto* q = copy.find<vsd::soml::Place>(p.place("queue", p.object("line"))->id());
+    ASSERT_NE(q, nullptr);
+    ASSERT_EQ(q->objects().size(), 1u);
+    EXPECT_EQ(q->objects()[0]->id(), p.object("j3")->id());
+    EXPECT_EQ(copy.find<vsd::soml::Place>(p.place("credits", p.object("line"))->id())->tokens(), 0);
+  }
+}
+
+}  // namespace
+#endif

@@ -71,6 +71,8 @@ class Program {
   [[nodiscard]] vsd::Node* object(std::string_view name) const;
   /// @brief The place @p name of object @p owner (nullptr: the script object), or nullptr.
   [[nodiscard]] Place* place(std::string_view name, const vsd::Node* owner = nullptr) const;
+  /// @brief Every place of every net instance, in creation order.
+  [[nodiscard]] std::vector<Place*> places() const;
   /// @brief The run-time class of script class or object @p name ("Demo"), or nullptr.
   [[nodiscard]] const MetaInstance* script_class(std::string_view name) const;
 
