@@ -243,3 +243,44 @@ TEST_F(Runtime, ScriptErrorsAndUnsupportedConstructsAreReportedWithPositions) {
 }
 
 }  // namespace
+
+#include <filesystem>
+#include <fstream>
+
+namespace {
+
+// Every golden script that checks clean either loads and runs (a bounded number of firings) or is
+// refused with the position of what the runtime cannot run yet; never a crash.
+TEST(RuntimeScripts, EveryCleanGoldenScriptLoadsOrIsRefusedWithAPosition) {
+  namespace fs = std::filesystem;
+  int loaded = 0, refused = 0;
+  for (const auto& entry : fs::directory_iterator(VSD_SOML_SCRIPTS_DIR)) {
+    if (entry.path().extension() != ".soml") continue;
+    std::ifstream in(entry.path(), std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string name = entry.path().filename().string();
+    if (!vsd::soml::check_source(name, text)->ok()) continue;
+    SCOPED_TRACE(name);
+    vsd::Registry reg;
+    vsd::Environment env(0, reg);
+    std::ostringstream out;
+    vsd::soml::RunOptions o;
+    o.out = &out;
+    o.instruction_budget = 100000;
+    try {
+      auto p = Program::load(env.main_state(), name, text, o);
+      p->step(100);
+      ++loaded;
+    } catch (const vsd::Error& e) {
+      const std::string what = e.what();
+      EXPECT_THAT(what, ::testing::AnyOf(HasSubstr("not supported by the SOML++ runtime yet"),
+                                         HasSubstr("SOML++ run-time error")));
+      EXPECT_THAT(what, HasSubstr(name + ":"));
+      ++refused;
+    }
+  }
+  EXPECT_GE(loaded, 3);
+  std::cout << "golden scripts: " << loaded << " loaded and ran, " << refused << " refused\n";
+}
+
+}  // namespace
