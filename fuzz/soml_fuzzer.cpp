@@ -1,13 +1,17 @@
-// Fuzzes the SOML++ front end (lexer, parser, checker): any input must end with diagnostics, never a
-// crash, a hang or a sanitizer report. Beyond that it checks what the checker promises:
+// Fuzzes SOML++ (lexer, parser, checker, and for clean scripts the loader, VM and executor): any input
+// must end with diagnostics or a vsd::Error, never a crash, a hang or a sanitizer report. Beyond that it
+// checks what the checker promises:
 //  - every diagnostic points into the source (line in range, column at most one past the line's end);
 //  - checking is deterministic (the same text gives the same diagnostics);
 //  - a script without errors is fully annotated: no expression has the Error type, every arrow has both
 //    ends and every start statement its place (the Error type is only for what was reported).
 #include <cstdint>
 #include <cstdlib>
+#include <sstream>
 #include <string>
 
+#include "vsd/core/environment.hpp"
+#include "vsd/core/error.hpp"
 #include "vsd/soml.hpp"
 
 namespace {
@@ -154,6 +158,23 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   const std::string formatted = result->diagnostics.format();
   require(check_source("fuzz.soml", text)->diagnostics.format() == formatted);
-  if (result->ok()) walk(*result->script.root);
+  if (result->ok()) {
+    walk(*result->script.root);
+    // A clean script is loaded and run briefly: load errors ("not supported yet") and run-time errors
+    // are vsd::Errors; anything else (a crash, a hang, a sanitizer report) is a bug. Each input gets a
+    // registry of its own, so the classes it defines go with it.
+    vsd::Registry registry;
+    vsd::Environment env(0, registry);
+    std::ostringstream out;
+    RunOptions options;
+    options.instruction_budget = 20000;
+    options.max_depth = 64;
+    options.out = &out;
+    try {
+      auto program = Program::load(env.main_state(), "fuzz.soml", text, options);
+      program->step(200);
+    } catch (const vsd::Error&) {
+    }
+  }
   return 0;
 }

@@ -28,6 +28,8 @@ PACKAGES=(
   qtbase5-dev
   libboost-dev
   libsigc++-3.0-dev
+  # the SOML++ VM benchmarks run the same functions in Lua 5.4, embedded (skipped without it)
+  liblua5.4-dev
   # fuzzing (libFuzzer comes with clang's runtime)
   clang
   libclang-rt-14-dev

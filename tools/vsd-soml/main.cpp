@@ -1,5 +1,5 @@
-// vsd-soml: the command-line tool for nets (`vsd-soml --help`): state-space analysis of PNML and SOML++
-// nets, and conversion between the two.
+// vsd-soml: the command-line tool for nets (`vsd-soml --help`): runs SOML++ scripts, analyses the state
+// spaces of PNML and SOML++ nets, and converts between the two.
 #include <cstring>
 #include <exception>
 #include <filesystem>
@@ -9,7 +9,9 @@
 #include <string_view>
 #include <vector>
 
+#include "vsd/core/environment.hpp"
 #include "vsd/core/error.hpp"
+#include "vsd/soml.hpp"
 #include "vsd/soml_analysis.hpp"
 
 namespace {
@@ -18,8 +20,16 @@ namespace an = vsd::soml::analysis;
 
 constexpr const char* kUsage =
     "Usage: vsd-soml analyze FILE [--json] [--threads N] [--limit-mem SIZE] [--progress | --no-progress]\n"
+    "       vsd-soml run FILE [--steps N] [--trace] [--seed S]\n"
     "       vsd-soml convert IN OUT\n"
     "       vsd-soml --help\n"
+    "\n"
+    "run      Loads the SOML++ script FILE into a database and fires its transitions: N firings, or until\n"
+    "         none is enabled (at most 1000000). print() writes to stdout; at the end the marking of\n"
+    "         every place is printed. Errors in the script are printed with file:line:col.\n"
+    "  --steps N         fire at most N transitions\n"
+    "  --trace           print every firing: step, transition, the token it moved, from where to where\n"
+    "  --seed S          the seed of the choice among enabled transitions (default 1)\n"
     "\n"
     "analyze  Explores the state space of the net in FILE and prints a summary: reachable markings\n"
     "         (states), firings (edges: one per reachable marking and transition enabled in it, as the\n"
@@ -107,6 +117,106 @@ int convert(const std::vector<std::string_view>& args) {
   return 0;
 }
 
+std::string node_label(const vsd::Node* n) {
+  if (n == nullptr) return "-";
+  const vsd::Node* owner = n->parent();
+  const bool script_level =
+      owner != nullptr && owner->parent() != nullptr && owner->parent()->parent() == nullptr;
+  return (owner != nullptr && !script_level ? owner->name() + "." : std::string()) + n->name();
+}
+
+int run(const std::vector<std::string_view>& args) {
+  std::string file;
+  std::uint64_t steps = 1'000'000;
+  bool trace = false;
+  vsd::soml::RunOptions options;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    auto value = [&]() {
+      if (i + 1 >= args.size()) throw std::invalid_argument(std::string(args[i]) + " needs a value");
+      return std::string(args[++i]);
+    };
+    auto number = [&](const std::string& v, const char* what) {
+      std::size_t used = 0;
+      unsigned long long n = 0;
+      try {
+        n = std::stoull(v, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != v.size() || v.empty() || v[0] == '-')
+        throw std::invalid_argument(std::string(what) + " needs a number, not '" + v + "'");
+      return static_cast<std::uint64_t>(n);
+    };
+    if (args[i] == "--steps") {
+      steps = number(value(), "--steps");
+    } else if (args[i] == "--seed") {
+      options.seed = number(value(), "--seed");
+    } else if (args[i] == "--trace") {
+      trace = true;
+    } else if (!args[i].empty() && args[i][0] == '-') {
+      throw std::invalid_argument("unknown option '" + std::string(args[i]) + "'");
+    } else if (file.empty()) {
+      file = std::string(args[i]);
+    } else {
+      throw std::invalid_argument("run takes one FILE");
+    }
+  }
+  if (file.empty()) throw std::invalid_argument("run needs a FILE");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    std::cerr << "vsd-soml: cannot read '" << file << "'\n";
+    return 1;
+  }
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  vsd::Registry registry;
+  vsd::Environment env(0, registry);
+  auto& soml = env.use<vsd::soml::Module>();
+  vsd::soml::Program* p = nullptr;
+  try {
+    p = &soml.load(env.main_state(), file, text, options);
+  } catch (const vsd::Error& e) {
+    std::cerr << e.what() << (std::string(e.what()).ends_with("\n") ? "" : "\n");
+    return 1;
+  }
+  if (trace)
+    p->on_firing([](const vsd::soml::Firing& f) {
+      std::cout << "step " << f.step << ": " << node_label(f.transition);
+      if (f.mark != 0) {
+        const vsd::SimStateInstance* m = f.transition->state().find(f.mark);
+        const auto* mn = m != nullptr ? m->as<vsd::Node>() : nullptr;
+        std::cout << " mark "
+                  << (mn != nullptr && !mn->name().empty() ? mn->name() : "#" + std::to_string(f.mark)) << " "
+                  << node_label(f.from) << " -> " << node_label(f.to);
+      }
+      std::cout << "\n";
+    });
+  std::uint64_t fired = 0;
+  try {
+    fired = p->step(steps);
+  } catch (const vsd::Error& e) {
+    std::cout.flush();
+    std::cerr << e.what() << "\n";
+    return 1;
+  }
+  std::cout << fired << (fired == 1 ? " firing" : " firings") << (p->enabled_any() ? "" : ", quiet") << "\n";
+  for (const vsd::soml::Place* pl : p->places()) {
+    std::cout << "  " << node_label(pl) << " = ";
+    if (pl->object_tokens()) {
+      std::cout << "[";
+      for (std::size_t i = 0; i < pl->objects().size(); ++i)
+        std::cout << (i != 0 ? ", " : "")
+                  << (pl->objects()[i]->name().empty() ? "#" + std::to_string(pl->objects()[i]->id())
+                                                       : pl->objects()[i]->name());
+      std::cout << "]\n";
+    } else {
+      std::cout << pl->tokens() << "\n";
+    }
+  }
+  for (const std::string& e : p->condition_errors())
+    std::cerr << "warning: a condition failed: " << e << "\n";
+  return 0;
+}
+
 int analyze(const std::vector<std::string_view>& args) {
   std::string file;
   bool json = false;
@@ -173,6 +283,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (args[0] == "analyze") return analyze(std::vector<std::string_view>(args.begin() + 1, args.end()));
+    if (args[0] == "run") return run(std::vector<std::string_view>(args.begin() + 1, args.end()));
     if (args[0] == "convert") return convert(std::vector<std::string_view>(args.begin() + 1, args.end()));
     return usage_error("unknown command '" + std::string(args[0]) + "'");
   } catch (const std::invalid_argument& e) {

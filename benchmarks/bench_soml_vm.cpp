@@ -1,0 +1,186 @@
+// SOML++ runtime benchmarks: the bytecode VM side by side with Lua 5.4 (embedded in this binary) on the
+// same functions, transition firings per second, re-testing after one property change, and checking and
+// loading a large script. Command and figures: benchmarks/README.md, section "SOML++ runtime".
+#include <benchmark/benchmark.h>
+
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "vsd/core.hpp"
+#include "vsd/soml.hpp"
+
+#if VSD_BENCH_HAVE_LUA
+extern "C" {
+#include <lauxlib.h>
+#include <lua.h>
+#include <lualib.h>
+}
+#endif
+
+namespace {
+
+constexpr const char* kFunctions = R"(
+int fib(int n) { if (n < 2) return n; return fib(n - 1) + fib(n - 2); }
+int loop(int n) {
+  int s = 0;
+  for (int i = 0; i < n; i++) { s = s + i * 3 % 7; }
+  return s;
+}
+)";
+
+struct Soml {
+  vsd::Registry reg;
+  vsd::Environment env{0, reg};
+  vsd::soml::Program* program = nullptr;
+  explicit Soml(const std::string& text, std::uint64_t budget = 1'000'000'000) {
+    vsd::soml::RunOptions o;
+    o.instruction_budget = budget;
+    program = &env.use<vsd::soml::Module>().load(env.main_state(), "bench.soml", text, o);
+  }
+};
+
+void BM_SomlFib27(benchmark::State& state) {
+  Soml s(kFunctions);
+  const vsd::Value arg(std::int64_t{27});
+  for (auto _ : state) benchmark::DoNotOptimize(s.program->root().call("fib", {arg}).as<std::int64_t>());
+  state.counters["calls"] =
+      benchmark::Counter(832039.0 + 514228.0 - 1.0, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_SomlFib27)->Unit(benchmark::kMillisecond);
+
+void BM_SomlLoop1e7(benchmark::State& state) {
+  Soml s(kFunctions);
+  const vsd::Value arg(std::int64_t{10'000'000});
+  for (auto _ : state) benchmark::DoNotOptimize(s.program->root().call("loop", {arg}).as<std::int64_t>());
+}
+BENCHMARK(BM_SomlLoop1e7)->Unit(benchmark::kMillisecond);
+
+#if VSD_BENCH_HAVE_LUA
+constexpr const char* kLua = R"(
+function fib(n) if n < 2 then return n end return fib(n - 1) + fib(n - 2) end
+function loop(n)
+  local s = 0
+  for i = 0, n - 1 do s = s + i * 3 % 7 end
+  return s
+end
+)";
+
+struct Lua {
+  lua_State* L = luaL_newstate();
+  Lua() {
+    luaL_openlibs(L);
+    if (luaL_dostring(L, kLua) != LUA_OK) throw std::runtime_error(lua_tostring(L, -1));
+  }
+  ~Lua() { lua_close(L); }
+  lua_Integer call(const char* fn, lua_Integer n) {
+    lua_getglobal(L, fn);
+    lua_pushinteger(L, n);
+    lua_call(L, 1, 1);
+    const lua_Integer r = lua_tointeger(L, -1);
+    lua_pop(L, 1);
+    return r;
+  }
+};
+
+void BM_LuaFib27(benchmark::State& state) {
+  Lua lua;
+  for (auto _ : state) benchmark::DoNotOptimize(lua.call("fib", 27));
+  state.counters["calls"] =
+      benchmark::Counter(832039.0 + 514228.0 - 1.0, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_LuaFib27)->Unit(benchmark::kMillisecond);
+
+void BM_LuaLoop1e7(benchmark::State& state) {
+  Lua lua;
+  for (auto _ : state) benchmark::DoNotOptimize(lua.call("loop", 10'000'000));
+}
+BENCHMARK(BM_LuaLoop1e7)->Unit(benchmark::kMillisecond);
+#endif
+
+// A ring of two black-token transitions: every firing moves the one token on.
+void BM_SomlFiringsBlack(benchmark::State& state) {
+  Soml s(R"(
+place a = 1;
+place b;
+transition t1;
+transition t2;
+arrow a -> t1;
+arrow t1 -> b;
+arrow b -> t2;
+arrow t2 -> a;
+)");
+  for (auto _ : state) benchmark::DoNotOptimize(s.program->step(1000));
+  state.SetItemsProcessed(state.iterations() * 1000);
+}
+BENCHMARK(BM_SomlFiringsBlack);
+
+// Object tokens circulating through two transitions whose conditions read a property of the mark.
+void BM_SomlFiringsObjectCondition(benchmark::State& state) {
+  Soml s(R"(
+class Tok : Node { int n = 1; start ring.a; }
+object ring {
+  place<Tok> a;
+  place<Tok> b;
+  transition t1 { when mark.n > 0; }
+  transition t2 { when mark.n > 0; }
+  arrow a -> t1;
+  arrow t1 -> b;
+  arrow b -> t2;
+  arrow t2 -> a;
+}
+object k1 : Tok;
+object k2 : Tok;
+object k3 : Tok;
+object k4 : Tok;
+)");
+  for (auto _ : state) benchmark::DoNotOptimize(s.program->step(1000));
+  state.SetItemsProcessed(state.iterations() * 1000);
+}
+BENCHMARK(BM_SomlFiringsObjectCondition);
+
+// One property change re-tests the one transition that reads it, however many others watch others.
+void BM_SomlRetestAfterChange(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  std::string text;
+  for (int i = 0; i < n; ++i) text += "int v" + std::to_string(i) + " = 0;\n";
+  text += "place p = 1;\n";
+  for (int i = 0; i < n; ++i) {
+    text += "transition t" + std::to_string(i) + " { when v" + std::to_string(i) + " > 5; }\n";
+    text += "arrow p -> t" + std::to_string(i) + ";\n";
+  }
+  Soml s(text);
+  s.program->run_until_quiet();
+  vsd::Node& root = s.program->root();
+  const vsd::MetaProperty& v0 = root.meta().property("v0");
+  std::int64_t x = 0;
+  for (auto _ : state) {
+    v0.set<std::int64_t>(root, ++x % 5);
+    benchmark::DoNotOptimize(s.program->enabled_any());
+  }
+}
+BENCHMARK(BM_SomlRetestAfterChange)->Arg(1)->Arg(100)->Arg(10000);
+
+// Checking and loading a script of about 10,000 lines.
+void BM_SomlLoad10kLines(benchmark::State& state) {
+  std::string text = "int total = 0;\n";
+  for (int i = 0; i < 1000; ++i) {
+    const std::string k = std::to_string(i);
+    text += "class C" + k + " : Node {\n  int a = " + k +
+            ";\n  double b = 1.5;\n  int f(int x) {\n    int y = x * a;\n"
+            "    if (y > 10) { y = y - 10; } else { y = y + 1; }\n    while (y > 100) { y = y / 2; }\n    "
+            "return y;\n  }\n}\n";
+  }
+  int lines = 0;
+  for (char c : text) lines += c == '\n';
+  for (auto _ : state) {
+    vsd::Registry reg;
+    vsd::Environment env(0, reg);
+    auto& m = env.use<vsd::soml::Module>();
+    benchmark::DoNotOptimize(&m.load(env.main_state(), "big.soml", text));
+  }
+  state.counters["lines"] = lines;
+}
+BENCHMARK(BM_SomlLoad10kLines)->Unit(benchmark::kMillisecond);
+
+}  // namespace

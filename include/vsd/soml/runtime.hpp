@@ -1,0 +1,103 @@
+/** @file
+ *  @brief Loading a SOML++ script into a SimState and running it: `Program`.
+ *
+ *  @code
+ *  vsd::Environment env;
+ *  auto& soml = env.use<vsd::soml::Module>();
+ *  vsd::soml::Program& p = soml.load(env.main_state(), "cell.soml", text);   // throws vsd::Error
+ *  p.object("cell")->call("reset", {});                                        // MetaMethods
+ *  p.run_until_quiet();                                                        // fire transitions
+ *  @endcode
+ *
+ *  Loading checks the script, makes a `SourceFile` with one `SourceComponent` per declaration, defines
+ *  a run-time class for every class, object and the script object ("soml::Demo"; properties become
+ *  MetaProperties, functions MetaMethods), makes the script enums run-time enums, compiles every
+ *  function, condition and action to bytecode, and creates the script object, its objects, their
+ *  places, transitions and arrows as database nodes under the SimState's Database.
+ *
+ *  Execution: `step()` fires one enabled transition (a seeded, deterministic choice among the enabled
+ *  ones); `run_until_quiet()` fires until none is enabled. Transitions are re-tested only when
+ *  something they read changed (a marking, or a property their condition read last time).
+ */
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vsd/core/fwd.hpp"
+#include "vsd/soml/net_classes.hpp"
+
+namespace vsd::soml {
+
+/// @brief Limits and settings of a loaded program.
+struct RunOptions {
+  std::uint64_t instruction_budget = 50'000'000;  ///< per call from outside (a call, a test, a firing)
+  int max_depth = 256;                            ///< nested SOML++ calls
+  std::uint64_t seed = 1;                         ///< the choice among enabled transitions
+  std::ostream* out = nullptr;                    ///< where print() writes (std::cout when null)
+};
+
+/// @brief One firing, as the trace reports it.
+struct Firing {
+  std::uint64_t step = 0;                  ///< number of the firing (1 for the first)
+  const Transition* transition = nullptr;  ///< what fired
+  vsd::Id mark = 0;                        ///< the token it moved (0: none)
+  const Place* from = nullptr;             ///< where the mark came from (object input place)
+  const Place* to = nullptr;               ///< where the mark went (null: it left the net)
+};
+
+class ProgramImpl;
+
+/// @brief A SOML++ script loaded into one SimState.
+class Program {
+ public:
+  /// @brief Checks, compiles and loads @p text (shown as @p name in messages) into @p state.
+  /// @throws vsd::Error with every diagnostic (file:line:col) when the script has errors, or with the
+  /// position of a construct the runtime cannot run yet; nothing is added to the state then.
+  static std::unique_ptr<Program> load(SimState& state, std::string name, std::string text,
+                                       RunOptions options = {});
+  ~Program();
+  Program(const Program&) = delete;
+  Program& operator=(const Program&) = delete;
+
+  /// @brief The script object's node (a child of the Database).
+  [[nodiscard]] vsd::Node& root() const noexcept;
+  /// @brief The top-level object named @p name, or nullptr.
+  [[nodiscard]] vsd::Node* object(std::string_view name) const;
+  /// @brief The place @p name of object @p owner (nullptr: the script object), or nullptr.
+  [[nodiscard]] Place* place(std::string_view name, const vsd::Node* owner = nullptr) const;
+  /// @brief Every place of every net instance, in creation order.
+  [[nodiscard]] std::vector<Place*> places() const;
+  /// @brief The run-time class of script class or object @p name ("Demo"), or nullptr.
+  [[nodiscard]] const MetaInstance* script_class(std::string_view name) const;
+
+  /// @brief Fires at most @p n transitions. @return how many fired.
+  /// @throws vsd::Error (with the SOML++ call stack) when an action fails; that firing is undone.
+  std::uint64_t step(std::uint64_t n = 1);
+  /// @brief Fires until no transition is enabled or @p limit firings happened. @return how many fired.
+  std::uint64_t run_until_quiet(std::uint64_t limit = 10'000'000);
+  /// @brief True when some transition is enabled.
+  [[nodiscard]] bool enabled_any();
+  /// @brief Firings so far.
+  [[nodiscard]] std::uint64_t firings() const noexcept;
+  /// @brief Calls @p fn after every firing (empty: no trace).
+  void on_firing(std::function<void(const Firing&)> fn);
+  /// @brief Condition evaluations so far (to see that conditions are not polled).
+  [[nodiscard]] std::uint64_t condition_tests() const noexcept;
+  /// @brief Run-time errors of conditions so far (a failing condition counts as not enabled).
+  [[nodiscard]] const std::vector<std::string>& condition_errors() const noexcept;
+
+  /// @brief The implementation (for the Module and the tools).
+  [[nodiscard]] ProgramImpl& impl() noexcept { return *impl_; }
+
+ private:
+  explicit Program(std::shared_ptr<ProgramImpl> impl);
+  std::shared_ptr<ProgramImpl> impl_;
+};
+
+}  // namespace vsd::soml

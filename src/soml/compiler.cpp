@@ -1,0 +1,1244 @@
+// The SOML++ bytecode compiler: annotated AST -> register bytecode (see program_impl.hpp for the
+// instruction set). The checker resolved every name and typed every expression, so the compiler does
+// no lookup: bindings become register numbers, property slots, function indices and outer plans.
+#include <bit>
+#include <cstring>
+#include <string>
+
+#include "program_impl.hpp"
+#include "vsd/core/error.hpp"
+#include "vsd/core/registry.hpp"
+
+namespace vsd::soml {
+
+using K = Type::Kind;
+using BK = Binding::Kind;
+
+RK reg_kind(const Type& t) noexcept {
+  switch (t.kind) {
+    case K::Bool:
+    case K::Int:
+    case K::Enum:
+      return RK::I;
+    case K::Double:
+      return RK::D;
+    case K::String:
+      return RK::S;
+    case K::Ref:
+    case K::Null:
+    case K::Place:
+      return RK::R;
+    default:
+      return RK::None;
+  }
+}
+
+std::string where(const ProgramImpl& p, SourceLoc loc) {
+  return p.checked_->source->name() + ":" + std::to_string(loc.line) + ":" + std::to_string(loc.column);
+}
+
+void not_supported(const ProgramImpl& p, SourceLoc loc, const std::string& what) {
+  throw Error(where(p, loc) + ": error: " + what + " is not supported by the SOML++ runtime yet");
+}
+
+namespace {
+
+const ScopeDecl* parent_scope(const Decl& d) {
+  return d.parent != nullptr ? &static_cast<const ScopeDecl&>(*d.parent) : nullptr;
+}
+
+// True for an instance that exists once per program (the script, objects not inside a class or net).
+bool is_static_instance(const Decl& d) {
+  if (d.kind == DeclKind::Script) return true;
+  if (d.kind != DeclKind::Object) return false;
+  for (const Decl* p = d.parent; p != nullptr; p = p->parent)
+    if (p->kind != DeclKind::Object && p->kind != DeclKind::Script) return false;
+  return true;
+}
+
+class Compiler {
+ public:
+  Compiler(ProgramImpl& p, Function& f, const ScopeDecl* scope, int nlocals)
+      : P(p), F(f), top_(nlocals), max_(nlocals) {
+    F.scope = scope;
+  }
+
+  void finish() {
+    F.nregs = max_ + 1;
+    F.compiled = true;
+    if (max_ > 60000) not_supported(P, SourceLoc{}, "a function with more than 60000 registers");
+  }
+
+  // ---- emission ----
+  std::size_t emit(Op op, int a = 0, int b = 0, int c = 0) {
+    F.code.push_back(Ins{op, 0, static_cast<std::uint16_t>(a), static_cast<std::uint16_t>(b),
+                         static_cast<std::uint16_t>(c)});
+    F.lines.push_back(line_);
+    return F.code.size() - 1;
+  }
+  std::size_t emit_jump(Op op, int a = 0, int b = 0) {
+    // The target goes into c (low 16 bits) and x (high 8 bits); a and b stay free for fused tests.
+    return emit(op, a, b, 0);
+  }
+  std::size_t here() const { return F.code.size(); }
+  void patch(std::size_t at, std::size_t target) {
+    if (target >= (1u << 24)) not_supported(P, SourceLoc{}, "a function of more than 16M instructions");
+    F.code[at].c = static_cast<std::uint16_t>(target & 0xFFFF);
+    F.code[at].x = static_cast<std::uint8_t>(target >> 16);
+  }
+  int temp() {
+    const int r = top_++;
+    if (top_ > max_) max_ = top_;
+    return r;
+  }
+  void at(SourceLoc loc) { line_ = loc.line; }
+
+  int konst(std::int64_t v) {
+    if (P.consts_.size() >= 65535) not_supported(P, SourceLoc{}, "more than 65535 constants in one script");
+    P.consts_.push_back(v);
+    return static_cast<int>(P.consts_.size() - 1);
+  }
+  int string_const(const std::string& s) {
+    if (P.strings_.size() >= 65535) not_supported(P, SourceLoc{}, "more than 65535 strings in one script");
+    P.strings_.push_back(s);
+    return static_cast<int>(P.strings_.size() - 1);
+  }
+  void load_int(int r, std::int64_t v) {
+    if (v >= -32768 && v <= 32767)
+      emit(OP_LOADI, r, static_cast<std::uint16_t>(static_cast<std::int16_t>(v)));
+    else
+      emit(OP_LOADK, r, konst(v));
+  }
+
+  int outer_plan(int outer, SourceLoc loc) {
+    OuterPlan plan;
+    const Decl* s = F.scope;
+    for (int k = 0; k < outer; ++k) {
+      const Decl* ps = s->parent;
+      if (ps == nullptr) not_supported(P, loc, "this scope");
+      if (is_static_instance(*ps)) {
+        plan.static_decl = &ps->as<ClassDecl>();
+        plan.parents = 0;
+      } else if (s->kind == DeclKind::Place || s->kind == DeclKind::Transition ||
+                 (s->kind == DeclKind::Object && plan.static_decl == nullptr)) {
+        ++plan.parents;
+      } else {
+        not_supported(P, loc, "reaching the enclosing instance of a nested class");
+      }
+      s = ps;
+    }
+    P.outer_plans_.push_back(plan);
+    return static_cast<int>(P.outer_plans_.size() - 1);
+  }
+  int self_at(int outer, SourceLoc loc) {
+    const int r = temp();
+    emit(OP_SELF, r, outer_plan(outer, loc));
+    return r;
+  }
+
+  int prop_slot(const Binding& b, SourceLoc loc) {
+    if (b.kind == BK::Property) {
+      auto it = P.prop_slot_.find(&b.decl->as<PropertyDecl>());
+      if (it == P.prop_slot_.end()) not_supported(P, loc, "this property");
+      return it->second;
+    }
+    return meta_slot(b.property);
+  }
+  int meta_slot(const MetaProperty* mp) {
+    auto it = P.meta_prop_slot_.find(mp);
+    if (it != P.meta_prop_slot_.end()) return it->second;
+    PropSlot s;
+    s.prop = mp;
+    const MetaType& t = mp->type();
+    switch (t.kind()) {
+      case TypeKind::Bool:
+        s.kind = PK::Bool;
+        break;
+      case TypeKind::Int:
+      case TypeKind::UInt:
+        s.kind = &t == &meta_type<std::int64_t>() ? PK::I64 : PK::Int;
+        break;
+      case TypeKind::Double:
+        s.kind = PK::Double;
+        break;
+      case TypeKind::Float:
+        s.kind = PK::Other;
+        break;
+      case TypeKind::String:
+        s.kind = PK::String;
+        break;
+      case TypeKind::Enum:
+      case TypeKind::Flags:
+        s.kind = PK::Enum;
+        break;
+      case TypeKind::Ref:
+      case TypeKind::SharedRef:
+        s.kind = PK::Ref;
+        break;
+      case TypeKind::RefList:
+      case TypeKind::SharedRefList:
+        s.kind = PK::List;
+        break;
+      default:
+        s.kind = PK::Other;
+    }
+    P.props_.push_back(s);
+    const int i = static_cast<int>(P.props_.size() - 1);
+    P.meta_prop_slot_[mp] = i;
+    return i;
+  }
+
+  int place_index(const PlaceDecl& pd, SourceLoc loc) {
+    const auto* owner = parent_scope(pd);
+    if (owner == nullptr || !owner->is_class_like()) not_supported(P, loc, "this place");
+    auto it = P.class_info_.find(&owner->as<ClassDecl>());
+    if (it == P.class_info_.end() || !it->second->net) not_supported(P, loc, "this place");
+    const auto& places = it->second->net->places;
+    for (std::size_t i = 0; i < places.size(); ++i)
+      if (places[i] == &pd) return static_cast<int>(i);
+    not_supported(P, loc, "this place");
+  }
+
+  int class_operand(const ClassRef& c, SourceLoc loc) {
+    const MetaInstance* m = c.meta;
+    const ClassInfo* ci = nullptr;
+    if (c.decl != nullptr) {
+      auto it = P.class_info_.find(c.decl);
+      if (it == P.class_info_.end()) not_supported(P, loc, "this class");
+      ci = it->second.get();
+      m = ci->meta;
+    }
+    P.classes_.push_back(ci);
+    P.class_metas_.push_back(m);
+    return static_cast<int>(P.classes_.size() - 1);
+  }
+
+  // ---- expressions ----
+  int coerce(int r, const Type& from, const Type& to) {
+    if (to.kind == K::Double && from.kind == K::Int) {
+      const int t = temp();
+      emit(OP_I2D, t, r);
+      return t;
+    }
+    return r;
+  }
+  void move(int dst, int src, RK k) {
+    if (dst == src) return;
+    emit(k == RK::S ? OP_MOVS : OP_MOV, dst, src);
+  }
+  void expr_to(const Expr& e, int dst, const Type& want) {
+    const int save = top_;
+    if (e.kind == ExprKind::Binary && reg_kind(e.type) == reg_kind(want) && reg_kind(want) != RK::S) {
+      const auto& b = e.as<BinaryExpr>();
+      if (b.op != TokenKind::AmpAmp && b.op != TokenKind::PipePipe) {
+        binary_into(b, dst);
+        top_ = save;
+        return;
+      }
+    }
+    int r = expr(e);
+    r = coerce(r, e.type, want);
+    move(dst, r, reg_kind(want));
+    top_ = save;
+  }
+  // Evaluates into a fresh register (a copy of a local when needed), so the caller may keep it.
+  int expr_fresh(const Expr& e, const Type& want) {
+    const int r = temp();
+    expr_to(e, r, want);
+    top_ = r + 1;
+    return r;
+  }
+
+  int value_check(const Expr& e) {
+    const RK k = reg_kind(e.type);
+    if (k == RK::None) not_supported(P, e.loc, "a value of type '" + e.type.name() + "'");
+    return 0;
+  }
+
+  int expr(const Expr& e) {
+    at(e.loc);
+    switch (e.kind) {
+      case ExprKind::Int: {
+        const int r = temp();
+        load_int(r, e.as<LiteralExpr>().int_value);
+        return r;
+      }
+      case ExprKind::Float: {
+        const int r = temp();
+        emit(OP_LOADK, r, konst(std::bit_cast<std::int64_t>(e.as<LiteralExpr>().float_value)));
+        return r;
+      }
+      case ExprKind::String: {
+        const int r = temp();
+        emit(OP_LOADS, r, string_const(e.as<LiteralExpr>().string_value));
+        return r;
+      }
+      case ExprKind::Bool: {
+        const int r = temp();
+        load_int(r, e.as<LiteralExpr>().bool_value ? 1 : 0);
+        return r;
+      }
+      case ExprKind::Null: {
+        const int r = temp();
+        load_int(r, 0);
+        return r;
+      }
+      case ExprKind::This:
+        return self_at(0, e.loc);
+      case ExprKind::Mark: {
+        const int r = temp();
+        emit(OP_MARK, r);
+        return r;
+      }
+      case ExprKind::Name:
+        return name(e.as<NameExpr>());
+      case ExprKind::Member:
+        return member(e.as<MemberExpr>());
+      case ExprKind::Unary:
+      case ExprKind::Postfix:
+        return unary(e.as<UnaryExpr>());
+      case ExprKind::Binary:
+        return binary(e.as<BinaryExpr>());
+      case ExprKind::Assign:
+        assign(e.as<BinaryExpr>());
+        return -1;
+      case ExprKind::Conditional: {
+        const auto& c = e.as<ConditionalExpr>();
+        value_check(e);
+        const int r = temp();
+        const int cr = expr(*c.cond);
+        const std::size_t jf = emit_jump(OP_JMPF, cr);
+        top_ = r + 1;
+        expr_to(*c.then_expr, r, e.type);
+        const std::size_t je = emit_jump(OP_JMP);
+        patch(jf, here());
+        top_ = r + 1;
+        expr_to(*c.else_expr, r, e.type);
+        patch(je, here());
+        top_ = r + 1;
+        return r;
+      }
+      case ExprKind::Call:
+        return call(e.as<CallExpr>());
+      case ExprKind::Index:
+        return index(e.as<IndexExpr>());
+      case ExprKind::New:
+        return make_new(e.as<NewExpr>());
+      case ExprKind::Is:
+      case ExprKind::As: {
+        const auto& n = e.as<NewExpr>();
+        const int o = expr(*n.operand);
+        const int r = temp();
+        ClassRef c = n.binding.decl != nullptr && n.binding.decl->is_class_like()
+                         ? ClassRef{&n.binding.decl->as<ClassDecl>(), nullptr}
+                         : ClassRef{nullptr, n.binding.meta_class};
+        if (c.empty()) c = e.kind == ExprKind::As ? e.type.cls : ClassRef{};
+        if (c.empty()) not_supported(P, e.loc, "this class test");
+        emit(e.kind == ExprKind::Is ? OP_ISA : OP_AS, r, o, class_operand(c, e.loc));
+        return r;
+      }
+    }
+    not_supported(P, e.loc, "this expression");
+  }
+
+  int name(const NameExpr& e) {
+    const Binding& b = e.binding;
+    switch (b.kind) {
+      case BK::Local:
+        return b.slot;
+      case BK::Property:
+      case BK::MetaProperty: {
+        value_check(e);
+        const int s = self_at(b.outer, e.loc);
+        emit(OP_GETP, s, s, prop_slot(b, e.loc));
+        return s;
+      }
+      case BK::EnumValue: {
+        const int r = temp();
+        load_int(r, b.slot);
+        return r;
+      }
+      case BK::Object: {
+        if (!is_static_instance(*b.decl)) not_supported(P, e.loc, "naming an object nested in a class");
+        const int r = temp();
+        P.object_refs_.push_back({konst(0), &b.decl->as<ClassDecl>()});
+        emit(OP_OBJ, r, P.object_refs_.back().first);
+        return r;
+      }
+      case BK::Place: {
+        const int s = self_at(b.outer, e.loc);
+        emit(OP_PLACE, s, s, place_index(b.decl->as<PlaceDecl>(), e.loc));
+        return s;
+      }
+      case BK::Builtin:
+        if (b.builtin == Builtin::PlaceCount) {
+          const int s = self_at(b.outer, e.loc);
+          emit(OP_PCOUNT, s, s);
+          return s;
+        }
+        break;
+      case BK::This:
+        return self_at(0, e.loc);
+      case BK::Mark: {
+        const int r = temp();
+        emit(OP_MARK, r);
+        return r;
+      }
+      default:
+        break;
+    }
+    not_supported(P, e.loc, "using '" + e.spelling() + "' as a value");
+  }
+
+  int member(const MemberExpr& e) {
+    const Binding& b = e.binding;
+    switch (b.kind) {
+      case BK::Property:
+      case BK::MetaProperty: {
+        value_check(e);
+        const int o = expr(*e.object);
+        const int r = temp();
+        emit(OP_GETP, r, o, prop_slot(b, e.loc));
+        return r;
+      }
+      case BK::Place: {
+        const int o = expr(*e.object);
+        const int r = temp();
+        emit(OP_PLACE, r, o, place_index(b.decl->as<PlaceDecl>(), e.loc));
+        return r;
+      }
+      case BK::Builtin:
+        if (b.builtin == Builtin::PlaceCount) {
+          const int o = expr(*e.object);
+          const int r = temp();
+          emit(OP_PCOUNT, r, o);
+          return r;
+        }
+        break;
+      default:
+        break;
+    }
+    not_supported(P, e.loc, "member '" + e.name + "' as a value");
+  }
+
+  // The holder register and property slot of a list-valued expression (a property of a list type).
+  std::pair<int, int> list_of(const Expr& e) {
+    if (e.kind == ExprKind::Member) {
+      const auto& m = e.as<MemberExpr>();
+      if (m.binding.kind == BK::Property || m.binding.kind == BK::MetaProperty) {
+        const int slot = prop_slot(m.binding, e.loc);
+        if (P.props_[slot].kind == PK::List) return {expr(*m.object), slot};
+      }
+    } else if (e.kind == ExprKind::Name) {
+      const auto& n = e.as<NameExpr>();
+      if (n.binding.kind == BK::Property || n.binding.kind == BK::MetaProperty) {
+        const int slot = prop_slot(n.binding, e.loc);
+        if (P.props_[slot].kind == PK::List) return {self_at(n.binding.outer, e.loc), slot};
+      }
+    }
+    not_supported(P, e.loc, "this list or vector expression (lists are reached as properties)");
+  }
+
+  int index(const IndexExpr& e) {
+    auto [h, slot] = list_of(*e.object);
+    const int r = temp();
+    expr_to(*e.index, r, e.index->type);
+    emit(OP_LGET, r, h, slot);
+    return r;
+  }
+
+  int unary(const UnaryExpr& e) {
+    const bool inc = e.op == TokenKind::PlusPlus || e.op == TokenKind::MinusMinus;
+    if (inc) {
+      store_compound(*e.operand, e.op == TokenKind::PlusPlus ? TokenKind::Plus : TokenKind::Minus, nullptr);
+      return -1;
+    }
+    const int o = expr(*e.operand);
+    const int r = temp();
+    switch (e.op) {
+      case TokenKind::Bang:
+        emit(OP_NOT, r, o);
+        return r;
+      case TokenKind::Minus:
+        emit(e.type.kind == K::Double ? OP_NEGD : OP_NEGI, r, o);
+        return r;
+      case TokenKind::Plus:
+        move(r, o, reg_kind(e.type));
+        return r;
+      default:
+        not_supported(P, e.loc, "this operator");
+    }
+  }
+
+  int arith(TokenKind op, int l, const Type& lt, int r, const Type& rt, const Type& result, SourceLoc loc,
+            int into = -1) {
+    const int d = into >= 0 && result.kind != K::String ? into : temp();
+    if (result.kind == K::String) {  // concatenation
+      const int ls = to_string(l, lt), rs = to_string(r, rt);
+      emit(OP_CONCAT, d, ls, rs);
+      return d;
+    }
+    const bool dbl = result.kind == K::Double;
+    if (dbl) {
+      l = coerce(l, lt, result);
+      r = coerce(r, rt, result);
+    }
+    Op o;
+    switch (op) {
+      case TokenKind::Plus:
+        o = dbl ? OP_ADDD : OP_ADDI;
+        break;
+      case TokenKind::Minus:
+        o = dbl ? OP_SUBD : OP_SUBI;
+        break;
+      case TokenKind::Star:
+        o = dbl ? OP_MULD : OP_MULI;
+        break;
+      case TokenKind::Slash:
+        o = dbl ? OP_DIVD : OP_DIVI;
+        break;
+      case TokenKind::Percent:
+        o = OP_MODI;
+        break;
+      default:
+        not_supported(P, loc, "this operator");
+    }
+    emit(o, d, l, r);
+    return d;
+  }
+
+  int to_string(int r, const Type& t) {
+    if (t.kind == K::String) return r;
+    const int d = temp();
+    int variant = 0;
+    switch (t.kind) {
+      case K::Int:
+        variant = 0;
+        break;
+      case K::Double:
+        variant = 1;
+        break;
+      case K::Bool:
+        variant = 2;
+        break;
+      case K::Enum: {
+        const MetaType* m = t.meta;
+        if (t.enum_decl != nullptr) {
+          auto it = P.enums_.find(t.enum_decl);
+          if (it != P.enums_.end()) m = it->second;
+        }
+        if (m == nullptr) not_supported(P, SourceLoc{}, "this enum");
+        P.enum_types_.push_back(m);
+        variant = 3 + static_cast<int>(P.enum_types_.size() - 1);
+        break;
+      }
+      case K::Ref:
+      case K::Null:
+        variant = 2 + 60000;  // never used: the checker rejects it
+        not_supported(P, SourceLoc{}, "converting a reference to a string");
+      default:
+        not_supported(P, SourceLoc{}, "converting '" + t.name() + "' to a string");
+    }
+    emit(OP_TOSTR, d, r, variant);
+    return d;
+  }
+
+  int compare(TokenKind op, int l, const Type& lt, int r, const Type& rt, int into = -1) {
+    const int d = into >= 0 ? into : temp();
+    const bool dbl = (lt.kind == K::Double || rt.kind == K::Double);
+    const bool str = lt.kind == K::String;
+    if (dbl) {
+      Type td = Type::of(K::Double);
+      l = coerce(l, lt, td);
+      r = coerce(r, rt, td);
+    }
+    bool swap = false;
+    Op o;
+    switch (op) {
+      case TokenKind::Less:
+        o = str ? OP_LTS : dbl ? OP_LTD : OP_LTI;
+        break;
+      case TokenKind::LessEqual:
+        o = str ? OP_LES : dbl ? OP_LED : OP_LEI;
+        break;
+      case TokenKind::Greater:
+        o = str ? OP_LTS : dbl ? OP_LTD : OP_LTI;
+        swap = true;
+        break;
+      case TokenKind::GreaterEqual:
+        o = str ? OP_LES : dbl ? OP_LED : OP_LEI;
+        swap = true;
+        break;
+      case TokenKind::EqualEqual:
+        o = str ? OP_EQS : dbl ? OP_EQD : OP_EQI;
+        break;
+      default:
+        o = str ? OP_NES : dbl ? OP_NED : OP_NEI;
+        break;
+    }
+    if (swap) std::swap(l, r);
+    emit(o, d, l, r);
+    return d;
+  }
+
+  int binary(const BinaryExpr& e) {
+    if (e.op == TokenKind::AmpAmp || e.op == TokenKind::PipePipe) {
+      const int r = temp();
+      expr_to(*e.lhs, r, e.type);
+      const std::size_t j = emit_jump(e.op == TokenKind::AmpAmp ? OP_JMPF : OP_JMPT, r);
+      top_ = r + 1;
+      expr_to(*e.rhs, r, e.type);
+      patch(j, here());
+      top_ = r + 1;
+      return r;
+    }
+    const int d = temp();
+    binary_into(e, d);
+    top_ = d + 1;
+    return d;
+  }
+
+  // An int operation with a small constant right operand: one instruction with an immediate.
+  bool immediate(const BinaryExpr& e, int dst) {
+    if (e.type.kind != K::Int || e.lhs->type.kind != K::Int || e.rhs->kind != ExprKind::Int) return false;
+    const std::int64_t k = e.rhs->as<LiteralExpr>().int_value;
+    if (k < -32767 || k > 32767) return false;
+    Op o;
+    std::int64_t v = k;
+    switch (e.op) {
+      case TokenKind::Plus:
+        o = OP_ADDIK;
+        break;
+      case TokenKind::Minus:
+        o = OP_ADDIK;
+        v = -k;
+        break;
+      case TokenKind::Star:
+        o = OP_MULIK;
+        break;
+      case TokenKind::Slash:
+        if (k == 0 || k == -1) return false;
+        o = OP_DIVIK;
+        break;
+      case TokenKind::Percent:
+        if (k == 0 || k == -1) return false;
+        o = OP_MODIK;
+        break;
+      default:
+        return false;
+    }
+    const int l = expr(*e.lhs);
+    emit(o, dst, l, static_cast<std::uint16_t>(static_cast<std::int16_t>(v)));
+    return true;
+  }
+
+  // Computes a (non-logical) binary expression into register dst.
+  void binary_into(const BinaryExpr& e, int dst) {
+    const int save = top_;
+    if (immediate(e, dst)) {
+      top_ = save;
+      return;
+    }
+    const int l = expr(*e.lhs);
+    const int r = expr(*e.rhs);
+    int d;
+    switch (e.op) {
+      case TokenKind::Plus:
+      case TokenKind::Minus:
+      case TokenKind::Star:
+      case TokenKind::Slash:
+      case TokenKind::Percent:
+        d = arith(e.op, l, e.lhs->type, r, e.rhs->type, e.type, e.loc, dst);
+        break;
+      default:
+        d = compare(e.op, l, e.lhs->type, r, e.rhs->type, dst);
+    }
+    move(dst, d, reg_kind(e.type));
+    top_ = save;
+  }
+
+  // Stores register v (of type vt) into the place lvalue e designates.
+  void store(const Expr& e, int v, const Type& vt) {
+    at(e.loc);
+    if (e.kind == ExprKind::Name) {
+      const auto& n = e.as<NameExpr>();
+      if (n.binding.kind == BK::Local) {
+        move(n.binding.slot, coerce(v, vt, e.type), reg_kind(e.type));
+        return;
+      }
+      if (n.binding.kind == BK::Property || n.binding.kind == BK::MetaProperty) {
+        const int s = self_at(n.binding.outer, e.loc);
+        emit(OP_SETP, s, coerce(v, vt, e.type), prop_slot(n.binding, e.loc));
+        return;
+      }
+    } else if (e.kind == ExprKind::Member) {
+      const auto& m = e.as<MemberExpr>();
+      if (m.binding.kind == BK::Property || m.binding.kind == BK::MetaProperty) {
+        const int o = expr(*m.object);
+        emit(OP_SETP, o, coerce(v, vt, e.type), prop_slot(m.binding, e.loc));
+        return;
+      }
+    }
+    not_supported(P, e.loc, "assigning to this expression");
+  }
+
+  void store_compound(const Expr& target, TokenKind op, const Expr* rhs) {
+    const int save = top_;
+    if (target.kind == ExprKind::Name && target.as<NameExpr>().binding.kind == BK::Local &&
+        target.type.kind == K::Int && (op == TokenKind::Plus || op == TokenKind::Minus) &&
+        (rhs == nullptr || (rhs->kind == ExprKind::Int && rhs->as<LiteralExpr>().int_value >= -32767 &&
+                            rhs->as<LiteralExpr>().int_value <= 32767))) {
+      std::int64_t k = rhs == nullptr ? 1 : rhs->as<LiteralExpr>().int_value;
+      if (op == TokenKind::Minus) k = -k;
+      const int slot = target.as<NameExpr>().binding.slot;
+      emit(OP_ADDIK, slot, slot, static_cast<std::uint16_t>(static_cast<std::int16_t>(k)));
+      return;
+    }
+    const int cur = expr(target);
+    int r;
+    Type rt;
+    if (rhs != nullptr) {
+      r = expr(*rhs);
+      rt = rhs->type;
+    } else {
+      r = temp();
+      load_int(r, 1);
+      rt = Type::of(K::Int);
+    }
+    Type result = target.type;
+    if (result.kind == K::Int && rt.kind == K::Double) result = Type::of(K::Double);
+    if (target.type.kind == K::String) result = Type::of(K::String);
+    int v = arith(op, cur, target.type, r, rt, result, target.loc);
+    if (result.kind == K::Double && target.type.kind == K::Int) {
+      const int t = temp();
+      emit(OP_D2I, t, v);
+      v = t;
+    }
+    store(target, v, target.type);
+    top_ = save;
+  }
+
+  void assign(const BinaryExpr& e) {
+    const int save = top_;
+    if (e.op == TokenKind::Equal) {
+      if (e.lhs->kind == ExprKind::Name && e.lhs->as<NameExpr>().binding.kind == BK::Local) {
+        expr_to(*e.rhs, e.lhs->as<NameExpr>().binding.slot, e.lhs->type);
+      } else {
+        const int v = expr(*e.rhs);
+        store(*e.lhs, v, e.rhs->type);
+      }
+      top_ = save;
+      return;
+    }
+    TokenKind op = TokenKind::Plus;
+    switch (e.op) {
+      case TokenKind::MinusEqual:
+        op = TokenKind::Minus;
+        break;
+      case TokenKind::StarEqual:
+        op = TokenKind::Star;
+        break;
+      case TokenKind::SlashEqual:
+        op = TokenKind::Slash;
+        break;
+      case TokenKind::PercentEqual:
+        op = TokenKind::Percent;
+        break;
+      default:
+        break;
+    }
+    store_compound(*e.lhs, op, e.rhs.get());
+  }
+
+  // Arguments into consecutive fresh registers starting at the returned one.
+  int args_at(const std::vector<ExprPtr>& args, const std::vector<Type>& want) {
+    const int base = top_;
+    for (std::size_t i = 0; i < args.size(); ++i) temp();
+    for (std::size_t i = 0; i < args.size(); ++i) {
+      const int save = top_;
+      expr_to(*args[i], base + static_cast<int>(i), i < want.size() ? want[i] : args[i]->type);
+      top_ = save;
+    }
+    return base;
+  }
+
+  int call(const CallExpr& e) {
+    const Binding& b = e.binding;
+    const Expr& callee = *e.callee;
+    switch (b.kind) {
+      case BK::Function: {
+        const auto& fd = b.decl->as<FunctionDecl>();
+        int self;
+        if (callee.kind == ExprKind::Member)
+          self = expr(*callee.as<MemberExpr>().object);
+        else
+          self = self_at(b.outer, callee.loc);
+        std::vector<Type> want;
+        for (const Param& p : fd.params) want.push_back(p.type);
+        const int base = args_at(e.args, want);
+        if (base == top_) temp();  // the result register
+        at(e.loc);
+        auto v = P.vslot_of_.find(&fd);
+        if (v != P.vslot_of_.end())
+          emit(OP_VCALL, base, v->second, self);
+        else
+          emit(OP_CALL, base, P.function_index_.at(&fd), self);
+        top_ = base + 1;
+        return base;
+      }
+      case BK::MetaMethod: {
+        const int r = temp();
+        if (callee.kind == ExprKind::Member) {
+          const int o = expr(*callee.as<MemberExpr>().object);
+          move(r, o, RK::R);
+        } else {
+          const int o = self_at(b.outer, callee.loc);
+          move(r, o, RK::R);
+        }
+        top_ = r + 1;
+        std::vector<Type> want;
+        args_at(e.args, want);
+        if (reg_kind(e.type) == RK::None && e.type.kind != K::Void)
+          not_supported(P, e.loc, "a method returning '" + e.type.name() + "'");
+        P.methods_.push_back(b.method);
+        P.method_kinds_.emplace_back();
+        for (const ExprPtr& a : e.args) {
+          if (reg_kind(a->type) == RK::None)
+            not_supported(P, a->loc, "an argument of type '" + a->type.name() + "'");
+          P.method_kinds_.back().push_back(reg_kind(a->type));
+        }
+        P.method_results_.push_back(reg_kind(e.type));
+        at(e.loc);
+        emit(OP_MCALL, r, static_cast<int>(P.methods_.size() - 1));
+        top_ = r + 1;
+        return r;
+      }
+      case BK::Builtin:
+        return builtin(e);
+      case BK::Conversion: {
+        const Expr& a = *e.args.at(0);
+        const int o = expr(a);
+        const int r = temp();
+        switch (e.type.kind) {
+          case K::Int:
+            if (a.type.kind == K::Double)
+              emit(OP_D2I, r, o);
+            else if (a.type.kind == K::String)
+              not_supported(P, e.loc, "int(string)");
+            else
+              move(r, o, RK::I);
+            return r;
+          case K::Double:
+            if (a.type.kind == K::Double)
+              move(r, o, RK::D);
+            else if (a.type.kind == K::String)
+              not_supported(P, e.loc, "double(string)");
+            else
+              emit(OP_I2D, r, o);
+            return r;
+          case K::String:
+            return to_string(o, a.type);
+          case K::Bool: {
+            if (a.type.kind == K::String) {
+              emit(OP_STR2B, r, o);
+              return r;
+            }
+            if (a.type.kind == K::Double) {
+              const int z = temp();
+              emit(OP_LOADK, z, konst(std::bit_cast<std::int64_t>(0.0)));
+              emit(OP_NED, r, o, z);
+              return r;
+            }
+            const int z = temp();
+            load_int(z, 0);
+            emit(OP_NEI, r, o, z);
+            return r;
+          }
+          default:
+            not_supported(P, e.loc, "this conversion");
+        }
+      }
+      default:
+        break;
+    }
+    not_supported(P, e.loc, "this call");
+  }
+
+  int builtin(const CallExpr& e) {
+    const Binding& b = e.binding;
+    const Expr& callee = *e.callee;
+    auto place_reg = [&]() {
+      if (callee.kind == ExprKind::Member) return expr(*callee.as<MemberExpr>().object);
+      return self_at(b.outer, callee.loc);
+    };
+    switch (b.builtin) {
+      case Builtin::Print: {
+        const int base = top_;
+        std::vector<RK> kinds;
+        for (std::size_t i = 0; i < e.args.size(); ++i) temp();
+        for (std::size_t i = 0; i < e.args.size(); ++i) {
+          const Expr& a = *e.args[i];
+          const int save = top_;
+          int r = expr(a);
+          if (a.type.kind == K::Enum || a.type.kind == K::Bool) r = to_string(r, a.type);
+          RK k = a.type.kind == K::Enum || a.type.kind == K::Bool ? RK::S : reg_kind(a.type);
+          if (k == RK::None) not_supported(P, a.loc, "printing a value of type '" + a.type.name() + "'");
+          move(base + static_cast<int>(i), r, k);
+          kinds.push_back(k);
+          top_ = save;
+        }
+        P.print_kinds_.push_back(std::move(kinds));
+        at(e.loc);
+        emit(OP_PRINT, base, static_cast<int>(e.args.size()), static_cast<int>(P.print_kinds_.size() - 1));
+        top_ = base;
+        return -1;
+      }
+      case Builtin::Sqrt:
+      case Builtin::Floor:
+      case Builtin::Ceil:
+      case Builtin::Abs:
+      case Builtin::Min:
+      case Builtin::Max:
+      case Builtin::Len: {
+        std::vector<Type> want;
+        const bool dbl = e.type.kind == K::Double;
+        for (std::size_t i = 0; i < e.args.size(); ++i)
+          want.push_back(dbl || b.builtin == Builtin::Sqrt ? Type::of(K::Double) : e.args[i]->type);
+        const int base = args_at(e.args, want);
+        if (base == top_) temp();
+        at(e.loc);
+        emit(OP_BUILTIN, base, static_cast<int>(b.builtin), dbl ? 1 : 0);
+        top_ = base + 1;
+        return base;
+      }
+      case Builtin::PlaceCount: {
+        const int p = place_reg();
+        const int r = temp();
+        emit(OP_PCOUNT, r, p);
+        return r;
+      }
+      case Builtin::PlacePut: {
+        const int p = place_reg();
+        const Expr& a = *e.args.at(0);
+        const int v = expr(a);
+        at(e.loc);
+        emit(OP_PPUT, p, v, a.type.kind == K::Int ? 0 : 1);
+        return -1;
+      }
+      case Builtin::PlaceClear: {
+        const int p = place_reg();
+        at(e.loc);
+        emit(OP_PCLEAR, p);
+        return -1;
+      }
+      case Builtin::Size: {
+        if (callee.kind != ExprKind::Member) break;
+        auto [h, slot] = list_of(*callee.as<MemberExpr>().object);
+        const int r = temp();
+        emit(OP_LSIZE, r, h, slot);
+        return r;
+      }
+      case Builtin::Push: {
+        if (callee.kind != ExprKind::Member) break;
+        auto [h, slot] = list_of(*callee.as<MemberExpr>().object);
+        const int v = expr(*e.args.at(0));
+        at(e.loc);
+        emit(OP_LPUSH, h, v, slot);
+        return -1;
+      }
+      default:
+        break;
+    }
+    not_supported(P, e.loc, "this built-in");
+  }
+
+  int make_new(const NewExpr& e) {
+    ClassRef c = e.type.cls;
+    const int r = temp();
+    std::vector<Type> want;
+    if (c.decl != nullptr && c.decl->constructor != nullptr)
+      for (const Param& p : c.decl->constructor->params) want.push_back(p.type);
+    args_at(e.args, want);
+    at(e.loc);
+    emit(OP_NEW, r, class_operand(c, e.loc), static_cast<int>(e.args.size()));
+    top_ = r + 1;
+    return r;
+  }
+
+  // ---- statements ----
+  struct Loop {
+    std::vector<std::size_t> breaks, continues;
+  };
+  std::vector<Loop> loops_;
+
+  void block(const BlockStmt& b) {
+    for (const StmtPtr& s : b.body) stmt(*s);
+  }
+
+  void stmt(const Stmt& s) {
+    const int save = top_;
+    at(s.loc);
+    switch (s.kind) {
+      case StmtKind::Block:
+        block(s.as<BlockStmt>());
+        break;
+      case StmtKind::Local: {
+        const auto& l = s.as<LocalStmt>();
+        const RK k = reg_kind(l.type);
+        if (k == RK::None) not_supported(P, l.loc, "a local of type '" + l.type.name() + "'");
+        if (l.init) {
+          expr_to(*l.init, l.slot, l.type);
+        } else if (k == RK::S) {
+          emit(OP_LOADS, l.slot, string_const(""));
+        } else if (k == RK::D) {
+          emit(OP_LOADK, l.slot, konst(std::bit_cast<std::int64_t>(0.0)));
+        } else {
+          load_int(l.slot, 0);
+        }
+        break;
+      }
+      case StmtKind::If: {
+        const auto& i = s.as<IfStmt>();
+        const int c = expr(*i.cond);
+        const std::size_t jf = emit_jump(OP_JMPF, c);
+        top_ = save;
+        stmt(*i.then_stmt);
+        if (i.else_stmt) {
+          const std::size_t je = emit_jump(OP_JMP);
+          patch(jf, here());
+          stmt(*i.else_stmt);
+          patch(je, here());
+        } else {
+          patch(jf, here());
+        }
+        break;
+      }
+      case StmtKind::While: {
+        const auto& w = s.as<WhileStmt>();
+        const std::size_t top = here();
+        const std::size_t jf = cond_jump(*w.cond);
+        top_ = save;
+        loops_.emplace_back();
+        stmt(*w.body);
+        const std::size_t back = emit_jump(OP_JMP);
+        patch(back, top);
+        patch(jf, here());
+        close_loop(top, here());
+        break;
+      }
+      case StmtKind::For: {
+        const auto& f = s.as<ForStmt>();
+        if (f.init) stmt(*f.init);
+        const std::size_t top = here();
+        std::size_t jf = static_cast<std::size_t>(-1);
+        if (f.cond) jf = cond_jump(*f.cond);
+        top_ = save;
+        loops_.emplace_back();
+        stmt(*f.body);
+        const std::size_t cont = here();
+        if (f.step) {
+          at(f.step->loc);
+          step_expr(*f.step);
+          top_ = save;
+        }
+        const std::size_t back = emit_jump(OP_JMP);
+        patch(back, top);
+        if (jf != static_cast<std::size_t>(-1)) patch(jf, here());
+        close_loop(cont, here());
+        break;
+      }
+      case StmtKind::ForEach: {
+        const auto& f = s.as<ForEachStmt>();
+        auto [h, slot] = list_of(*f.range);
+        const int hold = temp();
+        move(hold, h, RK::R);
+        const int i = temp();
+        const int n = temp();
+        load_int(i, 0);
+        const std::size_t top = here();
+        emit(OP_LSIZE, n, hold, slot);
+        const std::size_t jf = emit_jump(OP_JGEI, i, n);
+        move(f.var->slot, i, RK::I);
+        emit(OP_LGET, f.var->slot, hold, slot);
+        loops_.emplace_back();
+        stmt(*f.body);
+        const std::size_t cont = here();
+        emit(OP_ADDIK, i, i, 1);
+        const std::size_t back = emit_jump(OP_JMP);
+        patch(back, top);
+        patch(jf, here());
+        close_loop(cont, here());
+        break;
+      }
+      case StmtKind::Return: {
+        const auto& r = s.as<ReturnStmt>();
+        if (r.value) {
+          const int v = temp();
+          expr_to(*r.value, v, F.result_type);
+          emit(OP_RET, v);
+        } else {
+          emit(OP_RET0);
+        }
+        break;
+      }
+      case StmtKind::Finish:
+        not_supported(P, s.loc, "'finish' (net invocation)");
+      case StmtKind::Break:
+        loops_.back().breaks.push_back(emit_jump(OP_JMP));
+        break;
+      case StmtKind::Continue:
+        loops_.back().continues.push_back(emit_jump(OP_JMP));
+        break;
+      case StmtKind::Expr:
+        step_expr(*s.as<ExprStmt>().expr);
+        break;
+    }
+    top_ = save;
+  }
+
+  void step_expr(const Expr& e) { (void)expr(e); }
+
+  // Jump when the condition is false; `i < n` and `i <= n` on ints fuse into one instruction.
+  std::size_t cond_jump(const Expr& c) {
+    at(c.loc);
+    if (c.kind == ExprKind::Binary) {
+      const auto& b = c.as<BinaryExpr>();
+      if ((b.op == TokenKind::Less || b.op == TokenKind::LessEqual) && b.lhs->type.kind == K::Int &&
+          b.rhs->type.kind == K::Int) {
+        const int l = expr(*b.lhs);
+        const int r = expr(*b.rhs);
+        return emit_jump(b.op == TokenKind::Less ? OP_JGEI : OP_JGTI, l, r);
+      }
+    }
+    const int r = expr(c);
+    return emit_jump(OP_JMPF, r);
+  }
+
+  void close_loop(std::size_t cont, std::size_t end) {
+    for (std::size_t j : loops_.back().breaks) patch(j, end);
+    for (std::size_t j : loops_.back().continues) patch(j, cont);
+    loops_.pop_back();
+  }
+
+  ProgramImpl& P;
+  Function& F;
+  int top_;
+  int max_;
+  std::uint32_t line_ = 0;
+};
+
+}  // namespace
+
+int compile_function(ProgramImpl& p, int index, const FunctionDecl& fd) {
+  Function& f = *p.functions_[index];
+  f.result_type = fd.result_type;
+  f.result = reg_kind(fd.result_type);
+  Compiler c(p, f, parent_scope(fd), fd.slots);
+  for (const Param& prm : fd.params) {
+    const RK k = reg_kind(prm.type);
+    if (k == RK::None) not_supported(p, prm.loc, "a parameter of type '" + prm.type.name() + "'");
+    f.param_kinds.push_back(k);
+  }
+  f.nparams = static_cast<int>(fd.params.size());
+  if (fd.result_type.kind != K::Void && f.result == RK::None)
+    not_supported(p, fd.loc, "a result of type '" + fd.result_type.name() + "'");
+  c.block(*fd.body);
+  c.at(fd.body->loc);
+  if (fd.result_type.kind == K::Void)
+    c.emit(OP_RET0);
+  else
+    c.emit(OP_FAIL, 0, c.string_const("function '" + fd.name + "' ended without returning a value"));
+  c.finish();
+  return index;
+}
+
+int new_function(ProgramImpl& p, std::string name) {
+  p.functions_.push_back(std::make_unique<Function>());
+  p.functions_.back()->name = std::move(name);
+  return static_cast<int>(p.functions_.size() - 1);
+}
+
+int compile_condition(ProgramImpl& p, const TransitionDecl& t, const std::string& name) {
+  const int i = new_function(p, name);
+  Function& f = *p.functions_[i];
+  f.result = RK::I;
+  f.result_type = Type::of(K::Bool);
+  Compiler c(p, f, &t, t.when_slots);
+  if (t.when_expr) {
+    const int r = c.temp();
+    c.expr_to(*t.when_expr, r, f.result_type);
+    c.emit(OP_RET, r);
+  } else {
+    c.block(*t.when_block);
+    c.emit(OP_FAIL, 0, c.string_const("the condition ended without returning a value"));
+  }
+  c.finish();
+  return i;
+}
+
+int compile_action(ProgramImpl& p, const TransitionDecl& t, const std::string& name) {
+  const int i = new_function(p, name);
+  Function& f = *p.functions_[i];
+  Compiler c(p, f, &t, t.action_slots);
+  c.block(*t.action);
+  c.emit(OP_RET0);
+  c.finish();
+  return i;
+}
+
+int compile_arrow_condition(ProgramImpl& p, const ArrowDecl& a, const std::string& name) {
+  const int i = new_function(p, name);
+  Function& f = *p.functions_[i];
+  f.result = RK::I;
+  f.result_type = Type::of(K::Bool);
+  Compiler c(p, f, parent_scope(a), a.condition_slots);
+  const int r = c.temp();
+  c.expr_to(*a.condition, r, f.result_type);
+  c.emit(OP_RET, r);
+  c.finish();
+  return i;
+}
+
+// Property initialisers of a class-like declaration, place or transition (self: the new instance).
+int compile_init(ProgramImpl& p, const ScopeDecl& s, const std::string& name) {
+  const int i = new_function(p, name);
+  Function& f = *p.functions_[i];
+  Compiler c(p, f, &s, 0);
+  for (const DeclPtr& m : s.members) {
+    if (m->kind != DeclKind::Property) continue;
+    const auto& pd = m->as<PropertyDecl>();
+    if (!pd.init) continue;
+    if (reg_kind(pd.type) == RK::None)
+      not_supported(p, pd.init->loc, "an initial value of type '" + pd.type.name() + "'");
+    const int v = c.temp();
+    c.expr_to(*pd.init, v, pd.type);
+    const int self = c.self_at(0, pd.loc);
+    c.at(pd.loc);
+    c.emit(OP_SETP, self, v, p.prop_slot_.at(&pd));
+    c.top_ = 0;
+  }
+  c.emit(OP_RET0);
+  c.finish();
+  return i;
+}
+
+// The constructor call of an object derived from a class with arguments: slot 0 is the new object,
+// self is the object's parent scope (where the arguments are evaluated).
+int compile_object_ctor(ProgramImpl& p, const ClassDecl& obj, int ctor, const FunctionDecl& fd) {
+  const int i = new_function(p, obj.name + " (constructor arguments)");
+  Function& f = *p.functions_[i];
+  f.nparams = 1;
+  f.param_kinds = {RK::R};
+  Compiler c(p, f, parent_scope(obj), 1);
+  std::vector<Type> want;
+  for (const Param& prm : fd.params) want.push_back(prm.type);
+  const int base = c.args_at(obj.base_args, want);
+  if (base == c.top_) c.temp();
+  c.at(obj.base_loc);
+  c.emit(OP_CALL, base, ctor, 0);
+  c.emit(OP_RET0);
+  c.finish();
+  return i;
+}
+
+}  // namespace vsd::soml

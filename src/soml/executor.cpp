@@ -1,0 +1,197 @@
+// The SOML++ net executor (docs/soml.md, 5.2 and 5.3): transitions are re-tested only when something
+// they read changed — an input place (known from the arrows) or a property their condition or arrow
+// conditions read the last time they ran (recorded by the VM) — heard through the SimState's property
+// signal. Among the enabled transitions one is chosen with a seeded generator, so runs are
+// reproducible. Every firing changes markings through the setters of the place nodes.
+#include "program_impl.hpp"
+#include "vsd/core/error.hpp"
+
+namespace vsd::soml {
+
+void ProgramImpl::on_change(SimStateInstance& inst, const MetaProperty& p) {
+  if (&p == &Place::vsd_prop_tokens() || &p == &Place::vsd_prop_objects()) {
+    auto it = place_watch_.find(inst.id());
+    if (it != place_watch_.end())
+      for (std::uint32_t ti : it->second) mark_dirty(ti);
+  }
+  if (deps_map_.empty()) return;
+  auto it = deps_map_.find(DepKey{inst.id(), &p});
+  if (it != deps_map_.end())
+    for (std::uint32_t ti : it->second) mark_dirty(ti);
+}
+
+void ProgramImpl::put_token(Place& p, SimStateInstance* obj, std::int64_t n) {
+  if (obj == nullptr) {
+    p.set_tokens(p.tokens() + n);
+    return;
+  }
+  Node* node = obj->as<Node>();
+  if (node == nullptr) fail("only nodes can be tokens");
+  p.edit_objects().push_back(*node);
+}
+
+void ProgramImpl::set_enabled(std::uint32_t i, bool on) {
+  TI& ti = tis_[i];
+  if (on == ti.enabled) return;
+  ti.enabled = on;
+  if (on) {
+    ti.enabled_pos = static_cast<std::int32_t>(enabled_.size());
+    enabled_.push_back(i);
+  } else {
+    const auto pos = static_cast<std::size_t>(ti.enabled_pos);
+    const std::uint32_t last = enabled_.back();
+    enabled_[pos] = last;
+    tis_[last].enabled_pos = static_cast<std::int32_t>(pos);
+    enabled_.pop_back();
+    ti.enabled_pos = -1;
+  }
+}
+
+bool ProgramImpl::test(TI& ti) {
+  const NetInst& net = *ti.net;
+  const TransitionInfo& t = net.cls->transitions[static_cast<std::size_t>(ti.t)];
+  const std::uint64_t tid = net.transitions[static_cast<std::size_t>(ti.t)]->id();
+  dep_scratch_.clear();
+  deps_ = &dep_scratch_;
+  bool enabled = true;
+  std::uint64_t mark = 0;
+  auto truth = [&](int fn, std::uint64_t self, std::uint64_t m) {
+    ++tests_;
+    return run(fn, self, m, nullptr, nullptr).i != 0;
+  };
+  try {
+    for (std::size_t k = 0; k < t.in.size() && enabled; ++k) {
+      if (static_cast<int>(k) == t.mark_in) continue;
+      const ArrowInfo& a = t.in[k];
+      const Place& p = *net.places[static_cast<std::size_t>(a.place)];
+      std::int64_t n = 0;
+      if (a.cond < 0) {
+        n = p.count();
+      } else if (p.object_tokens()) {
+        for (std::size_t j = 0; j < p.objects().size(); ++j) {
+          const SimStateInstance* o = p.objects().at(j);
+          if (o != nullptr && truth(a.cond, net.owner, o->id())) ++n;
+        }
+      } else {
+        n = truth(a.cond, net.owner, 0) ? p.count() : 0;
+      }
+      enabled = a.inhibitor ? n < a.weight : n >= a.weight;
+    }
+    if (enabled && t.mark_in >= 0) {
+      const ArrowInfo& a = t.in[static_cast<std::size_t>(t.mark_in)];
+      const Place& p = *net.places[static_cast<std::size_t>(a.place)];
+      enabled = false;
+      for (std::size_t j = 0; j < p.objects().size() && !enabled; ++j) {
+        const SimStateInstance* o = p.objects().at(j);
+        if (o == nullptr) continue;
+        if (a.cond >= 0 && !truth(a.cond, net.owner, o->id())) continue;
+        if (t.cond >= 0 && !truth(t.cond, tid, o->id())) continue;
+        enabled = true;
+        mark = o->id();
+      }
+    } else if (enabled && t.cond >= 0) {
+      enabled = truth(t.cond, tid, 0);
+    }
+  } catch (const Error& e) {
+    enabled = false;
+    if (condition_errors_.size() < 100) condition_errors_.emplace_back(e.what());
+  }
+  deps_ = nullptr;
+  const auto index = static_cast<std::uint32_t>(&ti - tis_.data());
+  for (const auto& [id, prop] : dep_scratch_) {
+    auto& v = deps_map_[DepKey{id, prop}];
+    if (std::find(v.begin(), v.end(), index) == v.end()) v.push_back(index);
+  }
+  ti.mark = mark;
+  return enabled;
+}
+
+bool ProgramImpl::refresh() {
+  while (!dirty_.empty()) {
+    const std::uint32_t i = dirty_.back();
+    dirty_.pop_back();
+    tis_[i].dirty = false;
+    const bool on = test(tis_[i]);
+    set_enabled(i, on);
+  }
+  return !enabled_.empty();
+}
+
+void ProgramImpl::fire(std::uint32_t i) {
+  TI& ti = tis_[i];
+  NetInst& net = *ti.net;
+  const TransitionInfo& t = net.cls->transitions[static_cast<std::size_t>(ti.t)];
+  Transition& tn = *net.transitions[static_cast<std::size_t>(ti.t)];
+  const std::uint64_t mark = ti.mark;
+  SimStateInstance* m = mark != 0 ? state_.find(mark) : nullptr;
+  Place* from = nullptr;
+  std::size_t from_index = 0;
+  // Consume.
+  for (std::size_t k = 0; k < t.in.size(); ++k) {
+    const ArrowInfo& a = t.in[k];
+    if (a.inhibitor) continue;
+    Place& p = *net.places[static_cast<std::size_t>(a.place)];
+    if (static_cast<int>(k) == t.mark_in) {
+      from = &p;
+      from_index = p.objects().index_of(m);
+      if (from_index != RefListBase::npos) p.edit_objects().erase(from_index);
+    } else if (!a.object) {
+      p.set_tokens(p.tokens() - a.weight);
+    }
+  }
+  // Act; on an error, give the consumed tokens back and report.
+  if (t.action >= 0) {
+    try {
+      run(t.action, tn.id(), mark, nullptr, nullptr);
+    } catch (...) {
+      for (std::size_t k = 0; k < t.in.size(); ++k) {
+        const ArrowInfo& a = t.in[k];
+        if (a.inhibitor) continue;
+        Place& p = *net.places[static_cast<std::size_t>(a.place)];
+        if (static_cast<int>(k) == t.mark_in) {
+          if (m != nullptr && state_.find(mark) == m && from_index != RefListBase::npos)
+            p.edit_objects().insert(std::min(from_index, p.objects().size()), *m->as<Node>());
+        } else if (!a.object) {
+          p.set_tokens(p.tokens() + a.weight);
+        }
+      }
+      throw;
+    }
+  }
+  // Produce: black tokens to every black output place, the mark to the first object place that takes it.
+  Place* to = nullptr;
+  m = mark != 0 ? state_.find(mark) : nullptr;
+  for (const ArrowInfo& a : t.out) {
+    Place& p = *net.places[static_cast<std::size_t>(a.place)];
+    if (!a.object) {
+      if (a.cond < 0 || run(a.cond, net.owner, mark, nullptr, nullptr).i != 0)
+        p.set_tokens(p.tokens() + a.weight);
+    } else if (to == nullptr && m != nullptr && m->as<Node>() != nullptr) {
+      if (a.cond >= 0 && run(a.cond, net.owner, mark, nullptr, nullptr).i == 0) continue;
+      p.edit_objects().push_back(*m->as<Node>());
+      to = &p;
+    }
+  }
+  tn.set_firings(tn.firings() + 1);
+  ++firings_;
+  mark_dirty(i);
+  if (trace_) trace_(Firing{firings_, &tn, mark, from, to});
+}
+
+std::uint64_t ProgramImpl::step(std::uint64_t n) {
+  std::uint64_t fired = 0;
+  while (fired < n) {
+    if (!refresh()) break;
+    // xorshift64*: a seeded, reproducible choice among the enabled transitions.
+    rng_ ^= rng_ >> 12;
+    rng_ ^= rng_ << 25;
+    rng_ ^= rng_ >> 27;
+    const std::uint64_t r = rng_ * 0x2545F4914F6CDD1DULL;
+    const std::uint32_t pick = enabled_[static_cast<std::size_t>((r >> 32) % enabled_.size())];
+    fire(pick);
+    ++fired;
+  }
+  return fired;
+}
+
+}  // namespace vsd::soml

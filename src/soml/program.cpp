@@ -1,0 +1,652 @@
+// Loading a checked SOML++ script into a SimState (see runtime.hpp): source components, run-time
+// classes and enums, the linkage table, compilation, and the instances of the script object, its objects
+// and their nets.
+#include <algorithm>
+#include <cctype>
+
+#include "program_impl.hpp"
+#include "vsd/core/database.hpp"
+#include "vsd/core/environment.hpp"
+#include "vsd/core/error.hpp"
+#include "vsd/core/meta_method.hpp"
+#include "vsd/core/registry.hpp"
+#include "vsd/core/type_builder.hpp"
+
+namespace vsd::soml {
+
+using K = Type::Kind;
+
+namespace {
+
+const ScopeDecl* parent_scope(const Decl& d) {
+  return d.parent != nullptr ? &static_cast<const ScopeDecl&>(*d.parent) : nullptr;
+}
+
+bool is_static_instance(const Decl& d) {
+  if (d.kind == DeclKind::Script) return true;
+  if (d.kind != DeclKind::Object) return false;
+  for (const Decl* p = d.parent; p != nullptr; p = p->parent)
+    if (p->kind != DeclKind::Object && p->kind != DeclKind::Script) return false;
+  return true;
+}
+
+// "Outer::Inner" for nested declarations (the script object's members are top level).
+std::string qualified(const Decl& d) {
+  std::string s = d.name;
+  for (const Decl* p = d.parent; p != nullptr && p->kind != DeclKind::Script; p = p->parent)
+    s = p->name + "::" + s;
+  return s;
+}
+
+template <class F>
+void walk(const Decl& d, F&& fn) {
+  fn(d);
+  if (d.has_members())
+    for (const DeclPtr& m : d.as<ScopeDecl>().members) walk(*m, fn);
+}
+
+}  // namespace
+
+ProgramImpl::~ProgramImpl() { listener_.disconnect(); }
+
+// The MetaType that stores a value of static type t (references to script classes are stored as
+// references to their nearest built-in class: the checker already typed them).
+static const MetaType* storage_type(ProgramImpl& p, Registry& reg, const Type& t) {
+  switch (t.kind) {
+    case K::Bool:
+      return t.meta != nullptr ? t.meta : &meta_type<bool>();
+    case K::Int:
+      return t.meta != nullptr ? t.meta : &meta_type<std::int64_t>();
+    case K::Double:
+      return t.meta != nullptr ? t.meta : &meta_type<double>();
+    case K::String:
+      return &meta_type<std::string>();
+    case K::Enum:
+      if (t.enum_decl != nullptr) {
+        auto it = p.enums_.find(t.enum_decl);
+        return it != p.enums_.end() ? it->second : nullptr;
+      }
+      return t.meta;
+    case K::Struct:
+    case K::Vector:
+      return t.meta;
+    case K::Ref:
+    case K::List: {
+      const MetaInstance* m = t.cls.builtin();
+      if (m == nullptr) return nullptr;
+      const char* kind =
+          t.kind == K::Ref ? (t.shared ? "shared<" : "ref<") : (t.shared ? "shared_list<" : "list<");
+      return &reg.get_type(std::string(kind) + m->name() + ">");
+    }
+    default:
+      return nullptr;
+  }
+}
+
+void ProgramImpl::load(std::string name, std::string text) {
+  Registry& reg = state_.environment().registry();
+  checked_ = check_source(name, std::move(text), reg);
+  if (!checked_->ok()) throw Error(checked_->diagnostics.format());
+  {
+    std::string base = name.substr(name.find_last_of("/\\") + 1);
+    base = base.substr(0, base.find('.'));
+    for (char& c : base)
+      if (std::isalnum(static_cast<unsigned char>(c)) == 0) c = '_';
+    if (base.empty() || std::isdigit(static_cast<unsigned char>(base[0])) != 0) base = "script_" + base;
+    stem_ = base;
+  }
+  const ClassDecl& root = *checked_->script.root;
+
+  // 1. What the runtime cannot run yet is refused with its position, never ignored.
+  walk(root, [&](const Decl& d) {
+    if (d.kind == DeclKind::Net)
+      not_supported(*this, d.loc, "net '" + d.name + "' (substitution and invocation)");
+    if (d.kind == DeclKind::Arrow && d.as<ArrowDecl>().arrow == ArrowKind::Communication)
+      not_supported(*this, d.loc, "a communication arrow");
+    if (d.kind == DeclKind::Object && !is_static_instance(d))
+      not_supported(*this, d.loc, "an object nested in a class");
+    if (d.kind == DeclKind::Class && d.parent != nullptr && d.parent->kind == DeclKind::Class)
+      not_supported(*this, d.loc, "a class nested in a class");
+    if (d.kind == DeclKind::Transition) {
+      const auto& t = d.as<TransitionDecl>();
+      if (!t.invoke_name.empty()) not_supported(*this, t.invoke_loc, "net invocation");
+      if (!t.subst_name.empty()) not_supported(*this, t.subst_loc, "net substitution");
+    }
+  });
+
+  // 2. Script enums become run-time enums.
+  walk(root, [&](const Decl& d) {
+    if (d.kind != DeclKind::Enum) return;
+    const auto& e = d.as<EnumDecl>();
+    EnumBuilder b("soml::" + qualified(e));
+    b.underlying(meta_type<std::int64_t>());
+    for (std::size_t i = 0; i < e.values.size(); ++i) b.value(e.values[i], static_cast<std::int64_t>(i));
+    enums_[&e] = &b.define(reg);
+  });
+
+  // 3. Class-like declarations, bases first.
+  std::vector<const ClassDecl*> all;
+  walk(root, [&](const Decl& d) {
+    if (d.kind == DeclKind::Class || d.kind == DeclKind::Object || d.kind == DeclKind::Script)
+      all.push_back(&d.as<ClassDecl>());
+  });
+  std::unordered_map<const ClassDecl*, bool> placed;
+  std::function<void(const ClassDecl*)> order = [&](const ClassDecl* c) {
+    if (placed[c]) return;
+    placed[c] = true;
+    if (c->base.decl != nullptr) order(c->base.decl);
+    class_order_.push_back(c);
+  };
+  for (const ClassDecl* c : all) order(c);
+
+  // Function shells first: the MetaMethods' invokers and the compiler refer to them by index.
+  walk(root, [&](const Decl& d) {
+    if (d.kind != DeclKind::Function) return;
+    const auto& fd = d.as<FunctionDecl>();
+    const std::string owner =
+        d.parent != nullptr && d.parent->kind != DeclKind::Script ? qualified(*d.parent) + "." : "";
+    function_index_[&fd] =
+        new_function(*this, owner + (fd.is_constructor ? fd.name + " (constructor)" : fd.name));
+  });
+
+  auto add_members = [&](ClassBuilder& b, const ScopeDecl& s) {
+    for (const DeclPtr& m : s.members) {
+      if (m->kind == DeclKind::Property) {
+        const auto& pd = m->as<PropertyDecl>();
+        const MetaType* t = storage_type(*this, reg, pd.type);
+        if (t == nullptr) not_supported(*this, pd.loc, "a property of type '" + pd.type.name() + "'");
+        b.property(pd.name, *t);
+      } else if (m->kind == DeclKind::Function && !m->as<FunctionDecl>().is_constructor) {
+        const auto& fd = m->as<FunctionDecl>();
+        std::vector<const MetaType*> args;
+        for (const Param& prm : fd.params) {
+          const MetaType* t = storage_type(*this, reg, prm.type);
+          if (t == nullptr) not_supported(*this, prm.loc, "a parameter of type '" + prm.type.name() + "'");
+          args.push_back(t);
+        }
+        const MetaType* result =
+            fd.result_type.kind == K::Void ? nullptr : storage_type(*this, reg, fd.result_type);
+        const int fi = function_index_.at(&fd);
+        std::weak_ptr<ProgramImpl> weak = weak_self_;
+        b.method(fd.name, std::move(args), result,
+                 [weak, fi](SimStateInstance& self, std::span<const Value> a) {
+                   auto p = weak.lock();
+                   if (!p) throw Error("the SOML++ program of this method was unloaded");
+                   return p->call_from_cpp(fi, self, a);
+                 });
+      }
+    }
+  };
+
+  for (const ClassDecl* c : class_order_) {
+    auto ci = std::make_unique<ClassInfo>();
+    ci->decl = c;
+    const MetaInstance* base = &Node::static_meta();
+    if (c->base.decl != nullptr) {
+      ci->base = class_info_.at(c->base.decl).get();
+      base = ci->base->meta;
+    } else if (c->base.meta != nullptr) {
+      base = c->base.meta;
+    }
+    if (!base->is_a(Node::static_meta()))
+      not_supported(*this, c->base_loc, "a class derived from '" + base->name() + "' (not a Node)");
+    const std::string cname = c->kind == DeclKind::Script ? "soml::" + stem_ : "soml::" + qualified(*c);
+    ClassBuilder b(cname, *base);
+    add_members(b, *c);
+    ci->meta = &b.define(reg);
+    scope_meta_[c] = ci->meta;
+    by_meta_[ci->meta] = ci.get();
+    // Places and transitions with members of their own get a class of their own.
+    for (const DeclPtr& m : c->members) {
+      if (m->kind != DeclKind::Place && m->kind != DeclKind::Transition) continue;
+      const auto& s = m->as<ScopeDecl>();
+      bool own = false;
+      for (const DeclPtr& x : s.members)
+        own = own || x->kind == DeclKind::Property || x->kind == DeclKind::Function;
+      const MetaInstance& sb = m->kind == DeclKind::Place ? Place::static_meta() : Transition::static_meta();
+      if (!own) {
+        scope_meta_[m.get()] = &sb;
+        continue;
+      }
+      ClassBuilder pb(cname + "::" + m->name, sb);
+      add_members(pb, s);
+      scope_meta_[m.get()] = &pb.define(reg);
+    }
+    class_info_[c] = std::move(ci);
+  }
+
+  // 4. Linkage: property declarations -> MetaProperties (props_ slots).
+  walk(root, [&](const Decl& d) {
+    if (d.kind != DeclKind::Property) return;
+    const MetaInstance* m = scope_meta_.at(d.parent);
+    const MetaProperty* mp = m->find_property(d.name);
+    if (mp == nullptr) not_supported(*this, d.loc, "property '" + d.name + "'");
+    PropSlot s;
+    s.prop = mp;
+    const auto& pd = d.as<PropertyDecl>();
+    switch (pd.type.kind) {
+      case K::Bool:
+        s.kind = PK::Bool;
+        break;
+      case K::Int:
+        s.kind = &mp->type() == &meta_type<std::int64_t>() ? PK::I64 : PK::Int;
+        break;
+      case K::Double:
+        s.kind = &mp->type() == &meta_type<double>() ? PK::Double : PK::Other;
+        break;
+      case K::String:
+        s.kind = PK::String;
+        break;
+      case K::Enum:
+        s.kind = PK::Enum;
+        break;
+      case K::Ref:
+        s.kind = PK::Ref;
+        break;
+      case K::List:
+        s.kind = PK::List;
+        break;
+      default:
+        s.kind = PK::Other;
+    }
+    props_.push_back(s);
+    prop_slot_[&pd] = static_cast<int>(props_.size() - 1);
+    meta_prop_slot_[mp] = prop_slot_[&pd];
+  });
+
+  // 5. Overrides: a function with the name of a base class's function is called virtually.
+  for (const ClassDecl* c : class_order_) {
+    ClassInfo& ci = *class_info_.at(c);
+    if (ci.base != nullptr) ci.vtable = ci.base->vtable;
+    for (const DeclPtr& m : c->members) {
+      if (m->kind != DeclKind::Function || m->as<FunctionDecl>().is_constructor) continue;
+      const auto& fd = m->as<FunctionDecl>();
+      const FunctionDecl* rootf = &fd;
+      for (const ClassInfo* b = ci.base; b != nullptr; b = b->base)
+        for (const DeclPtr& bm : b->decl->members)
+          if (bm->kind == DeclKind::Function && bm->name == fd.name) rootf = &bm->as<FunctionDecl>();
+      if (rootf != &fd) {
+        if (vslot_of_.find(rootf) == vslot_of_.end()) {
+          vslot_of_[rootf] = static_cast<int>(vslots_.size());
+          vslots_.push_back(rootf);
+          vslot_default_.push_back(function_index_.at(rootf));
+        }
+        vslot_of_[&fd] = vslot_of_[rootf];
+        ci.vtable[rootf] = function_index_.at(&fd);
+      }
+    }
+  }
+
+  // 6. Nets of every class: places and transitions, bases' first.
+  for (const ClassDecl* c : class_order_) {
+    ClassInfo& ci = *class_info_.at(c);
+    auto net = std::make_unique<NetClass>();
+    if (ci.base != nullptr && ci.base->net) {
+      net->places = ci.base->net->places;
+      net->transitions = ci.base->net->transitions;
+    }
+    for (const DeclPtr& m : c->members)
+      if (m->kind == DeclKind::Place) net->places.push_back(&m->as<PlaceDecl>());
+    if (!net->places.empty()) ci.net = std::move(net);
+  }
+  auto place_index = [&](const NetClass& n, const Decl* d) {
+    for (std::size_t i = 0; i < n.places.size(); ++i)
+      if (n.places[i] == d) return static_cast<int>(i);
+    return -1;
+  };
+  for (const ClassDecl* c : class_order_) {
+    ClassInfo& ci = *class_info_.at(c);
+    bool has_transitions = false;
+    for (const DeclPtr& m : c->members) has_transitions = has_transitions || m->kind == DeclKind::Transition;
+    if (has_transitions && !ci.net) ci.net = std::make_unique<NetClass>();
+  }
+
+  // 7. Compile.
+  for (auto& [fd, fi] : function_index_) compile_function(*this, fi, *fd);
+  for (const ClassDecl* c : class_order_) {
+    ClassInfo& ci = *class_info_.at(c);
+    const std::string cname = c->kind == DeclKind::Script ? stem_ : qualified(*c);
+    const std::string prefix = c->kind == DeclKind::Script ? "" : cname + ".";
+    ci.init = compile_init(*this, *c, cname + " (initialisers)");
+    if (c->constructor != nullptr) ci.ctor = function_index_.at(c->constructor);
+    if (c->kind == DeclKind::Object && c->has_args && c->base.decl != nullptr &&
+        c->base.decl->constructor != nullptr)
+      ci.object_ctor = compile_object_ctor(*this, *c, function_index_.at(c->base.decl->constructor),
+                                           *c->base.decl->constructor);
+    for (const DeclPtr& m : c->members) {
+      if (m->kind == DeclKind::Place || m->kind == DeclKind::Transition)
+        scope_init_[m.get()] = compile_init(*this, m->as<ScopeDecl>(), prefix + m->name + " (initialisers)");
+      if (m->kind != DeclKind::Transition) continue;
+      const auto& t = m->as<TransitionDecl>();
+      TransitionInfo ti;
+      ti.decl = &t;
+      ti.index = static_cast<int>(ci.net->transitions.size());
+      if (t.when_expr || t.when_block)
+        ti.cond = compile_condition(*this, t, prefix + t.name + " (condition)");
+      if (t.action) ti.action = compile_action(*this, t, prefix + t.name + " (action)");
+      auto arrow_info = [&](const ArrowDecl& a, const Decl* place) {
+        ArrowInfo ai;
+        ai.decl = &a;
+        ai.place = place_index(*ci.net, place);
+        if (ai.place < 0) not_supported(*this, a.loc, "an arrow to a place of another net");
+        ai.weight = a.weight;
+        ai.inhibitor = a.arrow == ArrowKind::Inhibitor;
+        ai.object = !place->as<PlaceDecl>().token.empty();
+        if (a.condition)
+          ai.cond = compile_arrow_condition(*this, a,
+                                            prefix + "arrow " + a.from_decl->name + " -> " + a.to_decl->name);
+        return ai;
+      };
+      for (const ArrowDecl* a : t.inputs) {
+        ti.in.push_back(arrow_info(*a, a->from_decl));
+        if (ti.in.back().object && !ti.in.back().inhibitor) ti.mark_in = static_cast<int>(ti.in.size() - 1);
+      }
+      for (const ArrowDecl* a : t.outputs) ti.out.push_back(arrow_info(*a, a->to_decl));
+      ci.net->transitions.push_back(std::move(ti));
+    }
+  }
+  // Subclasses copied their bases' transitions before these were compiled: copy again.
+  for (const ClassDecl* c : class_order_) {
+    ClassInfo& ci = *class_info_.at(c);
+    if (ci.base == nullptr || !ci.base->net || !ci.net) continue;
+    std::vector<TransitionInfo> own = std::move(ci.net->transitions);
+    ci.net->transitions = ci.base->net->transitions;
+    for (auto& t : own) {
+      t.index = static_cast<int>(ci.net->transitions.size());
+      ci.net->transitions.push_back(std::move(t));
+    }
+  }
+
+  // 8. The database content: source components, the script object and its objects.
+  listener_ = state_.on_property_changed().connect(
+      [this](SimStateInstance& inst, const MetaProperty& p) { on_change(inst, p); });
+  source_node_ = &state_.create<SourceFile>();
+  source_node_->set_name(stem_ + " (source)");
+  source_node_->set_file(checked_->source->name());
+  source_node_->set_text(checked_->source->text());
+  state_.database().add_child(*source_node_);
+  std::function<void(const Decl&, Node&)> component = [&](const Decl& d, Node& parent) {
+    auto& sc = state_.create<SourceComponent>();
+    sc.set_name(d.kind == DeclKind::Script ? stem_ : d.name);
+    sc.set_kind(std::string(d.kind_name()));
+    sc.set_line(d.loc.line);
+    sc.set_column(d.loc.column);
+    parent.add_child(sc);
+    components_[&d] = &sc;
+    if (d.has_members())
+      for (const DeclPtr& m : d.as<ScopeDecl>().members) component(*m, sc);
+  };
+  component(root, *source_node_);
+
+  // Static instances first (their ids are constants of the code), then their values, nets and constructors.
+  std::vector<std::pair<const ClassDecl*, SimStateInstance*>> statics;
+  std::function<void(const ClassDecl&, Node*)> make = [&](const ClassDecl& c, Node* parent) {
+    SimStateInstance& inst =
+        create_node(*class_info_.at(&c), parent, c.kind == DeclKind::Script ? stem_ : c.name);
+    object_ids_[&c] = inst.id();
+    statics.emplace_back(&c, &inst);
+    for (const DeclPtr& m : c.members)
+      if (m->kind == DeclKind::Object) make(m->as<ClassDecl>(), inst.as<Node>());
+  };
+  make(root, &state_.database());
+  root_ = statics.front().second->as<Node>();
+  for (auto& [slot, decl] : object_refs_)
+    consts_[static_cast<std::size_t>(slot)] = static_cast<std::int64_t>(object_ids_.at(decl));
+  for (OuterPlan& p : outer_plans_)
+    if (p.static_decl != nullptr) p.static_id = object_ids_.at(p.static_decl);
+  for (auto& [decl, inst] : statics) setup(*class_info_.at(decl), *inst, nullptr, nullptr, 0);
+}
+
+SimStateInstance& ProgramImpl::create_node(const ClassInfo& ci, Node* parent, const std::string& name) {
+  SimStateInstance& inst = state_.create(*ci.meta);
+  Node* n = inst.as<Node>();
+  if (!name.empty()) n->set_name(name);
+  if (parent != nullptr) parent->add_child(*n);
+  return inst;
+}
+
+SimStateInstance& ProgramImpl::instantiate(const ClassInfo& ci, Node* parent, std::string name,
+                                           const Val* args, const std::string* sargs, int nargs) {
+  SimStateInstance& inst = create_node(ci, parent, name);
+  setup(ci, inst, args, sargs, nargs);
+  return inst;
+}
+
+void ProgramImpl::setup(const ClassInfo& ci, SimStateInstance& inst, const Val* args,
+                        const std::string* sargs, int nargs) {
+  std::vector<const ClassInfo*> chain;
+  for (const ClassInfo* c = &ci; c != nullptr; c = c->base) chain.push_back(c);
+  std::reverse(chain.begin(), chain.end());
+  for (const ClassInfo* c : chain)
+    if (c->init >= 0) run(c->init, inst.id(), 0, nullptr, nullptr);
+  if (ci.net) build_net(ci, inst);
+  // The start place: the most derived class's.
+  for (auto c = chain.rbegin(); c != chain.rend(); ++c) {
+    const StartDecl* sd = (*c)->decl->start;
+    if (sd == nullptr || sd->place_decl == nullptr) continue;
+    const ScopeDecl* owner = parent_scope(*sd->place_decl);
+    NetInst* net = nullptr;
+    if (owner != nullptr && owner->is_class_like() && is_static_instance(*owner)) {
+      net = net_of(object_ids_.at(&owner->as<ClassDecl>()));
+    } else {
+      net = net_of(inst.id());
+    }
+    if (net == nullptr) not_supported(*this, sd->loc, "this start place (its net does not exist yet)");
+    for (std::size_t i = 0; i < net->cls->places.size(); ++i)
+      if (net->cls->places[i] == sd->place_decl) put_token(*net->places[i], &inst, 1);
+    break;
+  }
+  // Constructors: bases' without arguments, then the class's own (or an object's base's) with them.
+  for (const ClassInfo* c : chain) {
+    if (c->ctor < 0) continue;
+    const Function& f = *functions_[static_cast<std::size_t>(c->ctor)];
+    if (c == &ci ||
+        (c == ci.base && ci.decl->kind == DeclKind::Object && ci.object_ctor < 0 && f.nparams == 0)) {
+      if (c == &ci && f.nparams != nargs)
+        fail("constructor of " + ci.decl->name + " needs " + std::to_string(f.nparams) + " arguments");
+      run(c->ctor, inst.id(), 0, args, sargs);
+    } else if (f.nparams == 0) {
+      run(c->ctor, inst.id(), 0, nullptr, nullptr);
+    }
+  }
+  if (ci.object_ctor >= 0) {
+    const Node* parent = inst.as<Node>()->parent();
+    Val self{};
+    self.id = inst.id();
+    run(ci.object_ctor, parent != nullptr ? parent->id() : 0, 0, &self, nullptr);
+  }
+}
+
+void ProgramImpl::build_net(const ClassInfo& ci, SimStateInstance& inst) {
+  auto net = std::make_unique<NetInst>();
+  net->owner = inst.id();
+  net->cls = ci.net.get();
+  Node& owner = *inst.as<Node>();
+  for (const PlaceDecl* pd : ci.net->places) {
+    auto& p = static_cast<Place&>(state_.create(*scope_meta_.at(pd)));
+    p.set_name(pd->name);
+    p.set_object_tokens(!pd->token.empty());
+    p.set_tokens(pd->initial_tokens);
+    owner.add_child(p);
+    net->places.push_back(&p);
+    place_watch_[p.id()];
+  }
+  for (const TransitionInfo& t : ci.net->transitions) {
+    auto& tn = static_cast<Transition&>(state_.create(*scope_meta_.at(t.decl)));
+    tn.set_name(t.decl->name);
+    owner.add_child(tn);
+    net->transitions.push_back(&tn);
+  }
+  auto node_of = [&](const Decl* d) -> Node* {
+    for (std::size_t i = 0; i < ci.net->places.size(); ++i)
+      if (ci.net->places[i] == d) return net->places[i];
+    for (std::size_t i = 0; i < ci.net->transitions.size(); ++i)
+      if (ci.net->transitions[i].decl == d) return net->transitions[i];
+    return nullptr;
+  };
+  for (const TransitionInfo& t : ci.net->transitions) {
+    auto add_arrow = [&](const ArrowInfo& a) {
+      Node* from = node_of(a.decl->from_decl);
+      Node* to = node_of(a.decl->to_decl);
+      auto& an = state_.create<Arrow>();
+      an.set_name(a.decl->from_decl->name + (a.inhibitor ? " -o " : " -> ") + a.decl->to_decl->name);
+      an.set_type(a.inhibitor ? ArrowType::Inhibitor : ArrowType::Normal);
+      an.set_weight(a.weight);
+      an.set_target(to);
+      from->add_child(an);
+    };
+    for (const ArrowInfo& a : t.in) add_arrow(a);
+    for (const ArrowInfo& a : t.out) add_arrow(a);
+  }
+  // Initialisers of places and transitions with properties.
+  for (std::size_t i = 0; i < ci.net->places.size(); ++i)
+    if (auto it = scope_init_.find(ci.net->places[i]); it != scope_init_.end())
+      run(it->second, net->places[i]->id(), 0, nullptr, nullptr);
+  for (std::size_t i = 0; i < ci.net->transitions.size(); ++i)
+    if (auto it = scope_init_.find(ci.net->transitions[i].decl); it != scope_init_.end())
+      run(it->second, net->transitions[i]->id(), 0, nullptr, nullptr);
+  // Register with the executor: every transition is tested once.
+  net->first_ti = static_cast<std::uint32_t>(tis_.size());
+  NetInst* n = net.get();
+  nets_[inst.id()] = std::move(net);
+  net_order_.push_back(n);
+  for (std::size_t t = 0; t < ci.net->transitions.size(); ++t) {
+    const auto ti = static_cast<std::uint32_t>(tis_.size());
+    tis_.push_back(TI{n, static_cast<int>(t)});
+    tis_.back().dirty = false;
+    mark_dirty(ti);
+    const TransitionInfo& info = ci.net->transitions[t];
+    for (const ArrowInfo& a : info.in)
+      place_watch_[n->places[static_cast<std::size_t>(a.place)]->id()].push_back(ti);
+  }
+}
+
+Value ProgramImpl::call_from_cpp(int fi, SimStateInstance& self, std::span<const Value> args) {
+  const Function& f = *functions_[static_cast<std::size_t>(fi)];
+  if (static_cast<int>(args.size()) != f.nparams)
+    throw Error("SOML++ function " + f.name + " takes " + std::to_string(f.nparams) + " arguments, " +
+                std::to_string(args.size()) + " given");
+  std::vector<Val> v(args.size());
+  std::vector<std::string> s(args.size());
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const Value& a = args[i];
+    const MetaType* t = a.type();
+    if (t == nullptr)
+      throw Error("SOML++ function " + f.name + ": argument " + std::to_string(i + 1) + " is empty");
+    switch (f.param_kinds[i]) {
+      case RK::I:
+        if (t->kind() == TypeKind::Bool)
+          v[i].i = a.as<bool>() ? 1 : 0;
+        else if (t->kind() == TypeKind::Enum || t->kind() == TypeKind::Int || t->kind() == TypeKind::UInt)
+          v[i].i = t->load_integer(a.data());
+        else
+          throw Error("SOML++ function " + f.name + ": argument " + std::to_string(i + 1) +
+                      " must be an integer, not " + t->name());
+        break;
+      case RK::D:
+        v[i].d = a.convert_to(meta_type<double>()).as<double>();
+        break;
+      case RK::S:
+        if (t->kind() != TypeKind::String)
+          throw Error("SOML++ function " + f.name + ": argument " + std::to_string(i + 1) +
+                      " must be a string, not " + t->name());
+        s[i] = a.as<std::string>();
+        break;
+      case RK::R: {
+        if (!t->is_reference() || t->is_ref_list())
+          throw Error("SOML++ function " + f.name + ": argument " + std::to_string(i + 1) +
+                      " must be a reference, not " + t->name());
+        const SimStateInstance* o = static_cast<const RefBase*>(a.data())->get();
+        v[i].id = o != nullptr ? o->id() : 0;
+        break;
+      }
+      default:
+        throw Error("SOML++ function " + f.name + ": unsupported argument type");
+    }
+  }
+  std::string sres;
+  const Val r = run(fi, self.id(), 0, v.data(), s.data(), &sres);
+  switch (f.result_type.kind) {
+    case K::Bool:
+      return Value(r.i != 0);
+    case K::Int:
+      return Value(r.i);
+    case K::Double:
+      return Value(r.d);
+    case K::String:
+      return Value(std::move(sres));
+    case K::Enum: {
+      const MetaType* et =
+          f.result_type.enum_decl != nullptr ? enums_.at(f.result_type.enum_decl) : f.result_type.meta;
+      Value e(*et);
+      std::memcpy(e.data(), &r.i, std::min<std::size_t>(et->size(), 8));
+      return e;
+    }
+    case K::Ref: {
+      SimStateInstance* o = r.id == 0 ? nullptr : state_.find(r.id);
+      return Value(SharedRef<Node>(o != nullptr ? o->as<Node>() : nullptr));
+    }
+    default:
+      return {};
+  }
+}
+
+// ---- Program ----
+
+Program::Program(std::shared_ptr<ProgramImpl> impl) : impl_(std::move(impl)) {}
+Program::~Program() = default;
+
+std::unique_ptr<Program> Program::load(SimState& state, std::string name, std::string text,
+                                       RunOptions options) {
+  auto impl = std::make_shared<ProgramImpl>(state, options);
+  impl->weak_self_ = impl;
+  impl->rng_ = options.seed == 0 ? 0x9E3779B97F4A7C15ULL : options.seed;
+  impl->load(std::move(name), std::move(text));
+  return std::unique_ptr<Program>(new Program(std::move(impl)));
+}
+
+Node& Program::root() const noexcept { return *impl_->root_; }
+
+Node* Program::object(std::string_view name) const {
+  for (const auto& [decl, id] : impl_->object_ids_)
+    if (decl->kind == DeclKind::Object && decl->name == name && decl->parent != nullptr &&
+        decl->parent->kind == DeclKind::Script) {
+      SimStateInstance* o = impl_->state_.find(id);
+      return o != nullptr ? o->as<Node>() : nullptr;
+    }
+  return nullptr;
+}
+
+Place* Program::place(std::string_view name, const Node* owner) const {
+  const Node* o = owner != nullptr ? owner : impl_->root_;
+  const NetInst* n = impl_->net_of(o->id());
+  if (n == nullptr) return nullptr;
+  for (std::size_t i = 0; i < n->places.size(); ++i)
+    if (n->cls->places[i]->name == name) return n->places[i];
+  return nullptr;
+}
+
+std::vector<Place*> Program::places() const {
+  std::vector<Place*> all;
+  for (const NetInst* n : impl_->net_order_)
+    if (impl_->state_.find(n->owner) != nullptr) all.insert(all.end(), n->places.begin(), n->places.end());
+  return all;
+}
+
+const MetaInstance* Program::script_class(std::string_view name) const {
+  for (const auto& [decl, ci] : impl_->class_info_)
+    if (decl->name == name && decl->kind != DeclKind::Script) return ci->meta;
+  return nullptr;
+}
+
+std::uint64_t Program::step(std::uint64_t n) { return impl_->step(n); }
+std::uint64_t Program::run_until_quiet(std::uint64_t limit) { return impl_->step(limit); }
+bool Program::enabled_any() { return impl_->refresh(); }
+std::uint64_t Program::firings() const noexcept { return impl_->firings_; }
+void Program::on_firing(std::function<void(const Firing&)> fn) { impl_->trace_ = std::move(fn); }
+std::uint64_t Program::condition_tests() const noexcept { return impl_->tests_; }
+const std::vector<std::string>& Program::condition_errors() const noexcept {
+  return impl_->condition_errors_;
+}
+
+}  // namespace vsd::soml

@@ -1,0 +1,334 @@
+// Internal: the loaded program (linkage table, bytecode, VM, executor). Not installed.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "vsd/core/meta_instance.hpp"
+#include "vsd/core/signal.hpp"
+#include "vsd/core/sim_state.hpp"
+#include "vsd/soml/checker.hpp"
+#include "vsd/soml/net_classes.hpp"
+#include "vsd/soml/runtime.hpp"
+
+namespace vsd::soml {
+
+// A register: statically typed code needs no tag. Ints, bools and enums use i, doubles d, references
+// the instance id (0 is null). Strings live in a parallel array of std::string (same index).
+union Val {
+  std::int64_t i;
+  double d;
+  std::uint64_t id;
+};
+
+// Register kinds of a static type.
+enum class RK : std::uint8_t { I, D, S, R, None };
+
+enum Op : std::uint8_t {
+  OP_NOP,
+  OP_LOADI,  // a = (int16) b
+  OP_LOADK,  // a = consts[b]            (ints and doubles as raw bits)
+  OP_LOADS,  // S[a] = strings[b]
+  OP_MOV,    // a = b
+  OP_MOVS,   // S[a] = S[b]
+  OP_ADDI,
+  OP_SUBI,
+  OP_MULI,
+  OP_DIVI,
+  OP_MODI,
+  OP_ADDD,
+  OP_SUBD,
+  OP_MULD,
+  OP_DIVD,
+  OP_ADDIK,  // a = b + (int16) c
+  OP_MULIK,  // a = b * (int16) c
+  OP_DIVIK,  // a = b / (int16) c   (c not 0 or -1)
+  OP_MODIK,  // a = b % (int16) c   (c not 0 or -1)
+  OP_NEGI,
+  OP_NEGD,
+  OP_NOT,
+  OP_I2D,
+  OP_D2I,
+  OP_LTI,
+  OP_LEI,
+  OP_EQI,
+  OP_NEI,
+  OP_LTD,
+  OP_LED,
+  OP_EQD,
+  OP_NED,
+  OP_LTS,
+  OP_LES,
+  OP_EQS,
+  OP_NES,
+  OP_CONCAT,   // S[a] = S[b] + S[c]
+  OP_TOSTR,    // S[a] = text of b; c: 0 int, 1 double, 2 bool, 3+k enum k
+  OP_STR2B,    // a = !S[b].empty()
+  OP_JMP,      // pc = target
+  OP_JMPF,     // if (!a) pc = target
+  OP_JMPT,     // if (a) pc = target
+  OP_JGEI,     // if (a >= b) pc = target   (fused loop test)
+  OP_JGTI,     // if (a > b) pc = target
+  OP_CALL,     // call functions[b] with frame at a, self in register c; result in a
+  OP_VCALL,    // like CALL, but b is a virtual slot resolved on the class of self
+  OP_RET,      // return register a
+  OP_RET0,     // return nothing
+  OP_SELF,     // a = instance of scope b levels out (outer plan b)
+  OP_MARK,     // a = mark
+  OP_OBJ,      // a = id of object consts[b]
+  OP_GETP,     // a = property props[c] of instance b
+  OP_SETP,     // property props[c] of instance a = b
+  OP_PLACE,    // a = place node number c of the net instance b
+  OP_PCOUNT,   // a = count of place b
+  OP_PPUT,     // place a .put(b)
+  OP_PCLEAR,   // place a .clear()
+  OP_LSIZE,    // a = size of list props[c] of b
+  OP_LGET,     // a = element (id) R[a] of list props[c] of b   (a holds the index on entry)
+  OP_LPUSH,    // list props[c] of a .push(b)
+  OP_NEW,      // a = new classes[b]; arguments from a+1, c of them
+  OP_ISA,      // a = instance b is_a classes[c]
+  OP_AS,       // a = instance b if is_a classes[c] else null
+  OP_MCALL,    // a = MetaMethod methods[b] on instance R[a], arguments from a+1 (count in the method)
+  OP_BUILTIN,  // a = builtin b over registers a.. (c: variant)
+  OP_PRINT,    // print registers a .. a+b-1; kinds from print_kinds[c]
+  OP_NULLCHK,  // error "null" unless a
+  OP_RANGE,    // check that a fits the storage type consts[b] (int properties narrower than int64)
+  OP_FAIL      // run-time error strings[b]
+};
+
+struct Ins {
+  std::uint8_t op;
+  std::uint8_t x;  // spare
+  std::uint16_t a;
+  std::uint16_t b;
+  std::uint16_t c;
+};
+static_assert(sizeof(Ins) == 8);
+
+struct Function {
+  std::string name;  // "Demo.time_to", "cell.go (condition)"
+  std::vector<Ins> code;
+  std::vector<std::uint32_t> lines;
+  std::vector<std::uint32_t> targets;  // jump targets by jump id
+  int nparams = 0;
+  int nregs = 0;
+  const ScopeDecl* scope = nullptr;  // the innermost instance scope (self)
+  std::vector<RK> param_kinds;
+  std::vector<const MetaInstance*> param_classes;  // reference parameters: the class they need
+  RK result = RK::None;
+  Type result_type;
+  bool compiled = false;
+};
+
+// How to reach the instance `outer` levels out of a function's scope: a fixed object, or parents.
+struct OuterPlan {
+  const ClassDecl* static_decl = nullptr;  // a fixed instance (resolved once objects exist)
+  std::uint64_t static_id = 0;
+  int parents = 0;
+};
+
+enum class PK : std::uint8_t { I64, Bool, Double, String, Int, Enum, Ref, List, Other };
+
+struct PropSlot {
+  const MetaProperty* prop = nullptr;
+  PK kind = PK::Other;
+};
+
+struct ArrowInfo {
+  const ArrowDecl* decl = nullptr;
+  int place = -1;  // index into the net's places
+  std::int64_t weight = 1;
+  bool inhibitor = false;
+  bool object = false;  // the place holds object tokens
+  int cond = -1;        // function index of the arrow condition
+};
+
+struct TransitionInfo {
+  const TransitionDecl* decl = nullptr;
+  int index = 0;  // in the net class
+  std::vector<ArrowInfo> in, out;
+  int mark_in = -1;  // index into in of the object input arrow
+  int cond = -1, action = -1;
+};
+
+// The net of a class-like declaration (its own places and transitions, bases' first).
+struct NetClass {
+  std::vector<const PlaceDecl*> places;
+  std::vector<TransitionInfo> transitions;
+};
+
+struct NetInst {
+  std::uint64_t owner = 0;
+  const NetClass* cls = nullptr;
+  std::vector<Place*> places;
+  std::vector<Transition*> transitions;
+  std::uint32_t first_ti = 0;  // index of its first transition in the executor's list
+};
+
+struct ClassInfo {
+  const ClassDecl* decl = nullptr;
+  const MetaInstance* meta = nullptr;
+  const ClassInfo* base = nullptr;  // script base
+  int init = -1;                    // property initialisers
+  int ctor = -1;
+  int object_ctor = -1;           // object derived with arguments: the constructor call
+  std::unique_ptr<NetClass> net;  // null when it has no places or transitions (own or inherited)
+  std::unordered_map<const FunctionDecl*, int> vtable;  // root function -> implementation
+};
+
+struct Frame {
+  const Function* fn;
+  const Ins* pc;
+  std::uint32_t base;
+  std::uint64_t self;
+  std::uint64_t mark;
+};
+
+class ProgramImpl {
+ public:
+  ProgramImpl(SimState& state, RunOptions options) : state_(state), opt_(options) {}
+  ~ProgramImpl();
+
+  void load(std::string name, std::string text);
+
+  // ---- VM ----
+  // Runs function @p f on @p self with arguments in args (count f.nparams); returns the result.
+  Val exec(std::size_t entry);
+  Val run(int f, std::uint64_t self, std::uint64_t mark, const Val* args, const std::string* sargs,
+          std::string* sresult = nullptr);
+  Value call_from_cpp(int f, SimStateInstance& self, std::span<const Value> args);
+  SimStateInstance& instantiate(const ClassInfo& ci, Node* parent, std::string name, const Val* args,
+                                const std::string* sargs, int nargs);
+  [[noreturn]] void fail(const std::string& what);
+
+  // ---- executor ----
+  std::uint64_t step(std::uint64_t n);
+  bool refresh();  // re-tests dirty transitions; true when some is enabled
+  void put_token(Place& p, SimStateInstance* obj, std::int64_t n);
+
+  std::weak_ptr<ProgramImpl> weak_self_;
+  std::function<void()> on_dirty_;  // called when a transition needs a test (the Module triggers its task)
+  SimStateInstance& create_node(const ClassInfo& ci, Node* parent, const std::string& name);
+  void setup(const ClassInfo& ci, SimStateInstance& inst, const Val* args, const std::string* sargs,
+             int nargs);
+  void build_net(const ClassInfo& ci, SimStateInstance& inst);
+
+  // ---- data ----
+  SimState& state_;
+  RunOptions opt_;
+  std::unique_ptr<CheckResult> checked_;
+  std::string stem_;
+  Node* root_ = nullptr;
+  SourceFile* source_node_ = nullptr;
+
+  std::vector<std::unique_ptr<Function>> functions_;
+  std::vector<std::int64_t> consts_;
+  std::vector<std::string> strings_;
+  std::vector<PropSlot> props_;
+  std::vector<const MetaMethod*> methods_;
+  std::vector<const ClassInfo*> classes_;         // by NEW/ISA operand (script classes)
+  std::vector<const MetaInstance*> class_metas_;  // by NEW/ISA operand
+  std::vector<const MetaType*> enum_types_;       // TOSTR of enums
+  std::vector<const MetaType*> range_types_;
+  std::vector<std::vector<RK>> print_kinds_;
+  std::vector<OuterPlan> outer_plans_;
+  std::vector<const FunctionDecl*> vslots_;                // virtual slot -> root function
+  std::unordered_map<const FunctionDecl*, int> vslot_of_;  // overridden functions -> virtual slot
+  std::vector<std::vector<RK>> method_kinds_;              // MCALL argument kinds
+  std::vector<RK> method_results_;
+  std::vector<std::pair<int, const ClassDecl*>> object_refs_;  // consts_ slot -> object
+  std::unordered_map<const Decl*, int> scope_init_;            // place/transition property initialisers
+
+  std::unordered_map<const ClassDecl*, std::unique_ptr<ClassInfo>> class_info_;
+  std::vector<const ClassDecl*> class_order_;  // bases first
+  std::unordered_map<const EnumDecl*, const MetaType*> enums_;
+  std::unordered_map<const PropertyDecl*, int> prop_slot_;  // decl -> props_ index
+  std::unordered_map<const MetaProperty*, int> meta_prop_slot_;
+  std::unordered_map<const FunctionDecl*, int> function_index_;
+  std::unordered_map<const Decl*, const MetaInstance*> scope_meta_;  // place/transition classes too
+  std::unordered_map<const ClassDecl*, std::uint64_t> object_ids_;   // top-level objects
+  std::unordered_map<const MetaInstance*, const ClassInfo*> by_meta_;
+  std::unordered_map<const Decl*, SourceComponent*> components_;
+  std::vector<std::pair<int, const TransitionDecl*>> when_fns_, action_fns_;
+
+  // VM state
+  std::vector<Val> regs_;
+  std::vector<std::string> sregs_;
+  std::vector<Frame> frames_;
+  std::uint32_t top_ = 0;  // first free register of the outermost frame stack
+  std::uint64_t budget_ = 0;
+  int entry_depth_ = 0;
+  std::vector<std::pair<std::uint64_t, const MetaProperty*>>* deps_ = nullptr;
+  std::vector<int> vslot_default_;  // virtual slot -> function of the root declaration
+  std::string stack_text(std::size_t from) const;
+
+  // executor state
+  std::unordered_map<std::uint64_t, std::unique_ptr<NetInst>> nets_;  // owner id -> net
+  std::vector<NetInst*> net_order_;
+  struct TI {
+    NetInst* net;
+    int t;
+    bool dirty = true;
+    bool enabled = false;
+    std::uint64_t mark = 0;
+    std::int32_t enabled_pos = -1;
+  };
+  std::vector<TI> tis_;
+  std::vector<std::uint32_t> dirty_;
+  std::vector<std::uint32_t> enabled_;
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> place_watch_;  // place id -> TIs
+  struct DepKey {
+    std::uint64_t id;
+    const MetaProperty* prop;
+    bool operator==(const DepKey&) const = default;
+  };
+  struct DepHash {
+    std::size_t operator()(const DepKey& k) const noexcept {
+      return std::hash<std::uint64_t>()(k.id * 0x9E3779B97F4A7C15ULL ^
+                                        reinterpret_cast<std::uintptr_t>(k.prop));
+    }
+  };
+  std::unordered_map<DepKey, std::vector<std::uint32_t>, DepHash> deps_map_;
+  std::vector<std::pair<std::uint64_t, const MetaProperty*>> dep_scratch_;
+  Connection listener_;
+  std::uint64_t rng_ = 1;
+  std::uint64_t firings_ = 0;
+  std::uint64_t tests_ = 0;
+  std::vector<std::string> condition_errors_;
+  std::function<void(const Firing&)> trace_;
+
+  void mark_dirty(std::uint32_t ti) {
+    if (!tis_[ti].dirty) {
+      tis_[ti].dirty = true;
+      if (dirty_.empty() && on_dirty_) on_dirty_();
+      dirty_.push_back(ti);
+    }
+  }
+  void on_change(SimStateInstance& inst, const MetaProperty& p);
+  NetInst* net_of(std::uint64_t owner) const {
+    auto it = nets_.find(owner);
+    return it == nets_.end() ? nullptr : it->second.get();
+  }
+  bool test(TI& ti);
+  void fire(std::uint32_t ti);
+  void set_enabled(std::uint32_t ti, bool on);
+};
+
+// Loader helpers shared by the compiler.
+RK reg_kind(const Type& t) noexcept;
+int compile_function(ProgramImpl& p, int index, const FunctionDecl& fd);
+int new_function(ProgramImpl& p, std::string name);
+int compile_condition(ProgramImpl& p, const TransitionDecl& t, const std::string& name);
+int compile_action(ProgramImpl& p, const TransitionDecl& t, const std::string& name);
+int compile_arrow_condition(ProgramImpl& p, const ArrowDecl& a, const std::string& name);
+int compile_init(ProgramImpl& p, const ScopeDecl& s, const std::string& name);
+int compile_object_ctor(ProgramImpl& p, const ClassDecl& obj, int ctor, const FunctionDecl& fd);
+[[noreturn]] void not_supported(const ProgramImpl& p, SourceLoc loc, const std::string& what);
+std::string where(const ProgramImpl& p, SourceLoc loc);
+
+}  // namespace vsd::soml

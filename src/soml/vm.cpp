@@ -1,0 +1,737 @@
+// The SOML++ virtual machine: a register machine over statically typed 64-bit registers (see
+// program_impl.hpp). One switch per instruction, no allocation per call (registers and frames are
+// vectors that only grow), property access through the MetaProperties (so every store signals and
+// records), a budget of jumps and calls and a depth limit whose errors carry the SOML++ call stack.
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <iostream>
+#include <limits>
+
+#include "program_impl.hpp"
+#include "vsd/core/error.hpp"
+#include "vsd/core/instance.hpp"
+#include "vsd/core/meta_method.hpp"
+#include "vsd/core/node.hpp"
+#include "vsd/core/reference.hpp"
+
+namespace vsd::soml {
+
+namespace {
+
+std::string fmt_double(double d) {
+  if (std::isnan(d)) return "nan";
+  if (std::isinf(d)) return d > 0 ? "inf" : "-inf";
+  char buf[64];
+  auto r = std::to_chars(buf, buf + sizeof buf, d);
+  std::string s(buf, r.ptr);
+  if (s.find_first_of(".en") == std::string::npos) s += ".0";
+  return s;
+}
+
+inline std::int64_t wrap_add(std::int64_t a, std::int64_t b) {
+  return static_cast<std::int64_t>(static_cast<std::uint64_t>(a) + static_cast<std::uint64_t>(b));
+}
+inline std::int64_t wrap_sub(std::int64_t a, std::int64_t b) {
+  return static_cast<std::int64_t>(static_cast<std::uint64_t>(a) - static_cast<std::uint64_t>(b));
+}
+inline std::int64_t wrap_mul(std::int64_t a, std::int64_t b) {
+  return static_cast<std::int64_t>(static_cast<std::uint64_t>(a) * static_cast<std::uint64_t>(b));
+}
+
+void store_integer(const MetaProperty& p, SimStateInstance& o, std::int64_t v) {
+  alignas(8) unsigned char buf[8] = {};
+  const std::size_t n = p.type().size();
+  if (n == 8) {
+    std::memcpy(buf, &v, 8);
+  } else if (n == 4) {
+    const auto x = static_cast<std::uint32_t>(v);
+    std::memcpy(buf, &x, 4);
+  } else if (n == 2) {
+    const auto x = static_cast<std::uint16_t>(v);
+    std::memcpy(buf, &x, 2);
+  } else {
+    const auto x = static_cast<std::uint8_t>(v);
+    std::memcpy(buf, &x, 1);
+  }
+  p.assign_raw(o, buf);
+}
+
+}  // namespace
+
+std::string ProgramImpl::stack_text(std::size_t from) const {
+  std::string s;
+  for (std::size_t i = frames_.size(); i-- > from;) {
+    const Frame& f = frames_[i];
+    const std::size_t at =
+        f.pc > f.fn->code.data() ? static_cast<std::size_t>(f.pc - f.fn->code.data()) - 1 : 0;
+    const std::uint32_t line = at < f.fn->lines.size() ? f.fn->lines[at] : 0;
+    s += "\n  at " + f.fn->name + " (" + checked_->source->name() + ":" + std::to_string(line) + ")";
+  }
+  return s;
+}
+
+void ProgramImpl::fail(const std::string& what) { throw Error("SOML++ run-time error: " + what); }
+
+Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* args,
+                     const std::string* sargs, std::string* sresult) {
+  const Function& f = *functions_[static_cast<std::size_t>(fi)];
+  const std::size_t entry = frames_.size();
+  if (entry == 0) {
+    budget_ = opt_.instruction_budget == 0 ? 1 : opt_.instruction_budget;
+    frames_.reserve(static_cast<std::size_t>(opt_.max_depth) + 8);
+  }
+  if (entry >= static_cast<std::size_t>(opt_.max_depth))
+    fail("call depth limit (" + std::to_string(opt_.max_depth) + ") reached calling " + f.name +
+         stack_text(0));
+  const std::uint32_t saved_top = top_;
+  const std::uint32_t base = top_;
+  if (regs_.size() < base + static_cast<std::size_t>(f.nregs) + 1) {
+    regs_.resize((base + static_cast<std::size_t>(f.nregs) + 1) * 2);
+    sregs_.resize(regs_.size());
+  }
+  for (int i = 0; i < f.nparams; ++i) {
+    regs_[base + static_cast<std::size_t>(i)] = args[i];
+    if (f.param_kinds[static_cast<std::size_t>(i)] == RK::S)
+      sregs_[base + static_cast<std::size_t>(i)] = sargs[i];
+  }
+  frames_.push_back(Frame{&f, f.code.data(), base, self, mark});
+  top_ = base + static_cast<std::uint32_t>(f.nregs);
+  try {
+    Val v = exec(entry);
+    if (sresult != nullptr && f.result == RK::S) *sresult = std::move(sregs_[base]);
+    top_ = saved_top;
+    return v;
+  } catch (const Error& e) {
+    std::string msg = e.what();
+    if (msg.rfind("SOML++ run-time error: ", 0) != 0) msg = "SOML++ run-time error: " + msg;
+    msg += stack_text(entry);
+    frames_.resize(entry);
+    top_ = saved_top;
+    throw Error(msg);
+  }
+}
+
+Val ProgramImpl::exec(std::size_t entry) {
+  Frame* fr = &frames_.back();
+  const Ins* code = fr->fn->code.data();
+  const Ins* pc = fr->pc;
+  Val* R = regs_.data() + fr->base;
+  std::string* S = sregs_.data() + fr->base;
+  const std::int64_t* K = consts_.data();
+  const std::size_t max_frames = static_cast<std::size_t>(opt_.max_depth);
+
+#define VSD_SAVE() (fr->pc = pc)
+#define VSD_TARGET(in) (code + ((static_cast<std::uint32_t>((in).x) << 16) | (in).c))
+#define VSD_REFRESH()             \
+  do {                            \
+    R = regs_.data() + fr->base;  \
+    S = sregs_.data() + fr->base; \
+  } while (0)
+
+  auto obj = [&](std::uint64_t id) -> SimStateInstance& {
+    SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
+    if (o == nullptr) {
+      VSD_SAVE();
+      fail(id == 0 ? "null reference" : "reference to a deleted instance (id " + std::to_string(id) + ")");
+    }
+    return *o;
+  };
+  auto place_of = [&](std::uint64_t id) -> Place& {
+    Place* p = obj(id).as<Place>();
+    if (p == nullptr) {
+      VSD_SAVE();
+      fail("not a place");
+    }
+    return *p;
+  };
+
+  for (;;) {
+    const Ins in = *pc++;
+    switch (in.op) {
+      case OP_NOP:
+        break;
+      case OP_LOADI:
+        R[in.a].i = static_cast<std::int16_t>(in.b);
+        break;
+      case OP_LOADK:
+        R[in.a].i = K[in.b];
+        break;
+      case OP_LOADS:
+        S[in.a] = strings_[in.b];
+        break;
+      case OP_MOV:
+        R[in.a] = R[in.b];
+        break;
+      case OP_MOVS:
+        S[in.a] = S[in.b];
+        break;
+      case OP_ADDI:
+        R[in.a].i = wrap_add(R[in.b].i, R[in.c].i);
+        break;
+      case OP_SUBI:
+        R[in.a].i = wrap_sub(R[in.b].i, R[in.c].i);
+        break;
+      case OP_MULI:
+        R[in.a].i = wrap_mul(R[in.b].i, R[in.c].i);
+        break;
+      case OP_DIVI:
+      case OP_MODI: {
+        const std::int64_t x = R[in.b].i, y = R[in.c].i;
+        if (y == 0) {
+          VSD_SAVE();
+          fail("division by zero");
+        }
+        if (y == -1) {
+          R[in.a].i = in.op == OP_DIVI ? wrap_sub(0, x) : 0;
+        } else {
+          R[in.a].i = in.op == OP_DIVI ? x / y : x % y;
+        }
+        break;
+      }
+      case OP_ADDD:
+        R[in.a].d = R[in.b].d + R[in.c].d;
+        break;
+      case OP_SUBD:
+        R[in.a].d = R[in.b].d - R[in.c].d;
+        break;
+      case OP_MULD:
+        R[in.a].d = R[in.b].d * R[in.c].d;
+        break;
+      case OP_DIVD:
+        R[in.a].d = R[in.b].d / R[in.c].d;
+        break;
+      case OP_ADDIK:
+        R[in.a].i = wrap_add(R[in.b].i, static_cast<std::int16_t>(in.c));
+        break;
+      case OP_MULIK:
+        R[in.a].i = wrap_mul(R[in.b].i, static_cast<std::int16_t>(in.c));
+        break;
+      case OP_DIVIK:
+        R[in.a].i = R[in.b].i / static_cast<std::int16_t>(in.c);
+        break;
+      case OP_MODIK:
+        R[in.a].i = R[in.b].i % static_cast<std::int16_t>(in.c);
+        break;
+      case OP_NEGI:
+        R[in.a].i = wrap_sub(0, R[in.b].i);
+        break;
+      case OP_NEGD:
+        R[in.a].d = -R[in.b].d;
+        break;
+      case OP_NOT:
+        R[in.a].i = R[in.b].i == 0 ? 1 : 0;
+        break;
+      case OP_I2D:
+        R[in.a].d = static_cast<double>(R[in.b].i);
+        break;
+      case OP_D2I: {
+        const double d = R[in.b].d;
+        if (!(d >= -9.2233720368547758e18 && d < 9.2233720368547758e18)) {
+          VSD_SAVE();
+          fail("the double " + fmt_double(d) + " does not fit an int");
+        }
+        R[in.a].i = static_cast<std::int64_t>(d);
+        break;
+      }
+      case OP_LTI:
+        R[in.a].i = R[in.b].i < R[in.c].i;
+        break;
+      case OP_LEI:
+        R[in.a].i = R[in.b].i <= R[in.c].i;
+        break;
+      case OP_EQI:
+        R[in.a].i = R[in.b].i == R[in.c].i;
+        break;
+      case OP_NEI:
+        R[in.a].i = R[in.b].i != R[in.c].i;
+        break;
+      case OP_LTD:
+        R[in.a].i = R[in.b].d < R[in.c].d;
+        break;
+      case OP_LED:
+        R[in.a].i = R[in.b].d <= R[in.c].d;
+        break;
+      case OP_EQD:
+        R[in.a].i = R[in.b].d == R[in.c].d;
+        break;
+      case OP_NED:
+        R[in.a].i = R[in.b].d != R[in.c].d;
+        break;
+      case OP_LTS:
+        R[in.a].i = S[in.b] < S[in.c];
+        break;
+      case OP_LES:
+        R[in.a].i = S[in.b] <= S[in.c];
+        break;
+      case OP_EQS:
+        R[in.a].i = S[in.b] == S[in.c];
+        break;
+      case OP_NES:
+        R[in.a].i = S[in.b] != S[in.c];
+        break;
+      case OP_CONCAT: {
+        std::string t;
+        t.reserve(S[in.b].size() + S[in.c].size());
+        t += S[in.b];
+        t += S[in.c];
+        S[in.a] = std::move(t);
+        break;
+      }
+      case OP_TOSTR:
+        if (in.c == 0) {
+          S[in.a] = std::to_string(R[in.b].i);
+        } else if (in.c == 1) {
+          S[in.a] = fmt_double(R[in.b].d);
+        } else if (in.c == 2) {
+          S[in.a] = R[in.b].i != 0 ? "true" : "false";
+        } else {
+          const MetaType& t = *enum_types_[in.c - 3u];
+          const std::string_view n = t.enum_name(R[in.b].i);
+          S[in.a] = n.empty() ? std::to_string(R[in.b].i) : std::string(n);
+        }
+        break;
+      case OP_STR2B:
+        R[in.a].i = S[in.b].empty() ? 0 : 1;
+        break;
+      case OP_JMP: {
+        const Ins* t = VSD_TARGET(in);
+        if (t < pc && --budget_ == 0) {
+          VSD_SAVE();
+          fail("instruction budget exhausted (" + std::to_string(opt_.instruction_budget) +
+               " jumps and calls): an endless loop?");
+        }
+        pc = t;
+        break;
+      }
+      case OP_JMPF:
+        if (R[in.a].i == 0) pc = VSD_TARGET(in);
+        break;
+      case OP_JMPT:
+        if (R[in.a].i != 0) pc = VSD_TARGET(in);
+        break;
+      case OP_JGEI:
+        if (R[in.a].i >= R[in.b].i) pc = VSD_TARGET(in);
+        break;
+      case OP_JGTI:
+        if (R[in.a].i > R[in.b].i) pc = VSD_TARGET(in);
+        break;
+      case OP_CALL:
+      case OP_VCALL: {
+        VSD_SAVE();
+        const std::uint64_t self = R[in.c].id;
+        int fi = in.b;
+        if (in.op == OP_VCALL) {
+          fi = vslot_default_[in.b];
+          const SimStateInstance& o = obj(self);
+          auto ci = by_meta_.find(&o.meta());
+          if (ci != by_meta_.end()) {
+            auto v = ci->second->vtable.find(vslots_[in.b]);
+            if (v != ci->second->vtable.end()) fi = v->second;
+          }
+        } else if (self == 0) {
+          fail("null reference");
+        }
+        const Function& callee = *functions_[static_cast<std::size_t>(fi)];
+        if (frames_.size() >= max_frames)
+          fail("call depth limit (" + std::to_string(opt_.max_depth) + ") reached calling " + callee.name);
+        if (--budget_ == 0)
+          fail("instruction budget exhausted (" + std::to_string(opt_.instruction_budget) +
+               " jumps and calls): runaway recursion?");
+        const std::uint32_t nb = fr->base + in.a;
+        const std::size_t need = nb + static_cast<std::size_t>(callee.nregs) + 1;
+        if (regs_.size() < need) {
+          regs_.resize(need * 2);
+          sregs_.resize(regs_.size());
+        }
+        const std::uint64_t mark = fr->mark;
+        frames_.push_back(Frame{&callee, callee.code.data(), nb, self, mark});
+        fr = &frames_.back();
+        code = callee.code.data();
+        pc = code;
+        top_ = nb + static_cast<std::uint32_t>(callee.nregs);
+        VSD_REFRESH();
+        break;
+      }
+      case OP_RET:
+      case OP_RET0: {
+        Val v{};
+        if (in.op == OP_RET) {
+          v = R[in.a];
+          if (fr->fn->result == RK::S && in.a != 0) S[0] = std::move(S[in.a]);
+        }
+        R[0] = v;
+        frames_.pop_back();
+        if (frames_.size() == entry) return v;
+        fr = &frames_.back();
+        code = fr->fn->code.data();
+        pc = fr->pc;
+        top_ = fr->base + static_cast<std::uint32_t>(fr->fn->nregs);
+        VSD_REFRESH();
+        break;
+      }
+      case OP_SELF: {
+        const OuterPlan& p = outer_plans_[in.b];
+        if (p.static_decl != nullptr) {
+          R[in.a].id = p.static_id;
+        } else {
+          std::uint64_t id = fr->self;
+          for (int k = 0; k < p.parents; ++k) {
+            Node* n = obj(id).as<Node>();
+            Node* up = n != nullptr ? n->parent() : nullptr;
+            if (up == nullptr) {
+              VSD_SAVE();
+              fail("the enclosing instance of " + std::to_string(id) + " is gone");
+            }
+            id = up->id();
+          }
+          R[in.a].id = id;
+        }
+        break;
+      }
+      case OP_MARK:
+        R[in.a].id = fr->mark;
+        break;
+      case OP_OBJ:
+        R[in.a].id = static_cast<std::uint64_t>(K[in.b]);
+        break;
+      case OP_GETP: {
+        const std::uint64_t id = R[in.b].id;
+        SimStateInstance& o = obj(id);
+        const PropSlot& ps = props_[in.c];
+        if (!o.meta().is_a(ps.prop->owner())) {
+          VSD_SAVE();
+          fail("instance of " + o.meta().name() + " has no property '" + ps.prop->name() + "'");
+        }
+        if (deps_ != nullptr) deps_->emplace_back(id, ps.prop);
+        const void* addr = ps.prop->address(o);
+        switch (ps.kind) {
+          case PK::I64:
+            R[in.a].i = *static_cast<const std::int64_t*>(addr);
+            break;
+          case PK::Bool:
+            R[in.a].i = *static_cast<const bool*>(addr) ? 1 : 0;
+            break;
+          case PK::Double:
+            R[in.a].d = *static_cast<const double*>(addr);
+            break;
+          case PK::String:
+            S[in.a] = *static_cast<const std::string*>(addr);
+            break;
+          case PK::Int:
+          case PK::Enum:
+            R[in.a].i = ps.prop->type().load_integer(addr);
+            break;
+          case PK::Ref: {
+            const SimStateInstance* t = static_cast<const RefBase*>(addr)->get();
+            R[in.a].id = t != nullptr ? t->id() : 0;
+            break;
+          }
+          default:
+            if (ps.prop->type().kind() == TypeKind::Float) {
+              R[in.a].d = *static_cast<const float*>(addr);
+              break;
+            }
+            VSD_SAVE();
+            fail("property '" + ps.prop->name() + "' of type " + ps.prop->type().name() +
+                 " cannot be read as a value yet");
+        }
+        break;
+      }
+      case OP_SETP: {
+        VSD_SAVE();
+        SimStateInstance& o = obj(R[in.a].id);
+        const PropSlot& ps = props_[in.c];
+        const MetaProperty& p = *ps.prop;
+        if (!o.meta().is_a(p.owner()))
+          fail("instance of " + o.meta().name() + " has no property '" + p.name() + "'");
+        if (p.has(ReadOnly)) fail("property '" + p.name() + "' is read-only");
+        switch (ps.kind) {
+          case PK::I64:
+            p.set<std::int64_t>(o, R[in.b].i);
+            break;
+          case PK::Bool:
+            p.set<bool>(o, R[in.b].i != 0);
+            break;
+          case PK::Double:
+            p.set<double>(o, R[in.b].d);
+            break;
+          case PK::String:
+            p.assign_raw(o, &S[in.b]);
+            break;
+          case PK::Int:
+            if (!p.type().integer_fits(R[in.b].i))
+              fail("the value " + std::to_string(R[in.b].i) + " does not fit property '" + p.name() + "' (" +
+                   p.type().name() + ")");
+            store_integer(p, o, R[in.b].i);
+            break;
+          case PK::Enum:
+            store_integer(p, o, R[in.b].i);
+            break;
+          case PK::Ref: {
+            SimStateInstance* t = R[in.b].id == 0 ? nullptr : &obj(R[in.b].id);
+            if (t != nullptr && p.type().target() != nullptr && !t->meta().is_a(*p.type().target()))
+              fail("a " + t->meta().name() + " cannot be stored in property '" + p.name() + "' (" +
+                   p.type().name() + ")");
+            if (p.type().kind() == TypeKind::Ref) {
+              Ref<SimStateInstance> r(t);
+              p.assign_raw(o, &r);
+            } else {
+              SharedRef<SimStateInstance> r(t);
+              p.assign_raw(o, &r);
+            }
+            break;
+          }
+          default:
+            if (p.type().kind() == TypeKind::Float) {
+              const auto f = static_cast<float>(R[in.b].d);
+              p.assign_raw(o, &f);
+              break;
+            }
+            fail("property '" + p.name() + "' of type " + p.type().name() + " cannot be assigned yet");
+        }
+        VSD_REFRESH();  // listeners of the change may have called into the VM
+        break;
+      }
+      case OP_PLACE: {
+        const NetInst* n = net_of(R[in.b].id);
+        if (n == nullptr || in.c >= n->places.size()) {
+          VSD_SAVE();
+          fail("instance " + std::to_string(R[in.b].id) + " has no net");
+        }
+        R[in.a].id = n->places[in.c]->id();
+        break;
+      }
+      case OP_PCOUNT: {
+        Place& p = place_of(R[in.b].id);
+        if (deps_ != nullptr)
+          deps_->emplace_back(p.id(),
+                              p.object_tokens() ? &Place::vsd_prop_objects() : &Place::vsd_prop_tokens());
+        R[in.a].i = p.count();
+        break;
+      }
+      case OP_PPUT: {
+        VSD_SAVE();
+        Place& p = place_of(R[in.a].id);
+        if (in.c == 0) {
+          if (p.object_tokens()) fail("put(n) on a place of object tokens");
+          if (R[in.b].i < 0) fail("put(" + std::to_string(R[in.b].i) + "): a negative number of tokens");
+          put_token(p, nullptr, R[in.b].i);
+        } else {
+          if (!p.object_tokens()) fail("put(object) on a place of black tokens");
+          put_token(p, &obj(R[in.b].id), 1);
+        }
+        VSD_REFRESH();
+        break;
+      }
+      case OP_PCLEAR: {
+        VSD_SAVE();
+        Place& p = place_of(R[in.a].id);
+        if (p.object_tokens())
+          p.edit_objects().clear();
+        else
+          p.set_tokens(0);
+        VSD_REFRESH();
+        break;
+      }
+      case OP_LSIZE:
+      case OP_LGET:
+      case OP_LPUSH: {
+        VSD_SAVE();
+        const std::uint64_t id = R[in.op == OP_LPUSH ? in.a : in.b].id;
+        SimStateInstance& o = obj(id);
+        const MetaProperty& p = *props_[in.c].prop;
+        if (!o.meta().is_a(p.owner()))
+          fail("instance of " + o.meta().name() + " has no property '" + p.name() + "'");
+        const auto& list = *static_cast<const RefListBase*>(p.address(o));
+        if (in.op == OP_LSIZE) {
+          if (deps_ != nullptr) deps_->emplace_back(id, &p);
+          R[in.a].i = static_cast<std::int64_t>(list.size());
+        } else if (in.op == OP_LGET) {
+          const std::int64_t i = R[in.a].i;
+          if (i < 0 || static_cast<std::size_t>(i) >= list.size())
+            fail("index " + std::to_string(i) + " out of range (size " + std::to_string(list.size()) + ")");
+          if (deps_ != nullptr) deps_->emplace_back(id, &p);
+          const SimStateInstance* t = list.at(static_cast<std::size_t>(i));
+          R[in.a].id = t != nullptr ? t->id() : 0;
+        } else {
+          o.list_insert(p, list.size(), obj(R[in.b].id));
+          VSD_REFRESH();
+        }
+        break;
+      }
+      case OP_NEW: {
+        VSD_SAVE();
+        const ClassInfo* ci = classes_[in.b];
+        SimStateInstance* made;
+        if (ci != nullptr) {
+          const Function* ctor =
+              ci->ctor >= 0 ? functions_[static_cast<std::size_t>(ci->ctor)].get() : nullptr;
+          std::string sargs[8];
+          if (in.c > 8) fail("more than 8 constructor arguments");
+          for (int i = 0; i < in.c; ++i)
+            if (ctor != nullptr && ctor->param_kinds[static_cast<std::size_t>(i)] == RK::S)
+              sargs[i] = S[in.a + 1 + i];
+          Val args[8];
+          for (int i = 0; i < in.c; ++i) args[i] = R[in.a + 1 + i];
+          made = &instantiate(*ci, nullptr, "", args, sargs, in.c);
+        } else {
+          made = &state_.create(*class_metas_[in.b]);
+        }
+        VSD_REFRESH();
+        R[in.a].id = made->id();
+        break;
+      }
+      case OP_ISA:
+      case OP_AS: {
+        const std::uint64_t id = R[in.b].id;
+        const SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
+        const bool yes = o != nullptr && o->meta().is_a(*class_metas_[in.c]);
+        if (in.op == OP_ISA)
+          R[in.a].i = yes ? 1 : 0;
+        else
+          R[in.a].id = yes ? id : 0;
+        break;
+      }
+      case OP_MCALL: {
+        VSD_SAVE();
+        SimStateInstance& o = obj(R[in.a].id);
+        const MetaMethod& m = *methods_[in.b];
+        const auto& kinds = method_kinds_[in.b];
+        std::vector<Value> args;
+        args.reserve(kinds.size());
+        for (std::size_t i = 0; i < kinds.size(); ++i) {
+          const Val v = R[in.a + 1 + i];
+          const MetaType* want = i < m.arguments().size() ? m.arguments()[i] : nullptr;
+          switch (kinds[i]) {
+            case RK::I:
+              if (want != nullptr && want->kind() == TypeKind::Bool)
+                args.emplace_back(v.i != 0);
+              else
+                args.emplace_back(v.i);
+              break;
+            case RK::D:
+              args.emplace_back(v.d);
+              break;
+            case RK::S:
+              args.emplace_back(S[in.a + 1 + i]);
+              break;
+            default: {
+              SimStateInstance* t = v.id == 0 ? nullptr : &obj(v.id);
+              args.emplace_back(SharedRef<SimStateInstance>(t));
+              break;
+            }
+          }
+        }
+        Value r = o.meta().call(o, m.name(), args);
+        VSD_REFRESH();
+        switch (method_results_[in.b]) {
+          case RK::I:
+            if (r.is<bool>())
+              R[in.a].i = r.as<bool>() ? 1 : 0;
+            else if (r.type() != nullptr &&
+                     (r.type()->kind() == TypeKind::Enum || r.type()->kind() == TypeKind::Flags))
+              R[in.a].i = r.type()->load_integer(r.data());
+            else
+              R[in.a].i = r.convert_to(meta_type<std::int64_t>()).as<std::int64_t>();
+            break;
+          case RK::D:
+            R[in.a].d = r.convert_to(meta_type<double>()).as<double>();
+            break;
+          case RK::S:
+            S[in.a] = r.as<std::string>();
+            break;
+          case RK::R: {
+            const SimStateInstance* t = r.type() != nullptr && r.type()->is_reference()
+                                            ? static_cast<const RefBase*>(r.data())->get()
+                                            : nullptr;
+            R[in.a].id = t != nullptr ? t->id() : 0;
+            break;
+          }
+          default:
+            break;
+        }
+        break;
+      }
+      case OP_BUILTIN: {
+        Val* a = &R[in.a];
+        switch (static_cast<Builtin>(in.b)) {
+          case Builtin::Sqrt:
+            a->d = std::sqrt(a->d);
+            break;
+          case Builtin::Floor:
+            a->d = std::floor(a->d);
+            break;
+          case Builtin::Ceil:
+            a->d = std::ceil(a->d);
+            break;
+          case Builtin::Abs:
+            if (in.c != 0)
+              a->d = std::fabs(a->d);
+            else
+              a->i = a->i < 0 ? wrap_sub(0, a->i) : a->i;
+            break;
+          case Builtin::Min:
+            if (in.c != 0)
+              a->d = std::min(a[0].d, a[1].d);
+            else
+              a->i = std::min(a[0].i, a[1].i);
+            break;
+          case Builtin::Max:
+            if (in.c != 0)
+              a->d = std::max(a[0].d, a[1].d);
+            else
+              a->i = std::max(a[0].i, a[1].i);
+            break;
+          case Builtin::Len:
+            a->i = static_cast<std::int64_t>(S[in.a].size());
+            break;
+          default:
+            break;
+        }
+        break;
+      }
+      case OP_PRINT: {
+        std::ostream& out = opt_.out != nullptr ? *opt_.out : std::cout;
+        const auto& kinds = print_kinds_[in.c];
+        std::string line;
+        for (int i = 0; i < in.b; ++i) {
+          switch (kinds[static_cast<std::size_t>(i)]) {
+            case RK::I:
+              line += std::to_string(R[in.a + i].i);
+              break;
+            case RK::D:
+              line += fmt_double(R[in.a + i].d);
+              break;
+            case RK::S:
+              line += S[in.a + i];
+              break;
+            default: {
+              const std::uint64_t id = R[in.a + i].id;
+              const SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
+              const auto* n = o != nullptr ? o->as<NamedModelInstance>() : nullptr;
+              line += o == nullptr ? std::string("null")
+                                   : (n != nullptr && !n->name().empty()
+                                          ? n->name()
+                                          : o->meta().name() + "#" + std::to_string(id));
+            }
+          }
+        }
+        out << line << '\n';
+        break;
+      }
+      case OP_FAIL:
+        VSD_SAVE();
+        fail(strings_[in.b]);
+      default:
+        VSD_SAVE();
+        fail("bad instruction");
+    }
+  }
+#undef VSD_SAVE
+#undef VSD_TARGET
+#undef VSD_REFRESH
+}
+
+}  // namespace vsd::soml

@@ -1,0 +1,291 @@
+// SOML++ net execution: the firing rule (weights, inhibitors, conditions, marks, arrow conditions),
+// seeded choice, dependency-driven re-testing, markings as database state (recording and replicas),
+// and the Module's scheduler task.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "vsd/core.hpp"
+#include "vsd/soml.hpp"
+
+namespace {
+
+using ::testing::HasSubstr;
+using vsd::soml::Program;
+
+struct Exec : ::testing::Test {
+  vsd::Registry reg;
+  vsd::Environment env{0, reg};
+  std::ostringstream out;
+  vsd::soml::Module* soml = nullptr;
+  void SetUp() override { soml = &env.use<vsd::soml::Module>(); }
+  Program& load(const std::string& text, std::uint64_t seed = 1) {
+    vsd::soml::RunOptions o;
+    o.out = &out;
+    o.seed = seed;
+    return soml->load(env.main_state(), "net.soml", text, o);
+  }
+};
+
+TEST_F(Exec, WeightsConsumeAndProduce) {
+  Program& p = load(R"(
+place a = 5;
+place b;
+transition t;
+arrow a -> t * 2;
+arrow t -> b * 3;
+)");
+  EXPECT_EQ(p.run_until_quiet(), 2u);
+  EXPECT_EQ(p.place("a")->tokens(), 1);
+  EXPECT_EQ(p.place("b")->tokens(), 6);
+  EXPECT_EQ(p.root().find_child("t")->get<std::int64_t>("firings"), 2);
+}
+
+TEST_F(Exec, InhibitorArrowBlocksWhileItsPlaceHoldsTokens) {
+  Program& p = load(R"(
+place a = 3;
+place stop;
+place done;
+transition t;
+arrow a -> t;
+arrow stop -o t;
+arrow t -> done;
+)");
+  p.place("stop")->set_tokens(1);  // C++ changes the marking through the setter
+  EXPECT_EQ(p.run_until_quiet(), 0u);
+  p.place("stop")->set_tokens(0);
+  EXPECT_EQ(p.run_until_quiet(), 3u);
+  EXPECT_EQ(p.place("done")->tokens(), 3);
+}
+
+TEST_F(Exec, ObjectTokensMarksConditionsAndArrowConditions) {
+  Program& p = load(R"(
+class Job : Node {
+  double speed = 1.0;
+  bool ready = true;
+  int visits = 0;
+  Job(double s, bool r) { speed = s; ready = r; }
+}
+object cell {
+  int served = 0;
+  place<Job> waiting;
+  place<Job> fast;
+  place<Job> slow;
+  transition go {
+    when mark.ready;
+    do { served += 1; mark.visits += 1; }
+  }
+  arrow waiting -> go;
+  arrow go -> fast when mark.speed > 1.5;
+  arrow go -> slow;
+  void add(double s, bool r) { waiting.put(new Job(s, r)); }
+}
+)");
+  vsd::Node* cell = p.object("cell");
+  cell->call("add", {vsd::Value(2.0), vsd::Value(true)});
+  cell->call("add", {vsd::Value(1.0), vsd::Value(true)});
+  cell->call("add", {vsd::Value(3.0), vsd::Value(false)});
+  std::vector<std::string> trace;
+  p.on_firing([&](const vsd::soml::Firing& f) {
+    trace.push_back(f.transition->name() + ":" + (f.from ? f.from->name() : "") + "->" +
+                    (f.to ? f.to->name() : "-"));
+  });
+  EXPECT_EQ(p.run_until_quiet(), 2u);
+  EXPECT_EQ(cell->get<std::int64_t>("served"), 2);
+  EXPECT_EQ(p.place("fast", cell)->objects().size(), 1u);
+  EXPECT_EQ(p.place("slow", cell)->objects().size(), 1u);
+  ASSERT_EQ(p.place("waiting", cell)->objects().size(), 1u) << "the job that is not ready waits";
+  vsd::Node* idle = p.place("waiting", cell)->objects()[0];
+  EXPECT_DOUBLE_EQ(idle->get<double>("speed"), 3.0);
+  EXPECT_EQ(p.place("fast", cell)->objects()[0]->get<std::int64_t>("visits"), 1);
+  EXPECT_THAT(trace, ::testing::ElementsAre("go:waiting->fast", "go:waiting->slow"));
+  // The waiting job's property changes: its transition is re-tested and fires.
+  idle->set("ready", vsd::Value(true));
+  EXPECT_EQ(p.run_until_quiet(), 1u);
+  EXPECT_EQ(p.place("fast", cell)->objects().size(), 2u);
+}
+
+TEST_F(Exec, ConditionsOnDatabasePropertiesAreRetestedOnlyWhenTheyChange) {
+  Program& p = load(R"(
+shared<Node> plant;
+int alarms = 0;
+place armed = 1;
+place fired;
+transition alarm {
+  when plant != null && plant.name == "hot";
+  do { alarms += 1; plant.name = "cooling"; }
+}
+arrow armed -> alarm;
+arrow alarm -> armed;
+)");
+  vsd::Node& plant = env.main_state().create<vsd::Node>();
+  env.main_state().database().add_child(plant);
+  vsd::Node& other = env.main_state().create<vsd::Node>();
+  p.root().set("plant", vsd::Value(vsd::SharedRef<vsd::Node>(&plant)));
+  EXPECT_EQ(p.run_until_quiet(), 0u);
+  const auto tests = p.condition_tests();
+  for (int i = 0; i < 50; ++i) other.set_name("x" + std::to_string(i));  // not read by the condition
+  EXPECT_EQ(p.run_until_quiet(), 0u);
+  EXPECT_EQ(p.condition_tests(), tests) << "no polling: unrelated changes test nothing";
+  plant.set_name("warm");
+  EXPECT_EQ(p.run_until_quiet(), 0u);
+  EXPECT_EQ(p.condition_tests(), tests + 1);
+  plant.set_name("hot");  // the event sigma
+  EXPECT_EQ(p.run_until_quiet(), 1u);
+  EXPECT_EQ(plant.name(), "cooling");  // the command gamma
+  EXPECT_EQ(p.root().get<std::int64_t>("alarms"), 1);
+}
+
+TEST_F(Exec, SeededChoiceIsReproducible) {
+  const std::string text = R"(
+place a = 20;
+place x;
+place y;
+transition tx;
+transition ty;
+arrow a -> tx;
+arrow a -> ty;
+arrow tx -> x;
+arrow ty -> y;
+)";
+  auto run = [&](std::uint64_t seed) {
+    vsd::Registry r;
+    vsd::Environment e(0, r);
+    auto& m = e.use<vsd::soml::Module>();
+    vsd::soml::RunOptions o;
+    o.seed = seed;
+    Program& p = m.load(e.main_state(), "net.soml", text, o);
+    std::string trace;
+    p.on_firing([&](const vsd::soml::Firing& f) { trace += f.transition->name(); });
+    p.run_until_quiet();
+    EXPECT_EQ(p.place("x")->tokens() + p.place("y")->tokens(), 20);
+    return trace;
+  };
+  EXPECT_EQ(run(7), run(7));
+  EXPECT_NE(run(7), run(8));
+}
+
+TEST_F(Exec, FiringsRecordedAndReplayedOnAReplicaGiveTheSameMarking) {
+  Program& p = load(R"(
+class Phil : Node { int meals = 0; start table.thinking; }
+object table {
+  place<Phil> thinking;
+  place<Phil> eating;
+  place forks = 3;
+  transition take { do { mark.meals += 1; } }
+  transition put;
+  arrow thinking -> take;
+  arrow forks -> take * 2;
+  arrow take -> eating;
+  arrow eating -> put;
+  arrow put -> thinking;
+  arrow put -> forks * 2;
+}
+object p1 : Phil;
+object p2 : Phil;
+object p3 : Phil;
+)");
+  vsd::SimState& replica = env.create_state("replica");
+  replica.copy_from(env.main_state());
+  env.main_state().start_recording();
+  EXPECT_EQ(p.step(25), 25u);
+  vsd::Transaction t = env.main_state().stop_recording();
+  replica.apply(t);
+  std::string diff;
+  EXPECT_TRUE(replica.equals(env.main_state(), &diff)) << diff;
+  std::int64_t meals = 0;
+  for (const char* n : {"p1", "p2", "p3"}) meals += p.object(n)->get<std::int64_t>("meals");
+  EXPECT_GE(meals, 12);
+}
+
+TEST_F(Exec, AnActionErrorGivesTheTokensBackAndCarriesTheCallStack) {
+  Program& p = load(R"(
+int zero = 0;
+place a = 1;
+place b;
+transition t { do { int x = 1 / zero; print(x); } }
+arrow a -> t;
+arrow t -> b;
+)");
+  try {
+    p.step(1);
+    FAIL() << "no error";
+  } catch (const vsd::Error& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr("division by zero"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("at t (action) (net.soml:5)"));
+  }
+  EXPECT_EQ(p.place("a")->tokens(), 1);
+  EXPECT_EQ(p.place("b")->tokens(), 0);
+}
+
+TEST_F(Exec, AFailingConditionCountsAsNotEnabled) {
+  Program& p = load(R"(
+shared<Node> missing;
+place a = 1;
+transition t { when missing.name == "x"; }
+arrow a -> t;
+)");
+  EXPECT_EQ(p.run_until_quiet(), 0u);
+  ASSERT_EQ(p.condition_errors().size(), 1u);
+  EXPECT_THAT(p.condition_errors()[0], HasSubstr("null reference"));
+}
+
+TEST_F(Exec, TheModuleRunsNetsInTheSchedulersSteps) {
+  Program& p = load(R"(
+place a = 4;
+place b;
+transition t;
+arrow a -> t;
+arrow t -> b;
+)");
+  env.step();
+  EXPECT_EQ(p.place("b")->tokens(), 4);
+  p.place("a")->set_tokens(2);  // C++ puts tokens: the task is triggered again
+  env.step();
+  EXPECT_EQ(p.place("b")->tokens(), 6);
+}
+
+}  // namespace
+
+#if VSD_SOML_TEST_IO
+#include "vsd/io/snapshot.hpp"
+
+namespace {
+
+TEST_F(Exec, MarkingsMidRunAreSavedAndLoadedByVsdIo) {
+  Program& p = load(R"(
+class Job : Node { int done = 0; start line.queue; }
+object line {
+  place<Job> queue;
+  place<Job> finished;
+  place credits = 2;
+  transition work { do { mark.done = 1; } }
+  arrow queue -> work;
+  arrow credits -> work;
+  arrow work -> finished;
+}
+object j1 : Job;
+object j2 : Job;
+object j3 : Job;
+)");
+  EXPECT_EQ(p.run_until_quiet(), 2u);
+  for (auto format : {vsd::io::Format::Text, vsd::io::Format::Binary}) {
+    const auto bytes = vsd::io::save_bytes(env.main_state(), format);
+    vsd::SimState& copy = env.create_state(format == vsd::io::Format::Text ? "text copy" : "binary copy");
+    vsd::io::load_bytes(copy, bytes);
+    std::string diff;
+    EXPECT_TRUE(copy.equals(env.main_state(), &diff)) << diff;
+    // The loaded places hold the same marking.
+    const auto* q = copy.find<vsd::soml::Place>(p.place("queue", p.object("line"))->id());
+    ASSERT_NE(q, nullptr);
+    ASSERT_EQ(q->objects().size(), 1u);
+    EXPECT_EQ(q->objects()[0]->id(), p.object("j3")->id());
+    EXPECT_EQ(copy.find<vsd::soml::Place>(p.place("credits", p.object("line"))->id())->tokens(), 0);
+  }
+}
+
+}  // namespace
+#endif

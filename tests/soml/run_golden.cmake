@@ -1,0 +1,16 @@
+# Runs `vsd-soml run SCRIPT <args>` (args from the script's first line "// args: ...") and compares stdout
+# with SCRIPT's .out file. Used by the ctest entries vsd_soml_run_<name>.
+file(STRINGS "${SCRIPT}" first LIMIT_COUNT 1)
+set(args "")
+if(first MATCHES "^// args: (.*)$")
+  separate_arguments(args UNIX_COMMAND "${CMAKE_MATCH_1}")
+endif()
+execute_process(COMMAND "${TOOL}" run "${SCRIPT}" ${args} OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+string(REGEX REPLACE "\\.soml$" ".out" expected_file "${SCRIPT}")
+file(READ "${expected_file}" expected)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "vsd-soml run failed (${rc}): ${err}")
+endif()
+if(NOT out STREQUAL expected)
+  message(FATAL_ERROR "output differs from ${expected_file}:\n--- got ---\n${out}--- expected ---\n${expected}")
+endif()
