@@ -10,6 +10,7 @@
 #include "text_file.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/soml/checker.hpp"
+#include "vsd/soml/module.hpp"
 
 namespace vsd::soml::analysis {
 
@@ -413,6 +414,11 @@ std::string write_soml(const PtNet& net, std::vector<std::string>* notes) {
 
 void write_soml_file(const PtNet& net, const std::filesystem::path& path, std::vector<std::string>* notes) {
   detail::write_text_file(path, write_soml(net, notes));
+}
+
+soml::Program& import_net(soml::Module& soml, SimState& state, const PtNet& net, std::vector<std::string>* notes) {
+  std::string name = net.id().empty() ? std::string("net") : net.id();
+  return soml.load(state, name + ".soml", write_soml(net, notes));
 }
 
 }  // namespace vsd::soml::analysis

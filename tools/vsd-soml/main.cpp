@@ -26,7 +26,8 @@ constexpr const char* kUsage =
     "\n"
     "run      Loads the SOML++ script FILE into a database and fires its transitions: N firings, or until\n"
     "         none is enabled (at most 1000000). print() writes to stdout; at the end the marking of\n"
-    "         every place is printed. Errors in the script are printed with file:line:col.\n"
+    "         every place is printed. Errors in the script are printed with file:line:col. A PNML file\n"
+    "         (.pnml) is imported as the SOML++ net `convert` writes for it.\n"
     "  --steps N         fire at most N transitions\n"
     "  --trace           print every firing: step, transition, the token it moved, from where to where\n"
     "  --seed S          the seed of the choice among enabled transitions (default 1)\n"
@@ -167,7 +168,14 @@ int run(const std::vector<std::string_view>& args) {
     std::cerr << "vsd-soml: cannot read '" << file << "'\n";
     return 1;
   }
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (looks_like_pnml(file)) {  // a P/T net: imported as the SOML++ net write_soml() makes of it
+    const an::PnmlImport imported = an::read_pnml(text, file);
+    for (const auto& note : imported.notes) std::cerr << "note: " << note << "\n";
+    std::vector<std::string> renamed;
+    text = an::write_soml(imported.net, &renamed);
+    for (const auto& r : renamed) std::cerr << "note: " << r << "\n";
+  }
   vsd::Registry registry;
   vsd::Environment env(0, registry);
   auto& soml = env.use<vsd::soml::Module>();

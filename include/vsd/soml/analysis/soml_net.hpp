@@ -17,6 +17,11 @@
  *  the transitions, then the arrows transition by transition (inputs, outputs, inhibitors, weights as
  *  `* w`). Ids that are not SOML++ identifiers (or are keywords) are renamed; the original id and name are
  *  kept in a comment on the line. Reading the result back gives the same net up to ids and names.
+ *
+ *  **PtNet → database.** import_net() loads that script into a SimState through the SOML++ module: a PNML
+ *  net becomes ordinary database content (a script object with `soml::Place` nodes holding the initial
+ *  marking in `tokens`, `soml::Transition` nodes, `soml::Arrow` nodes with their weights), run by the
+ *  module's executor like any SOML++ net, saved and replicated like any data.
  */
 #pragma once
 
@@ -30,6 +35,8 @@
 
 namespace vsd::soml {
 struct CheckResult;
+class Module;
+class Program;
 }
 
 namespace vsd::soml::analysis {
@@ -55,5 +62,13 @@ struct SomlNetImport {
 [[nodiscard]] std::string write_soml(const PtNet& net, std::vector<std::string>* notes = nullptr);
 /// @brief write_soml() to a file. @throws vsd::Error when the file cannot be written.
 void write_soml_file(const PtNet& net, const std::filesystem::path& path, std::vector<std::string>* notes = nullptr);
+
+/// @brief Imports @p net into @p state as a SOML++ net (write_soml(), then soml::Module::load), named
+/// after the net's id.
+/// @param notes when given, receives one line per renamed id.
+/// @return the loaded program, owned by @p soml (run by it in every scheduler step).
+/// @throws vsd::Error when the module cannot load it (see soml::Module::load).
+soml::Program& import_net(soml::Module& soml, SimState& state, const PtNet& net,
+                          std::vector<std::string>* notes = nullptr);
 
 }  // namespace vsd::soml::analysis
