@@ -51,45 +51,46 @@ void PtNet::check_arc(std::uint32_t transition, std::uint32_t place, std::uint32
 }
 
 namespace {
-// Parallel arcs between one place and one transition in one direction are one arc whose weight is the
-// sum (a P/T net's arcs form a multiset); returns the arc to merge into, if any.
-ArcRef* find_arc(std::vector<ArcRef>& arcs, std::uint32_t place) {
+enum class Merge { Sum, Min };
+
+// Parallel arcs between one place and one transition in one direction are one arc: input and output
+// arcs add their weights (a P/T net's arcs form a multiset), inhibitor arcs keep the stricter (smaller)
+// weight, since both must hold.
+void add_arc(std::vector<ArcRef>& arcs, std::uint32_t place, std::uint32_t weight, std::string arc_id, Merge merge,
+             const Transition& t, const char* what) {
   auto it = std::find_if(arcs.begin(), arcs.end(), [&](const ArcRef& a) { return a.place == place; });
-  return it == arcs.end() ? nullptr : &*it;
+  if (it == arcs.end()) {
+    arcs.push_back(ArcRef{place, weight, std::move(arc_id)});
+  } else if (merge == Merge::Min) {
+    it->weight = std::min(it->weight, weight);
+  } else if (weight > UINT32_MAX - it->weight) {
+    detail::throw_error(std::string("PtNet: parallel ") + what + " arcs of transition '" + t.id +
+                        "' weigh more than 2^32-1 together");
+  } else {
+    it->weight += weight;
+  }
 }
 }  // namespace
 
 void PtNet::add_input(std::uint32_t transition, std::uint32_t place, std::uint32_t weight,
                       std::string arc_id) {
   check_arc(transition, place, weight, "input");
-  auto& arcs = transitions_[transition].inputs;
-  if (ArcRef* a = find_arc(arcs, place)) {
-    a->weight += weight;
-    return;
-  }
-  arcs.push_back(ArcRef{place, weight, std::move(arc_id)});
+  Transition& t = transitions_[transition];
+  add_arc(t.inputs, place, weight, std::move(arc_id), Merge::Sum, t, "input");
 }
 
 void PtNet::add_output(std::uint32_t transition, std::uint32_t place, std::uint32_t weight,
                        std::string arc_id) {
   check_arc(transition, place, weight, "output");
-  auto& arcs = transitions_[transition].outputs;
-  if (ArcRef* a = find_arc(arcs, place)) {
-    a->weight += weight;
-    return;
-  }
-  arcs.push_back(ArcRef{place, weight, std::move(arc_id)});
+  Transition& t = transitions_[transition];
+  add_arc(t.outputs, place, weight, std::move(arc_id), Merge::Sum, t, "output");
 }
 
 void PtNet::add_inhibitor(std::uint32_t transition, std::uint32_t place, std::uint32_t weight,
                           std::string arc_id) {
   check_arc(transition, place, weight, "inhibitor");
-  auto& arcs = transitions_[transition].inhibitors;
-  if (ArcRef* a = find_arc(arcs, place)) {
-    a->weight = std::min(a->weight, weight);  // both must hold: the stricter one
-    return;
-  }
-  arcs.push_back(ArcRef{place, weight, std::move(arc_id)});
+  Transition& t = transitions_[transition];
+  add_arc(t.inhibitors, place, weight, std::move(arc_id), Merge::Min, t, "inhibitor");
 }
 
 std::optional<std::uint32_t> PtNet::find_place(std::string_view id) const {

@@ -38,6 +38,10 @@ TEST(PtNet, ParallelArcsMerge) {
   EXPECT_EQ(net.transitions()[0].inputs[0].weight, 3u);
   EXPECT_EQ(net.transitions()[0].inputs[0].id, "a");
   EXPECT_EQ(net.transitions()[0].inhibitors[0].weight, 7u);
+  // Weights that would wrap around when summed are refused, and the arc keeps its weight.
+  net.add_output(0, 0, 4'000'000'000u);
+  EXPECT_THROW(net.add_output(0, 0, 400'000'000u), vsd::Error);
+  EXPECT_EQ(net.transitions()[0].outputs[0].weight, 4'000'000'000u);
 }
 
 TEST(PtNet, FiringRule) {
