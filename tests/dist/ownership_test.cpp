@@ -105,7 +105,8 @@ TEST_F(OwnershipTest, AnOwnedInstanceCannotBeDeletedByAnother) {
   ASSERT_TRUE(settle([&] { return ui->owner(arm->id()) == 0; }));
   u.destroy(ui_arm());
   ASSERT_TRUE(ui->publish());
-  ASSERT_TRUE(settle([&] { return r.find(arm->id()) == nullptr && c.find(arm->id()) == nullptr; }));
+  const vsd::Id id = arm->id();  // arm is deleted by the bundle
+  ASSERT_TRUE(settle([&] { return r.find(id) == nullptr && c.find(id) == nullptr; }));
 }
 
 TEST_F(OwnershipTest, ClaimErrors) {
