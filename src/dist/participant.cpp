@@ -144,7 +144,12 @@ struct Participant::Impl {
       throw Error("dist: domain id " + std::to_string(opt.domain) + " is out of range (0-230)");
     acquire_domain(opt.domain, opt.config);
     domain_acquired = true;
-    participant = dds_create_participant(opt.domain, nullptr, nullptr);
+    // The lease decides how soon the others drop a participant that died without a goodbye; until then a
+    // reliable writer waits for its acknowledgements.
+    dds_qos_t* pqos = dds_create_qos();
+    dds_qset_liveliness(pqos, DDS_LIVELINESS_AUTOMATIC, DDS_MSECS(opt.lease_duration.count()));
+    participant = dds_create_participant(opt.domain, pqos, nullptr);
+    dds_delete_qos(pqos);
     if (participant < 0) dds_fail("dds_create_participant", participant);
     dds_qos_t* qos = dds_create_qos();
     dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(opt.write_timeout.count()));
@@ -348,6 +353,7 @@ struct Participant::Impl {
     buffer.clear();
     if (pending != nullptr) buffer.push_back(*pending);
     nonce = random_id();
+    resync_started = std::chrono::steady_clock::now();
     request_snapshot();
   }
 
@@ -396,6 +402,7 @@ struct Participant::Impl {
     applied = std::move(seqs);
     owners = std::move(table);
     synced = true;
+    self_diverged = false;
     if (ever_synced) ++stats.resyncs;
     ever_synced = true;
     log("synchronised from a snapshot of " + who(m.sender) + " (" + std::to_string(state.size()) +
@@ -407,12 +414,31 @@ struct Participant::Impl {
   }
 
   std::size_t applied_now = 0;  // bundles applied during the current poll()
+  bool accept_gaps = false;     // while give_up_resync() drains the buffer
+  // The last bundle that did not apply: when it fails again after a snapshot, it is dropped.
+  std::pair<std::uint64_t, std::uint64_t> last_failure{0, 0};
+  // Set when this state holds a change of mine that the others rejected: it must not serve snapshots.
+  bool self_diverged = false;
+  std::chrono::steady_clock::time_point resync_started{};
 
   // A bundle or claim, in the sender's order.
   void sequenced(const Message& m) {
     if (!synced) {
       buffer.push_back(m);
       return;
+    }
+    Transaction t;
+    if (m.kind == Kind::Bundle) {
+      // Decoded before its sequence number counts: a broken message must not make anyone resynchronise.
+      try {
+        t = decode_bundle(m.payload);
+      } catch (const Error& e) {
+        ++stats.malformed;
+        log("rejected bundle " + std::to_string(m.seq) + " of " + who(m.sender) + ": " + e.what());
+        if (auto it = applied.find(m.sender); it != applied.end() && it->second + 1 == m.seq)
+          it->second = m.seq;  // every participant drops it alike
+        return;
+      }
     }
     auto [it, fresh] = applied.try_emplace(m.sender, 0);
     const std::uint64_t expected = it->second + 1;
@@ -421,23 +447,19 @@ struct Participant::Impl {
       return;
     }
     if (m.seq > expected) {
-      resync("gap in the messages of " + who(m.sender) + ": expected " + std::to_string(expected) + ", got " +
-                 std::to_string(m.seq),
-             &m);
-      return;
+      if (accept_gaps) {
+        log("the messages of " + who(m.sender) + " continue at " + std::to_string(m.seq) +
+            " here (expected " + std::to_string(expected) + ")");
+      } else {
+        resync("gap in the messages of " + who(m.sender) + ": expected " + std::to_string(expected) +
+                   ", got " + std::to_string(m.seq),
+               &m);
+        return;
+      }
     }
     if (m.kind == Kind::Claim) {
       apply_claim(m);
       it->second = m.seq;
-      return;
-    }
-    Transaction t;
-    try {
-      t = decode_bundle(m.payload);
-    } catch (const Error& e) {
-      ++stats.malformed;
-      it->second = m.seq;  // every participant drops it alike
-      log("rejected bundle " + std::to_string(m.seq) + " of " + who(m.sender) + ": " + e.what());
       return;
     }
     if (auto c = find_conflict(t, m.sender)) {
@@ -451,6 +473,15 @@ struct Participant::Impl {
       state.apply(t);
     } catch (const Error& e) {
       discard_recording();
+      if (last_failure == std::pair(m.sender, m.seq)) {
+        // It failed on the snapshot too: the shared state cannot take it. Everyone drops it alike.
+        ++stats.malformed;
+        it->second = m.seq;
+        log("bundle " + std::to_string(m.seq) + " of " + who(m.sender) +
+            " does not apply to the shared state either; dropped");
+        return;
+      }
+      last_failure = {m.sender, m.seq};
       resync("bundle " + std::to_string(m.seq) + " of " + who(m.sender) + " does not apply here (" +
                  e.what() + ")",
              &m);
@@ -461,6 +492,19 @@ struct Participant::Impl {
     it->second = m.seq;
     ++stats.bundles_applied;
     ++applied_now;
+  }
+
+  // Nobody answered a resynchronisation (every participant may have seen the same gap): go on with this
+  // state and take every stream from where it is.
+  void give_up_resync() {
+    log("no snapshot arrived within " + std::to_string(opt.resync_give_up.count()) +
+        " ms; continuing with this state");
+    synced = true;
+    accept_gaps = true;
+    std::deque<Message> pending = std::move(buffer);
+    buffer.clear();
+    for (const Message& b : pending) sequenced(b);
+    accept_gaps = false;
   }
 
   void apply_claim(const Message& m) {
@@ -497,7 +541,10 @@ struct Participant::Impl {
     if (c.writer == id) {
       report(c, false);
       // My bundle was rejected by the others but applied here: this state has diverged.
-      if (c.seq != 0 && synced) resync("my bundle " + std::to_string(c.seq) + " was rejected", nullptr);
+      if (c.seq != 0 && synced) {
+        self_diverged = true;
+        resync("my bundle " + std::to_string(c.seq) + " was rejected", nullptr);
+      }
     } else if (c.owner == id) {
       report(c, false);
     }
@@ -513,7 +560,10 @@ struct Participant::Impl {
           sequenced(m);
           break;
         case Kind::Request:
-          if (synced) serve_snapshot(m);
+          // A participant resynchronising after a gap or a bundle that did not apply still holds a state
+          // that matches its sequence numbers (bundles apply whole or not at all): it may answer too, so
+          // that participants that all saw the same fault do not wait for each other.
+          if (synced || (ever_synced && !self_diverged)) serve_snapshot(m);
           break;
         case Kind::Snapshot:
           if (m.target == id) install_snapshot(m);

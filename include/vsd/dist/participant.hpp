@@ -65,8 +65,15 @@ struct ParticipantOptions {
   bool seed = false;
   /// @brief How often an unsynchronised participant repeats its snapshot request.
   std::chrono::milliseconds request_interval{200};
+  /// @brief How long a participant that was synchronised before waits for a snapshot when it
+  /// resynchronises; then it goes on with its own state and logs so (every participant may have seen the
+  /// same gap, and an unsynchronised participant answers no requests). 0: wait forever.
+  std::chrono::milliseconds resync_give_up{5000};
   /// @brief How long publish() may block on a full DDS writer queue before it throws.
-  std::chrono::milliseconds write_timeout{2000};
+  std::chrono::milliseconds write_timeout{10000};
+  /// @brief The participant's DDS lease: a participant that died without leaving is dropped by the others
+  /// after this long (their writers wait for it until then). Keep write_timeout above it.
+  std::chrono::milliseconds lease_duration{3000};
   /// @brief Receives one line per noteworthy event (rejections, resynchronisation, conflicts). Default:
   /// standard error, prefixed "vsd::dist[name]: ".
   std::function<void(std::string_view line)> log;
