@@ -185,13 +185,29 @@ struct Session {
 
 Session* session = nullptr;
 
+// Spins on @p poll until @p done; false (and the benchmark skipped with an error) after 30 s.
+template <class Poll, class Done>
+bool spin(benchmark::State& st, Poll&& poll, Done&& done) {
+  const auto end = std::chrono::steady_clock::now() + 30s;
+  while (!done()) {
+    poll();
+    if (std::chrono::steady_clock::now() > end) {
+      st.SkipWithError("the peer did not answer within 30 s");
+      return false;
+    }
+  }
+  return true;
+}
+
 void BM_DistRoundTrip(benchmark::State& st) {
   Session& x = *session;
   for (auto _ : st) {
     const double v = x.arm.ping() + 1;
     x.arm.set_ping(v);
     x.p->publish();
-    while (x.arm.pong() != v) x.p->poll();
+    if (!spin(
+            st, [&] { x.p->poll(); }, [&] { return x.arm.pong() == v; }))
+      break;
   }
   st.counters["payload_bytes"] = static_cast<double>(x.payload.size());
 }
@@ -202,7 +218,13 @@ void BM_RawDdsRoundTrip(benchmark::State& st) {
     const std::uint64_t seq = ++x.raw_seq;
     x.raw->write(Ping, seq, x.payload);
     bool back = false;
-    while (!back) x.raw->take([&](std::uint8_t kind, std::uint64_t s) { back |= kind == Pong && s == seq; });
+    if (!spin(
+            st,
+            [&] {
+              x.raw->take([&](std::uint8_t kind, std::uint64_t s) { back |= kind == Pong && s == seq; });
+            },
+            [&] { return back; }))
+      break;
   }
   st.counters["payload_bytes"] = static_cast<double>(x.payload.size());
 }
@@ -216,7 +238,9 @@ void BM_DistChangesPerSecond(benchmark::State& st) {
       x.p->publish();
     }
     const int want = x.arm.counter();
-    while (x.arm.ack() != want) x.p->poll();
+    if (!spin(
+            st, [&] { x.p->poll(); }, [&] { return x.arm.ack() == want; }))
+      break;
   }
   st.SetItemsProcessed(static_cast<std::int64_t>(st.iterations()) * ack_every);
 }
@@ -224,11 +248,14 @@ void BM_DistChangesPerSecond(benchmark::State& st) {
 void BM_RawDdsSamplesPerSecond(benchmark::State& st) {
   Session& x = *session;
   for (auto _ : st) {
+    x.raw_seq = x.raw_seq / ack_every * ack_every;  // the batch ends on a multiple of ack_every
     for (int i = 0; i < ack_every; ++i) x.raw->write(Data, ++x.raw_seq, x.payload);
     const std::uint64_t want = x.raw_seq;
     bool acked = false;
-    while (!acked)
+    auto take = [&] {
       x.raw->take([&](std::uint8_t kind, std::uint64_t s) { acked |= kind == Ack && s == want; });
+    };
+    if (!spin(st, take, [&] { return acked; })) break;
   }
   st.SetItemsProcessed(static_cast<std::int64_t>(st.iterations()) * ack_every);
 }
@@ -242,7 +269,9 @@ void BM_DistChangesPerSecondBatched(benchmark::State& st) {
       x.p->publish();
     }
     const int want = x.arm.counter();
-    while (x.arm.ack() != want) x.p->poll();
+    if (!spin(
+            st, [&] { x.p->poll(); }, [&] { return x.arm.ack() == want; }))
+      break;
   }
   st.SetItemsProcessed(static_cast<std::int64_t>(st.iterations()) * ack_every);
 }
