@@ -2,6 +2,8 @@
 //
 //   vsd-dist serve FILE --domain N [--topic T] [--config URI] [--for SECONDS]
 //   vsd-dist watch --domain N [--topic T] [--config URI] [--for SECONDS]
+#include <unistd.h>
+
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
@@ -73,7 +75,8 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, [](int) { interrupted = 1; });
   std::signal(SIGTERM, [](int) { interrupted = 1; });
   try {
-    vsd::Environment env(static_cast<std::uint16_t>(1000 + std::rand() % 30000));
+    // A site of its own (ids of instances it creates must not clash with other processes').
+    vsd::Environment env(static_cast<std::uint16_t>(1000 + ::getpid() % 30000));
     vsd::SimState& state = env.main_state();
     if (command == "serve") {
       const auto report = vsd::io::load(state, file);
