@@ -19,6 +19,9 @@ PACKAGES=(
   # vsd::scene: URDF and mesh loading
   liburdfdom-dev
   libassimp-dev
+  # vsd::dist: Cyclone DDS (C API) and its IDL compiler idlc
+  cyclonedds-dev
+  cyclonedds-tools
   # tests and benchmarks
   libgtest-dev
   libgmock-dev

@@ -1,0 +1,137 @@
+#include "vsd/dist/wire.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string_view>
+
+#include "dist_test_util.hpp"
+
+using testing::HasSubstr;
+using vsd_dist_test::DArm;
+
+namespace {
+
+std::size_t occurrences(const std::vector<std::uint8_t>& bytes, std::string_view what) {
+  std::size_t n = 0;
+  const std::string_view all(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  for (auto at = all.find(what); at != std::string_view::npos; at = all.find(what, at + 1)) ++n;
+  return n;
+}
+
+struct WireTest : testing::Test {
+  vsd::Environment env{1};
+  vsd::SimState& source = env.main_state();
+  vsd::SimState& replica = env.create_state("replica");
+};
+
+TEST_F(WireTest, NamesEachClassAndPropertyOncePerBundle) {
+  source.start_recording();
+  for (int i = 0; i < 50; ++i) {
+    auto& a = source.create<DArm>();
+    source.database().add_child(a);
+    a.set_target(i * 0.5);
+    a.set_position(i * 0.25);
+  }
+  const vsd::Transaction t = source.stop_recording();
+  const auto wire = vsd::dist::encode_bundle(t, source);
+  EXPECT_EQ(occurrences(wire.bytes, "DArm"), 1u);
+  EXPECT_EQ(occurrences(wire.bytes, "target"), 1u);
+  EXPECT_EQ(occurrences(wire.bytes, "position"), 1u);
+  EXPECT_EQ(occurrences(wire.bytes, "children"), 1u);
+  EXPECT_GT(occurrences(t.bytes(), "target"), 50u);  // the core's VSDT names it in every operation
+  EXPECT_LT(wire.bytes.size() * 2, t.bytes().size());
+  EXPECT_EQ(wire.ops, t.size());
+  replica.apply(vsd::dist::decode_bundle(wire.bytes));
+  std::string diff;
+  EXPECT_TRUE(source.equals(replica, &diff)) << diff;
+}
+
+TEST_F(WireTest, OnlyDistributedPropertiesTravel) {
+  auto& a = source.create<DArm>();
+  source.database().add_child(a);
+  replica.apply(source.snapshot());
+  source.start_recording();
+  a.set_note("local only");
+  a.set_target(2.0);
+  auto& b = source.create<DArm>();
+  b.set_note("also local");
+  const vsd::Transaction t = source.stop_recording();
+  const auto wire = vsd::dist::encode_bundle(t, source);
+  EXPECT_EQ(wire.dropped, 2u);  // the two sets of note (b's create carries no note either)
+  EXPECT_EQ(occurrences(wire.bytes, "note"), 0u);
+  replica.apply(vsd::dist::decode_bundle(wire.bytes));
+  EXPECT_EQ(replica.find<DArm>(a.id())->target(), 2.0);
+  EXPECT_EQ(replica.find<DArm>(a.id())->note(), "");
+  ASSERT_NE(replica.find<DArm>(b.id()), nullptr);
+  EXPECT_EQ(replica.find<DArm>(b.id())->note(), "");
+}
+
+TEST_F(WireTest, SetThenDeleteInOneBundleEncodes) {
+  auto& a = source.create<DArm>();
+  source.database().add_child(a);
+  const vsd::Id id = a.id();
+  replica.apply(source.snapshot());
+  source.start_recording();
+  a.set_target(1.0);
+  source.destroy(a);  // gone from the state when the bundle is encoded
+  const auto wire = vsd::dist::encode_bundle(source.stop_recording(), source);
+  replica.apply(vsd::dist::decode_bundle(wire.bytes));
+  EXPECT_EQ(replica.find(id), nullptr);
+  EXPECT_TRUE(replica.database().children().empty());
+}
+
+TEST_F(WireTest, MalformedBytesAreErrorsWithTheirPosition) {
+  source.start_recording();
+  auto& a = source.create<DArm>();
+  a.set_target(3.0);
+  const auto good = vsd::dist::encode_bundle(source.stop_recording(), source).bytes;
+
+  EXPECT_THAT(
+      [&] {
+        (void)vsd::dist::decode_bundle(std::vector<std::uint8_t>{'V', 'S', 'D', 'T', 1});
+      },
+      testing::ThrowsMessage<vsd::Error>(HasSubstr("wire bundle byte 0: not a vsd wire bundle")));
+  auto bad_version = good;
+  bad_version[4] = 9;
+  EXPECT_THAT([&] { (void)vsd::dist::decode_bundle(bad_version); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("byte 4: wire bundle version 9")));
+  for (std::size_t cut = 5; cut < good.size(); ++cut) {  // every truncation is an error, never a crash
+    std::vector<std::uint8_t> part(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(cut));
+    EXPECT_THROW((void)vsd::dist::decode_bundle(part), vsd::Error) << "cut at " << cut;
+  }
+  auto trailing = good;
+  trailing.push_back(0);
+  EXPECT_THAT([&] { (void)vsd::dist::decode_bundle(trailing); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("1 unexpected bytes after the last operation")));
+  // A name index past the table.
+  const std::vector<std::uint8_t> bad_name{'V', 'S', 'D', 'W', 1, 1, 4, 'D', 'A', 'r', 'm', 1, 1, 5, 3};
+  EXPECT_THAT([&] { (void)vsd::dist::decode_bundle(bad_name); },
+              testing::ThrowsMessage<vsd::Error>(
+                  HasSubstr("byte 14: name index 3 is past the name table (1 names)")));
+  const std::vector<std::uint8_t> bad_code{'V', 'S', 'D', 'W', 1, 1, 4, 'D', 'A', 'r', 'm', 1, 9, 5, 0};
+  EXPECT_THAT([&] { (void)vsd::dist::decode_bundle(bad_code); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("byte 12: unknown operation code 9")));
+  const std::vector<std::uint8_t> huge_count{'V', 'S', 'D', 'W', 1, 0, 0x7f};
+  EXPECT_THAT([&] { (void)vsd::dist::decode_bundle(huge_count); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("exceeds")));
+}
+
+TEST_F(WireTest, ABundleThatDoesNotFitChangesNothing) {
+  auto& a = source.create<DArm>();
+  source.database().add_child(a);
+  const vsd::Id id = a.id();
+  replica.apply(source.snapshot());
+  source.start_recording();
+  a.set_target(5.0);
+  source.destroy(a);
+  const auto wire = vsd::dist::encode_bundle(source.stop_recording(), source).bytes;
+  replica.destroy(*replica.find(id));  // the replica has diverged: the set cannot apply
+  const std::size_t before = replica.size();
+  EXPECT_THAT([&] { replica.apply(vsd::dist::decode_bundle(wire)); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr("no instance #" + std::to_string(id))));
+  EXPECT_EQ(replica.size(), before);
+}
+
+}  // namespace
