@@ -3,6 +3,8 @@
 // conditions read the last time they ran (recorded by the VM) — heard through the SimState's property
 // signal. Among the enabled transitions one is chosen with a seeded generator, so runs are
 // reproducible. Every firing changes markings through the setters of the place nodes.
+#include <algorithm>
+
 #include "program_impl.hpp"
 #include "vsd/core/error.hpp"
 
@@ -97,10 +99,27 @@ bool ProgramImpl::test(TI& ti) {
     if (condition_errors_.size() < 100) condition_errors_.emplace_back(e.what());
   }
   deps_ = nullptr;
-  const auto index = static_cast<std::uint32_t>(&ti - tis_.data());
-  for (const auto& [id, prop] : dep_scratch_) {
-    auto& v = deps_map_[DepKey{id, prop}];
-    if (std::find(v.begin(), v.end(), index) == v.end()) v.push_back(index);
+  // Listen to what this test read, and stop listening to what it no longer reads (a token that left,
+  // a deleted instance): the table holds only current dependencies.
+  std::sort(dep_scratch_.begin(), dep_scratch_.end());
+  dep_scratch_.erase(std::unique(dep_scratch_.begin(), dep_scratch_.end()), dep_scratch_.end());
+  bool same = dep_scratch_.size() == ti.deps.size();
+  for (std::size_t k = 0; same && k < dep_scratch_.size(); ++k)
+    same = ti.deps[k].id == dep_scratch_[k].first && ti.deps[k].prop == dep_scratch_[k].second;
+  if (!same) {
+    const auto index = static_cast<std::uint32_t>(&ti - tis_.data());
+    for (const DepKey& k : ti.deps) {
+      auto it = deps_map_.find(k);
+      if (it == deps_map_.end()) continue;
+      auto& v = it->second;
+      v.erase(std::remove(v.begin(), v.end(), index), v.end());
+      if (v.empty()) deps_map_.erase(it);
+    }
+    ti.deps.clear();
+    for (const auto& [id, prop] : dep_scratch_) {
+      ti.deps.push_back(DepKey{id, prop});
+      deps_map_[DepKey{id, prop}].push_back(index);
+    }
   }
   ti.mark = mark;
   return enabled;

@@ -512,7 +512,7 @@ void ProgramImpl::build_net(const ClassInfo& ci, SimStateInstance& inst) {
   net_order_.push_back(n);
   for (std::size_t t = 0; t < ci.net->transitions.size(); ++t) {
     const auto ti = static_cast<std::uint32_t>(tis_.size());
-    tis_.push_back(TI{n, static_cast<int>(t)});
+    tis_.push_back(TI{{}, n, static_cast<int>(t)});
     tis_.back().dirty = false;
     mark_dirty(ti);
     const TransitionInfo& info = ci.net->transitions[t];
@@ -644,6 +644,7 @@ std::uint64_t Program::run_until_quiet(std::uint64_t limit) { return impl_->step
 bool Program::enabled_any() { return impl_->refresh(); }
 std::uint64_t Program::firings() const noexcept { return impl_->firings_; }
 void Program::on_firing(std::function<void(const Firing&)> fn) { impl_->trace_ = std::move(fn); }
+std::size_t Program::watched_properties() const noexcept { return impl_->deps_map_.size(); }
 std::uint64_t Program::condition_tests() const noexcept { return impl_->tests_; }
 const std::vector<std::string>& Program::condition_errors() const noexcept {
   return impl_->condition_errors_;

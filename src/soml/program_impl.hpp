@@ -270,7 +270,13 @@ class ProgramImpl {
   // executor state
   std::unordered_map<std::uint64_t, std::unique_ptr<NetInst>> nets_;  // owner id -> net
   std::vector<NetInst*> net_order_;
+  struct DepKey {
+    std::uint64_t id;
+    const MetaProperty* prop;
+    bool operator==(const DepKey&) const = default;
+  };
   struct TI {
+    std::vector<DepKey> deps;  // what its last test read (sorted): where it is listed in deps_map_
     NetInst* net;
     int t;
     bool dirty = true;
@@ -282,11 +288,6 @@ class ProgramImpl {
   std::vector<std::uint32_t> dirty_;
   std::vector<std::uint32_t> enabled_;
   std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> place_watch_;  // place id -> TIs
-  struct DepKey {
-    std::uint64_t id;
-    const MetaProperty* prop;
-    bool operator==(const DepKey&) const = default;
-  };
   struct DepHash {
     std::size_t operator()(const DepKey& k) const noexcept {
       return std::hash<std::uint64_t>()(k.id * 0x9E3779B97F4A7C15ULL ^

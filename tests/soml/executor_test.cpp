@@ -139,6 +139,27 @@ arrow alarm -> armed;
   EXPECT_EQ(p.root().get<std::int64_t>("alarms"), 1);
 }
 
+TEST_F(Exec, OnlyWhatTheLastTestReadIsWatched) {
+  Program& p = load(R"(
+class Tok : Node { int n = 0; }
+object line {
+  place<Tok> in;
+  place<Tok> out;
+  transition pass { when mark.n > 0; }
+  arrow in -> pass;
+  arrow pass -> out;
+  void add(int k) { for (int i = 0; i < k; i++) { shared<Tok> t = new Tok(); t.n = 1; in.put(t); } }
+}
+)");
+  vsd::Node* line = p.object("line");
+  for (int round = 0; round < 20; ++round) {
+    line->call("add", {vsd::Value(std::int64_t{5})});
+    EXPECT_EQ(p.run_until_quiet(), 5u);
+  }
+  EXPECT_EQ(p.place("out", line)->objects().size(), 100u);
+  EXPECT_LE(p.watched_properties(), 1u) << "tokens that left are not watched any more";
+}
+
 TEST_F(Exec, SeededChoiceIsReproducible) {
   const std::string text = R"(
 place a = 20;
