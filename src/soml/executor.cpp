@@ -49,6 +49,30 @@ void ProgramImpl::set_enabled(std::uint32_t i, bool on) {
   }
 }
 
+Place* ProgramImpl::remote_place(const ArrowInfo& a, std::uint64_t owner) {
+  std::uint64_t id = owner;
+  for (const PathStep& st : a.path) {
+    if (st.object != nullptr) {
+      id = object_ids_.at(st.object);
+      continue;
+    }
+    SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
+    if (o == nullptr || !o->meta().is_a(st.prop->owner())) return nullptr;
+    if (deps_ != nullptr) deps_->emplace_back(id, st.prop);
+    const SimStateInstance* t = static_cast<const RefBase*>(st.prop->address(*o))->get();
+    id = t != nullptr ? t->id() : 0;
+  }
+  const NetInst* n = net_of(id);
+  if (n == nullptr) return nullptr;
+  for (std::size_t i = 0; i < n->cls->places.size(); ++i)
+    if (n->cls->places[i] == a.remote_place) {
+      Place* p = n->places[i];
+      if (deps_ != nullptr) deps_->emplace_back(p->id(), &Place::vsd_prop_tokens());
+      return p;
+    }
+  return nullptr;
+}
+
 bool ProgramImpl::test(TI& ti) {
   const NetInst& net = *ti.net;
   const TransitionInfo& t = net.cls->transitions[static_cast<std::size_t>(ti.t)];
@@ -65,6 +89,11 @@ bool ProgramImpl::test(TI& ti) {
     for (std::size_t k = 0; k < t.in.size() && enabled; ++k) {
       if (static_cast<int>(k) == t.mark_in) continue;
       const ArrowInfo& a = t.in[k];
+      if (a.remote) {  // communication: the remote place is found now; a null reference disables
+        const Place* rp = remote_place(a, net.owner);
+        enabled = rp != nullptr && rp->count() >= a.weight;
+        continue;
+      }
       const Place& p = *net.places[static_cast<std::size_t>(a.place)];
       std::int64_t n = 0;
       if (a.cond < 0) {
@@ -79,6 +108,10 @@ bool ProgramImpl::test(TI& ti) {
       }
       enabled = a.inhibitor ? n < a.weight : n >= a.weight;
     }
+    // A communication output arrow whose path meets a null reference disables too: its tokens would
+    // have nowhere to go.
+    for (std::size_t k = 0; k < t.out.size() && enabled; ++k)
+      if (t.out[k].remote) enabled = remote_place(t.out[k], net.owner) != nullptr;
     if (enabled && t.mark_in >= 0) {
       const ArrowInfo& a = t.in[static_cast<std::size_t>(t.mark_in)];
       const Place& p = *net.places[static_cast<std::size_t>(a.place)];
@@ -146,9 +179,16 @@ void ProgramImpl::fire(std::uint32_t i) {
   Place* from = nullptr;
   std::size_t from_index = 0;
   // Consume.
+  std::vector<Place*>& remote_in = remote_scratch_;  // reused: no allocation per firing
+  remote_in.assign(t.in.size(), nullptr);
   for (std::size_t k = 0; k < t.in.size(); ++k) {
     const ArrowInfo& a = t.in[k];
     if (a.inhibitor) continue;
+    if (a.remote) {
+      remote_in[k] = remote_place(a, net.owner);
+      if (remote_in[k] != nullptr) remote_in[k]->set_tokens(remote_in[k]->tokens() - a.weight);
+      continue;
+    }
     Place& p = *net.places[static_cast<std::size_t>(a.place)];
     if (static_cast<int>(k) == t.mark_in) {
       from = &p;
@@ -166,6 +206,11 @@ void ProgramImpl::fire(std::uint32_t i) {
       for (std::size_t k = 0; k < t.in.size(); ++k) {
         const ArrowInfo& a = t.in[k];
         if (a.inhibitor) continue;
+        if (a.remote) {
+          if (remote_in[k] != nullptr && state_.find(remote_in[k]->id()) == remote_in[k])
+            remote_in[k]->set_tokens(remote_in[k]->tokens() + a.weight);
+          continue;
+        }
         Place& p = *net.places[static_cast<std::size_t>(a.place)];
         if (static_cast<int>(k) == t.mark_in) {
           if (m != nullptr && state_.find(mark) == m && from_index != RefListBase::npos)
@@ -181,7 +226,9 @@ void ProgramImpl::fire(std::uint32_t i) {
   Place* to = nullptr;
   m = mark != 0 ? state_.find(mark) : nullptr;
   for (const ArrowInfo& a : t.out) {
-    Place& p = *net.places[static_cast<std::size_t>(a.place)];
+    Place* pp = a.remote ? remote_place(a, net.owner) : net.places[static_cast<std::size_t>(a.place)];
+    if (pp == nullptr) continue;  // a communication arrow whose path meets a null reference
+    Place& p = *pp;
     if (!a.object) {
       if (a.cond < 0 || run(a.cond, net.owner, mark, nullptr, nullptr).i != 0)
         p.set_tokens(p.tokens() + a.weight);

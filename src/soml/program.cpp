@@ -101,8 +101,6 @@ void ProgramImpl::load(std::string name, std::string text) {
   walk(root, [&](const Decl& d) {
     if (d.kind == DeclKind::Net)
       not_supported(*this, d.loc, "net '" + d.name + "' (substitution and invocation)");
-    if (d.kind == DeclKind::Arrow && d.as<ArrowDecl>().arrow == ArrowKind::Communication)
-      not_supported(*this, d.loc, "a communication arrow");
     if (d.kind == DeclKind::Object && !is_static_instance(d))
       not_supported(*this, d.loc, "an object nested in a class");
     if (d.kind == DeclKind::Class && d.parent != nullptr && d.parent->kind == DeclKind::Class)
@@ -301,6 +299,57 @@ void ProgramImpl::load(std::string name, std::string text) {
     if (has_transitions && !ci.net) ci.net = std::make_unique<NetClass>();
   }
 
+  // Communication arrows: the path to the remote place, resolved like the checker did (objects and
+  // reference properties), as steps the executor follows when it tests or fires.
+  auto comm_path = [&](const ArrowDecl& a, const ClassDecl& owner) {
+    const std::vector<std::string>& path = a.to_decl->kind == DeclKind::Transition ? a.from : a.to;
+    std::vector<PathStep> steps;
+    ClassRef cls{&owner, nullptr};
+    auto find_in = [&](ClassRef c, const std::string& n, PathStep& st, ClassRef& next) {
+      for (const ClassDecl* d = c.decl; d != nullptr; d = d->base.decl)
+        for (const DeclPtr& m : d->members) {
+          if (m->name != n) continue;
+          if (m->kind == DeclKind::Object && is_static_instance(*m)) {
+            st.object = &m->as<ClassDecl>();
+            next = ClassRef{st.object, nullptr};
+            return true;
+          }
+          if (m->kind == DeclKind::Property && m->as<PropertyDecl>().type.kind == K::Ref) {
+            st.prop = scope_meta_.at(d)->find_property(n);
+            next = m->as<PropertyDecl>().type.cls;
+            return st.prop != nullptr;
+          }
+          return false;
+        }
+      const MetaInstance* b = c.builtin();
+      if (b != nullptr && c.decl == nullptr) {
+        if (const MetaProperty* mp = b->find_property(n);
+            mp != nullptr && mp->type().kind() == TypeKind::SharedRef) {
+          st.prop = mp;
+          next = ClassRef{nullptr, mp->type().target()};
+          return true;
+        }
+      }
+      return false;
+    };
+    for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+      PathStep st;
+      ClassRef next;
+      bool ok = find_in(cls, path[i], st, next);
+      // The first name may also be a static object or a property of a static object around the owner.
+      for (const Decl* up = owner.parent; !ok && i == 0 && up != nullptr; up = up->parent)
+        if (up->is_class_like() && is_static_instance(*up)) {
+          ok = find_in(ClassRef{&up->as<ClassDecl>(), nullptr}, path[i], st, next);
+          if (ok && st.prop != nullptr) steps.push_back(PathStep{&up->as<ClassDecl>(), nullptr});
+        }
+      if (!ok) not_supported(*this, a.loc, "this communication arrow path");
+      steps.push_back(st);
+      cls = next;
+    }
+    if (steps.empty()) not_supported(*this, a.loc, "a communication arrow without a path");
+    return steps;
+  };
+
   // 7. Compile.
   for (auto& [fd, fi] : function_index_) compile_function(*this, fi, *fd);
   for (const ClassDecl* c : class_order_) {
@@ -327,6 +376,17 @@ void ProgramImpl::load(std::string name, std::string text) {
       auto arrow_info = [&](const ArrowDecl& a, const Decl* place) {
         ArrowInfo ai;
         ai.decl = &a;
+        if (a.arrow == ArrowKind::Communication) {
+          ai.remote = true;
+          ai.remote_place = &place->as<PlaceDecl>();
+          ai.path = comm_path(a, *c);
+          ai.weight = a.weight;
+          ai.object = !ai.remote_place->token.empty();
+          if (a.condition) not_supported(*this, a.loc, "a condition on a communication arrow");
+          if (ai.object && a.to_decl->kind == DeclKind::Transition)
+            not_supported(*this, a.loc, "a communication arrow taking object tokens");
+          return ai;
+        }
         ai.place = place_index(*ci.net, place);
         if (ai.place < 0) not_supported(*this, a.loc, "an arrow to a place of another net");
         ai.weight = a.weight;
@@ -488,6 +548,18 @@ void ProgramImpl::build_net(const ClassInfo& ci, SimStateInstance& inst) {
     auto add_arrow = [&](const ArrowInfo& a) {
       Node* from = node_of(a.decl->from_decl);
       Node* to = node_of(a.decl->to_decl);
+      if (a.remote) {
+        // A communication arrow leaves the transition (output) or points at it (input); its place is
+        // found when it fires, so its target is set only when it is local.
+        Node* tn = a.decl->to_decl->kind == DeclKind::Transition ? to : from;
+        auto& an = state_.create<Arrow>();
+        an.set_name(a.decl->from_decl->name + " ~> " + a.decl->to_decl->name);
+        an.set_type(ArrowType::Communication);
+        an.set_weight(a.weight);
+        if (a.decl->to_decl->kind == DeclKind::Transition) an.set_target(tn);
+        tn->add_child(an);
+        return;
+      }
       auto& an = state_.create<Arrow>();
       an.set_name(a.decl->from_decl->name + (a.inhibitor ? " -o " : " -> ") + a.decl->to_decl->name);
       an.set_type(a.inhibitor ? ArrowType::Inhibitor : ArrowType::Normal);
@@ -517,7 +589,7 @@ void ProgramImpl::build_net(const ClassInfo& ci, SimStateInstance& inst) {
     mark_dirty(ti);
     const TransitionInfo& info = ci.net->transitions[t];
     for (const ArrowInfo& a : info.in)
-      place_watch_[n->places[static_cast<std::size_t>(a.place)]->id()].push_back(ti);
+      if (!a.remote) place_watch_[n->places[static_cast<std::size_t>(a.place)]->id()].push_back(ti);
   }
 }
 

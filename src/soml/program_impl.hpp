@@ -139,9 +139,19 @@ struct PropSlot {
   PK kind = PK::Other;
 };
 
+// One step of a communication arrow's path: a fixed object, or a reference property of the instance
+// reached so far.
+struct PathStep {
+  const ClassDecl* object = nullptr;  // a static object (its id once created)
+  const MetaProperty* prop = nullptr;
+};
+
 struct ArrowInfo {
   const ArrowDecl* decl = nullptr;
-  int place = -1;  // index into the net's places
+  int place = -1;              // index into the net's places (-1 for a communication arrow)
+  bool remote = false;         // communication arrow: the place is found through `path`
+  std::vector<PathStep> path;  // from the owner of the transition to the remote instance
+  const PlaceDecl* remote_place = nullptr;
   std::int64_t weight = 1;
   bool inhibitor = false;
   bool object = false;  // the place holds object tokens
@@ -296,6 +306,7 @@ class ProgramImpl {
   };
   std::unordered_map<DepKey, std::vector<std::uint32_t>, DepHash> deps_map_;
   std::vector<std::pair<std::uint64_t, const MetaProperty*>> dep_scratch_;
+  std::vector<Place*> remote_scratch_;
   Connection listener_;
   std::uint64_t rng_ = 1;
   std::uint64_t firings_ = 0;
@@ -316,6 +327,9 @@ class ProgramImpl {
     return it == nets_.end() ? nullptr : it->second.get();
   }
   bool test(TI& ti);
+  // The remote place of a communication arrow (null when the path meets a null reference); records what
+  // it read as dependencies while a test runs.
+  Place* remote_place(const ArrowInfo& a, std::uint64_t owner);
   void fire(std::uint32_t ti);
   void set_enabled(std::uint32_t ti, bool on);
 };

@@ -160,6 +160,45 @@ object line {
   EXPECT_LE(p.watched_properties(), 1u) << "tokens that left are not watched any more";
 }
 
+TEST_F(Exec, CommunicationArrowsDepositAndTakeTokensInOtherObjectsNets) {
+  Program& p = load(R"(
+class Station : Node {
+  int taken = 0;
+  place inbox;
+  place done;
+  transition take { do { taken += 1; } }
+  arrow inbox -> take;
+  arrow take -> done;
+}
+object dispatcher {
+  shared<Station> target;
+  place jobs = 3;
+  place collected;
+  transition send;
+  transition collect;
+  arrow jobs -> send;
+  arrow send ~> target.inbox;
+  arrow target.done ~> collect;
+  arrow collect -> collected;
+}
+object s1 : Station;
+object s2 : Station;
+)");
+  vsd::Node* dispatcher = p.object("dispatcher");
+  EXPECT_EQ(p.run_until_quiet(), 0u) << "a null reference on the path disables";
+  dispatcher->set("target", vsd::Value(vsd::SharedRef<vsd::Node>(p.object("s1"))));
+  EXPECT_EQ(p.run_until_quiet(), 9u);  // 3 x (send, take, collect)
+  EXPECT_EQ(p.object("s1")->get<std::int64_t>("taken"), 3);
+  EXPECT_EQ(p.place("collected", dispatcher)->tokens(), 3);
+  EXPECT_EQ(p.place("done", p.object("s1"))->tokens(), 0);
+  // Re-routing through the reference property: more jobs go to s2.
+  dispatcher->set("target", vsd::Value(vsd::SharedRef<vsd::Node>(p.object("s2"))));
+  p.place("jobs", dispatcher)->set_tokens(2);
+  EXPECT_EQ(p.run_until_quiet(), 6u);
+  EXPECT_EQ(p.object("s2")->get<std::int64_t>("taken"), 2);
+  EXPECT_EQ(p.place("collected", dispatcher)->tokens(), 5);
+}
+
 TEST_F(Exec, SeededChoiceIsReproducible) {
   const std::string text = R"(
 place a = 20;
