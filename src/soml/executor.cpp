@@ -22,6 +22,26 @@ void ProgramImpl::on_change(SimStateInstance& inst, const MetaProperty& p) {
     for (std::uint32_t ti : it->second) mark_dirty(ti);
 }
 
+// A net whose owner, place or transition is deleted stops: its transitions leave the enabled set and
+// are never tested again (their nodes, which the executor holds by pointer, are going away).
+void ProgramImpl::on_deleted(SimStateInstance& inst) {
+  auto it = node_net_.find(inst.id());
+  if (it == node_net_.end()) return;
+  NetInst* n = it->second;
+  if (n->dead) return;
+  n->dead = true;
+  for (std::size_t t = 0; t < n->transitions.size(); ++t) {
+    const auto i = static_cast<std::uint32_t>(n->first_ti + t);
+    set_enabled(i, false);
+  }
+  for (Place* p : n->places) {
+    place_watch_.erase(p->id());
+    node_net_.erase(p->id());
+  }
+  for (Transition* t : n->transitions) node_net_.erase(t->id());
+  node_net_.erase(n->owner);
+}
+
 void ProgramImpl::put_token(Place& p, SimStateInstance* obj, std::int64_t n) {
   if (obj == nullptr) {
     p.set_tokens(p.tokens() + n);
@@ -83,7 +103,10 @@ bool ProgramImpl::test(TI& ti) {
   std::uint64_t mark = 0;
   auto truth = [&](int fn, std::uint64_t self, std::uint64_t m) {
     ++tests_;
-    return run(fn, self, m, nullptr, nullptr).i != 0;
+    const bool yes = run(fn, self, m, nullptr, nullptr).i != 0;
+    if (net.dead)
+      throw Error("the net of instance " + std::to_string(net.owner) + " was deleted while it was tested");
+    return yes;
   };
   try {
     for (std::size_t k = 0; k < t.in.size() && enabled; ++k) {
@@ -163,6 +186,7 @@ bool ProgramImpl::refresh() {
     const std::uint32_t i = dirty_.back();
     dirty_.pop_back();
     tis_[i].dirty = false;
+    if (tis_[i].net->dead) continue;
     const bool on = test(tis_[i]);
     set_enabled(i, on);
   }
@@ -220,6 +244,10 @@ void ProgramImpl::fire(std::uint32_t i) {
         }
       }
       throw;
+    }
+    if (net.dead) {  // the action deleted its own net: nothing to produce into
+      ++firings_;
+      return;
     }
   }
   // Produce: black tokens to every black output place, the mark to the first object place that takes it.

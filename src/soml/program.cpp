@@ -47,7 +47,10 @@ void walk(const Decl& d, F&& fn) {
 
 }  // namespace
 
-ProgramImpl::~ProgramImpl() { listener_.disconnect(); }
+ProgramImpl::~ProgramImpl() {
+  listener_.disconnect();
+  deleted_listener_.disconnect();
+}
 
 // The MetaType that stores a value of static type t (references to script classes are stored as
 // references to their nearest built-in class: the checker already typed them).
@@ -420,6 +423,7 @@ void ProgramImpl::load(std::string name, std::string text) {
   // 8. The database content: source components, the script object and its objects.
   listener_ = state_.on_property_changed().connect(
       [this](SimStateInstance& inst, const MetaProperty& p) { on_change(inst, p); });
+  deleted_listener_ = state_.on_deleted().connect([this](SimStateInstance& inst) { on_deleted(inst); });
   source_node_ = &state_.create<SourceFile>();
   source_node_->set_name(stem_ + " (source)");
   source_node_->set_file(checked_->source->name());
@@ -580,6 +584,9 @@ void ProgramImpl::build_net(const ClassInfo& ci, SimStateInstance& inst) {
   // Register with the executor: every transition is tested once.
   net->first_ti = static_cast<std::uint32_t>(tis_.size());
   NetInst* n = net.get();
+  node_net_[inst.id()] = n;
+  for (Place* p : n->places) node_net_[p->id()] = n;
+  for (Transition* t : n->transitions) node_net_[t->id()] = n;
   nets_[inst.id()] = std::move(net);
   net_order_.push_back(n);
   for (std::size_t t = 0; t < ci.net->transitions.size(); ++t) {
@@ -701,7 +708,7 @@ Place* Program::place(std::string_view name, const Node* owner) const {
 std::vector<Place*> Program::places() const {
   std::vector<Place*> all;
   for (const NetInst* n : impl_->net_order_)
-    if (impl_->state_.find(n->owner) != nullptr) all.insert(all.end(), n->places.begin(), n->places.end());
+    if (!n->dead) all.insert(all.end(), n->places.begin(), n->places.end());
   return all;
 }
 

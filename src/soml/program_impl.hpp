@@ -178,6 +178,7 @@ struct NetInst {
   std::vector<Place*> places;
   std::vector<Transition*> transitions;
   std::uint32_t first_ti = 0;  // index of its first transition in the executor's list
+  bool dead = false;           // its owner, a place or a transition was deleted: it fires no more
 };
 
 struct ClassInfo {
@@ -308,6 +309,9 @@ class ProgramImpl {
   std::vector<std::pair<std::uint64_t, const MetaProperty*>> dep_scratch_;
   std::vector<Place*> remote_scratch_;
   Connection listener_;
+  Connection deleted_listener_;
+  std::unordered_map<std::uint64_t, NetInst*> node_net_;  // owner, place and transition ids -> net
+  void on_deleted(SimStateInstance& inst);
   std::uint64_t rng_ = 1;
   std::uint64_t firings_ = 0;
   std::uint64_t tests_ = 0;
@@ -315,7 +319,7 @@ class ProgramImpl {
   std::function<void(const Firing&)> trace_;
 
   void mark_dirty(std::uint32_t ti) {
-    if (!tis_[ti].dirty) {
+    if (!tis_[ti].dirty && !tis_[ti].net->dead) {
       tis_[ti].dirty = true;
       if (dirty_.empty() && on_dirty_) on_dirty_();
       dirty_.push_back(ti);
@@ -324,7 +328,7 @@ class ProgramImpl {
   void on_change(SimStateInstance& inst, const MetaProperty& p);
   NetInst* net_of(std::uint64_t owner) const {
     auto it = nets_.find(owner);
-    return it == nets_.end() ? nullptr : it->second.get();
+    return it == nets_.end() || it->second->dead ? nullptr : it->second.get();
   }
   bool test(TI& ti);
   // The remote place of a communication arrow (null when the path meets a null reference); records what

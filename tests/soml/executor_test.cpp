@@ -199,6 +199,30 @@ object s2 : Station;
   EXPECT_EQ(p.place("collected", dispatcher)->tokens(), 5);
 }
 
+TEST_F(Exec, DeletingANetsNodesStopsThatNetOnly) {
+  Program& p = load(R"(
+class Cell : Node {
+  place a = 3;
+  place b;
+  transition t;
+  arrow a -> t;
+  arrow t -> b;
+}
+object c1 : Cell;
+object c2 : Cell;
+)");
+  vsd::Node* c1 = p.object("c1");
+  vsd::Node* c2 = p.object("c2");
+  vsd::soml::Place* b2 = p.place("b", c2);
+  env.main_state().destroy(*c1);  // C++ deletes a net object with its places and transitions
+  EXPECT_EQ(p.run_until_quiet(), 3u);
+  EXPECT_EQ(b2->tokens(), 3);
+  b2->set_tokens(0);
+  env.main_state().destroy(*p.place("a", c2));  // one place of the other net
+  EXPECT_EQ(p.run_until_quiet(), 0u);
+  EXPECT_EQ(p.places().size(), 0u);
+}
+
 TEST_F(Exec, SeededChoiceIsReproducible) {
   const std::string text = R"(
 place a = 20;
