@@ -71,6 +71,10 @@ class Compiler {
 
   // ---- emission ----
   std::size_t emit(Op op, int a = 0, int b = 0, int c = 0) {
+    // Operands are 16 bits: registers, table indices (properties, plans, classes, ...) and immediates
+    // (already cast). A script that needs more is refused rather than miscompiled.
+    if (a < 0 || a > 0xFFFF || b < 0 || b > 0xFFFF || c < 0 || c > 0xFFFF)
+      not_supported(P, SourceLoc{0, line_, 1}, "a script or function this large (an operand above 65535)");
     F.code.push_back(Ins{op, 0, static_cast<std::uint16_t>(a), static_cast<std::uint16_t>(b),
                          static_cast<std::uint16_t>(c)});
     F.lines.push_back(line_);

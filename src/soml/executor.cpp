@@ -3,6 +3,8 @@
 // conditions read the last time they ran (recorded by the VM) — heard through the SimState's property
 // signal. Among the enabled transitions one is chosen with a seeded generator, so runs are
 // reproducible. Every firing changes markings through the setters of the place nodes.
+#include <algorithm>
+
 #include "program_impl.hpp"
 #include "vsd/core/error.hpp"
 
@@ -18,6 +20,26 @@ void ProgramImpl::on_change(SimStateInstance& inst, const MetaProperty& p) {
   auto it = deps_map_.find(DepKey{inst.id(), &p});
   if (it != deps_map_.end())
     for (std::uint32_t ti : it->second) mark_dirty(ti);
+}
+
+// A net whose owner, place or transition is deleted stops: its transitions leave the enabled set and
+// are never tested again (their nodes, which the executor holds by pointer, are going away).
+void ProgramImpl::on_deleted(SimStateInstance& inst) {
+  auto it = node_net_.find(inst.id());
+  if (it == node_net_.end()) return;
+  NetInst* n = it->second;
+  if (n->dead) return;
+  n->dead = true;
+  for (std::size_t t = 0; t < n->transitions.size(); ++t) {
+    const auto i = static_cast<std::uint32_t>(n->first_ti + t);
+    set_enabled(i, false);
+  }
+  for (Place* p : n->places) {
+    place_watch_.erase(p->id());
+    node_net_.erase(p->id());
+  }
+  for (Transition* t : n->transitions) node_net_.erase(t->id());
+  node_net_.erase(n->owner);
 }
 
 void ProgramImpl::put_token(Place& p, SimStateInstance* obj, std::int64_t n) {
@@ -47,6 +69,30 @@ void ProgramImpl::set_enabled(std::uint32_t i, bool on) {
   }
 }
 
+Place* ProgramImpl::remote_place(const ArrowInfo& a, std::uint64_t owner) {
+  std::uint64_t id = owner;
+  for (const PathStep& st : a.path) {
+    if (st.object != nullptr) {
+      id = object_ids_.at(st.object);
+      continue;
+    }
+    SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
+    if (o == nullptr || !o->meta().is_a(st.prop->owner())) return nullptr;
+    if (deps_ != nullptr) deps_->emplace_back(id, st.prop);
+    const SimStateInstance* t = static_cast<const RefBase*>(st.prop->address(*o))->get();
+    id = t != nullptr ? t->id() : 0;
+  }
+  const NetInst* n = net_of(id);
+  if (n == nullptr) return nullptr;
+  for (std::size_t i = 0; i < n->cls->places.size(); ++i)
+    if (n->cls->places[i] == a.remote_place) {
+      Place* p = n->places[i];
+      if (deps_ != nullptr) deps_->emplace_back(p->id(), &Place::vsd_prop_tokens());
+      return p;
+    }
+  return nullptr;
+}
+
 bool ProgramImpl::test(TI& ti) {
   const NetInst& net = *ti.net;
   const TransitionInfo& t = net.cls->transitions[static_cast<std::size_t>(ti.t)];
@@ -57,12 +103,20 @@ bool ProgramImpl::test(TI& ti) {
   std::uint64_t mark = 0;
   auto truth = [&](int fn, std::uint64_t self, std::uint64_t m) {
     ++tests_;
-    return run(fn, self, m, nullptr, nullptr).i != 0;
+    const bool yes = run(fn, self, m, nullptr, nullptr).i != 0;
+    if (net.dead)
+      throw Error("the net of instance " + std::to_string(net.owner) + " was deleted while it was tested");
+    return yes;
   };
   try {
     for (std::size_t k = 0; k < t.in.size() && enabled; ++k) {
       if (static_cast<int>(k) == t.mark_in) continue;
       const ArrowInfo& a = t.in[k];
+      if (a.remote) {  // communication: the remote place is found now; a null reference disables
+        const Place* rp = remote_place(a, net.owner);
+        enabled = rp != nullptr && rp->count() >= a.weight;
+        continue;
+      }
       const Place& p = *net.places[static_cast<std::size_t>(a.place)];
       std::int64_t n = 0;
       if (a.cond < 0) {
@@ -77,6 +131,10 @@ bool ProgramImpl::test(TI& ti) {
       }
       enabled = a.inhibitor ? n < a.weight : n >= a.weight;
     }
+    // A communication output arrow whose path meets a null reference disables too: its tokens would
+    // have nowhere to go.
+    for (std::size_t k = 0; k < t.out.size() && enabled; ++k)
+      if (t.out[k].remote) enabled = remote_place(t.out[k], net.owner) != nullptr;
     if (enabled && t.mark_in >= 0) {
       const ArrowInfo& a = t.in[static_cast<std::size_t>(t.mark_in)];
       const Place& p = *net.places[static_cast<std::size_t>(a.place)];
@@ -97,10 +155,27 @@ bool ProgramImpl::test(TI& ti) {
     if (condition_errors_.size() < 100) condition_errors_.emplace_back(e.what());
   }
   deps_ = nullptr;
-  const auto index = static_cast<std::uint32_t>(&ti - tis_.data());
-  for (const auto& [id, prop] : dep_scratch_) {
-    auto& v = deps_map_[DepKey{id, prop}];
-    if (std::find(v.begin(), v.end(), index) == v.end()) v.push_back(index);
+  // Listen to what this test read, and stop listening to what it no longer reads (a token that left,
+  // a deleted instance): the table holds only current dependencies.
+  std::sort(dep_scratch_.begin(), dep_scratch_.end());
+  dep_scratch_.erase(std::unique(dep_scratch_.begin(), dep_scratch_.end()), dep_scratch_.end());
+  bool same = dep_scratch_.size() == ti.deps.size();
+  for (std::size_t k = 0; same && k < dep_scratch_.size(); ++k)
+    same = ti.deps[k].id == dep_scratch_[k].first && ti.deps[k].prop == dep_scratch_[k].second;
+  if (!same) {
+    const auto index = static_cast<std::uint32_t>(&ti - tis_.data());
+    for (const DepKey& k : ti.deps) {
+      auto it = deps_map_.find(k);
+      if (it == deps_map_.end()) continue;
+      auto& v = it->second;
+      v.erase(std::remove(v.begin(), v.end(), index), v.end());
+      if (v.empty()) deps_map_.erase(it);
+    }
+    ti.deps.clear();
+    for (const auto& [id, prop] : dep_scratch_) {
+      ti.deps.push_back(DepKey{id, prop});
+      deps_map_[DepKey{id, prop}].push_back(index);
+    }
   }
   ti.mark = mark;
   return enabled;
@@ -111,6 +186,7 @@ bool ProgramImpl::refresh() {
     const std::uint32_t i = dirty_.back();
     dirty_.pop_back();
     tis_[i].dirty = false;
+    if (tis_[i].net->dead) continue;
     const bool on = test(tis_[i]);
     set_enabled(i, on);
   }
@@ -127,9 +203,16 @@ void ProgramImpl::fire(std::uint32_t i) {
   Place* from = nullptr;
   std::size_t from_index = 0;
   // Consume.
+  std::vector<Place*>& remote_in = remote_scratch_;  // reused: no allocation per firing
+  remote_in.assign(t.in.size(), nullptr);
   for (std::size_t k = 0; k < t.in.size(); ++k) {
     const ArrowInfo& a = t.in[k];
     if (a.inhibitor) continue;
+    if (a.remote) {
+      remote_in[k] = remote_place(a, net.owner);
+      if (remote_in[k] != nullptr) remote_in[k]->set_tokens(remote_in[k]->tokens() - a.weight);
+      continue;
+    }
     Place& p = *net.places[static_cast<std::size_t>(a.place)];
     if (static_cast<int>(k) == t.mark_in) {
       from = &p;
@@ -147,6 +230,11 @@ void ProgramImpl::fire(std::uint32_t i) {
       for (std::size_t k = 0; k < t.in.size(); ++k) {
         const ArrowInfo& a = t.in[k];
         if (a.inhibitor) continue;
+        if (a.remote) {
+          if (remote_in[k] != nullptr && state_.find(remote_in[k]->id()) == remote_in[k])
+            remote_in[k]->set_tokens(remote_in[k]->tokens() + a.weight);
+          continue;
+        }
         Place& p = *net.places[static_cast<std::size_t>(a.place)];
         if (static_cast<int>(k) == t.mark_in) {
           if (m != nullptr && state_.find(mark) == m && from_index != RefListBase::npos)
@@ -157,12 +245,18 @@ void ProgramImpl::fire(std::uint32_t i) {
       }
       throw;
     }
+    if (net.dead) {  // the action deleted its own net: nothing to produce into
+      ++firings_;
+      return;
+    }
   }
   // Produce: black tokens to every black output place, the mark to the first object place that takes it.
   Place* to = nullptr;
   m = mark != 0 ? state_.find(mark) : nullptr;
   for (const ArrowInfo& a : t.out) {
-    Place& p = *net.places[static_cast<std::size_t>(a.place)];
+    Place* pp = a.remote ? remote_place(a, net.owner) : net.places[static_cast<std::size_t>(a.place)];
+    if (pp == nullptr) continue;  // a communication arrow whose path meets a null reference
+    Place& p = *pp;
     if (!a.object) {
       if (a.cond < 0 || run(a.cond, net.owner, mark, nullptr, nullptr).i != 0)
         p.set_tokens(p.tokens() + a.weight);

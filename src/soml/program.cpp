@@ -47,7 +47,10 @@ void walk(const Decl& d, F&& fn) {
 
 }  // namespace
 
-ProgramImpl::~ProgramImpl() { listener_.disconnect(); }
+ProgramImpl::~ProgramImpl() {
+  listener_.disconnect();
+  deleted_listener_.disconnect();
+}
 
 // The MetaType that stores a value of static type t (references to script classes are stored as
 // references to their nearest built-in class: the checker already typed them).
@@ -101,8 +104,6 @@ void ProgramImpl::load(std::string name, std::string text) {
   walk(root, [&](const Decl& d) {
     if (d.kind == DeclKind::Net)
       not_supported(*this, d.loc, "net '" + d.name + "' (substitution and invocation)");
-    if (d.kind == DeclKind::Arrow && d.as<ArrowDecl>().arrow == ArrowKind::Communication)
-      not_supported(*this, d.loc, "a communication arrow");
     if (d.kind == DeclKind::Object && !is_static_instance(d))
       not_supported(*this, d.loc, "an object nested in a class");
     if (d.kind == DeclKind::Class && d.parent != nullptr && d.parent->kind == DeclKind::Class)
@@ -301,6 +302,57 @@ void ProgramImpl::load(std::string name, std::string text) {
     if (has_transitions && !ci.net) ci.net = std::make_unique<NetClass>();
   }
 
+  // Communication arrows: the path to the remote place, resolved like the checker did (objects and
+  // reference properties), as steps the executor follows when it tests or fires.
+  auto comm_path = [&](const ArrowDecl& a, const ClassDecl& owner) {
+    const std::vector<std::string>& path = a.to_decl->kind == DeclKind::Transition ? a.from : a.to;
+    std::vector<PathStep> steps;
+    ClassRef cls{&owner, nullptr};
+    auto find_in = [&](ClassRef c, const std::string& n, PathStep& st, ClassRef& next) {
+      for (const ClassDecl* d = c.decl; d != nullptr; d = d->base.decl)
+        for (const DeclPtr& m : d->members) {
+          if (m->name != n) continue;
+          if (m->kind == DeclKind::Object && is_static_instance(*m)) {
+            st.object = &m->as<ClassDecl>();
+            next = ClassRef{st.object, nullptr};
+            return true;
+          }
+          if (m->kind == DeclKind::Property && m->as<PropertyDecl>().type.kind == K::Ref) {
+            st.prop = scope_meta_.at(d)->find_property(n);
+            next = m->as<PropertyDecl>().type.cls;
+            return st.prop != nullptr;
+          }
+          return false;
+        }
+      const MetaInstance* b = c.builtin();
+      if (b != nullptr && c.decl == nullptr) {
+        if (const MetaProperty* mp = b->find_property(n);
+            mp != nullptr && mp->type().kind() == TypeKind::SharedRef) {
+          st.prop = mp;
+          next = ClassRef{nullptr, mp->type().target()};
+          return true;
+        }
+      }
+      return false;
+    };
+    for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+      PathStep st;
+      ClassRef next;
+      bool ok = find_in(cls, path[i], st, next);
+      // The first name may also be a static object or a property of a static object around the owner.
+      for (const Decl* up = owner.parent; !ok && i == 0 && up != nullptr; up = up->parent)
+        if (up->is_class_like() && is_static_instance(*up)) {
+          ok = find_in(ClassRef{&up->as<ClassDecl>(), nullptr}, path[i], st, next);
+          if (ok && st.prop != nullptr) steps.push_back(PathStep{&up->as<ClassDecl>(), nullptr});
+        }
+      if (!ok) not_supported(*this, a.loc, "this communication arrow path");
+      steps.push_back(st);
+      cls = next;
+    }
+    if (steps.empty()) not_supported(*this, a.loc, "a communication arrow without a path");
+    return steps;
+  };
+
   // 7. Compile.
   for (auto& [fd, fi] : function_index_) compile_function(*this, fi, *fd);
   for (const ClassDecl* c : class_order_) {
@@ -327,6 +379,17 @@ void ProgramImpl::load(std::string name, std::string text) {
       auto arrow_info = [&](const ArrowDecl& a, const Decl* place) {
         ArrowInfo ai;
         ai.decl = &a;
+        if (a.arrow == ArrowKind::Communication) {
+          ai.remote = true;
+          ai.remote_place = &place->as<PlaceDecl>();
+          ai.path = comm_path(a, *c);
+          ai.weight = a.weight;
+          ai.object = !ai.remote_place->token.empty();
+          if (a.condition) not_supported(*this, a.loc, "a condition on a communication arrow");
+          if (ai.object && a.to_decl->kind == DeclKind::Transition)
+            not_supported(*this, a.loc, "a communication arrow taking object tokens");
+          return ai;
+        }
         ai.place = place_index(*ci.net, place);
         if (ai.place < 0) not_supported(*this, a.loc, "an arrow to a place of another net");
         ai.weight = a.weight;
@@ -360,6 +423,7 @@ void ProgramImpl::load(std::string name, std::string text) {
   // 8. The database content: source components, the script object and its objects.
   listener_ = state_.on_property_changed().connect(
       [this](SimStateInstance& inst, const MetaProperty& p) { on_change(inst, p); });
+  deleted_listener_ = state_.on_deleted().connect([this](SimStateInstance& inst) { on_deleted(inst); });
   source_node_ = &state_.create<SourceFile>();
   source_node_->set_name(stem_ + " (source)");
   source_node_->set_file(checked_->source->name());
@@ -488,6 +552,18 @@ void ProgramImpl::build_net(const ClassInfo& ci, SimStateInstance& inst) {
     auto add_arrow = [&](const ArrowInfo& a) {
       Node* from = node_of(a.decl->from_decl);
       Node* to = node_of(a.decl->to_decl);
+      if (a.remote) {
+        // A communication arrow leaves the transition (output) or points at it (input); its place is
+        // found when it fires, so its target is set only when it is local.
+        Node* tn = a.decl->to_decl->kind == DeclKind::Transition ? to : from;
+        auto& an = state_.create<Arrow>();
+        an.set_name(a.decl->from_decl->name + " ~> " + a.decl->to_decl->name);
+        an.set_type(ArrowType::Communication);
+        an.set_weight(a.weight);
+        if (a.decl->to_decl->kind == DeclKind::Transition) an.set_target(tn);
+        tn->add_child(an);
+        return;
+      }
       auto& an = state_.create<Arrow>();
       an.set_name(a.decl->from_decl->name + (a.inhibitor ? " -o " : " -> ") + a.decl->to_decl->name);
       an.set_type(a.inhibitor ? ArrowType::Inhibitor : ArrowType::Normal);
@@ -508,16 +584,19 @@ void ProgramImpl::build_net(const ClassInfo& ci, SimStateInstance& inst) {
   // Register with the executor: every transition is tested once.
   net->first_ti = static_cast<std::uint32_t>(tis_.size());
   NetInst* n = net.get();
+  node_net_[inst.id()] = n;
+  for (Place* p : n->places) node_net_[p->id()] = n;
+  for (Transition* t : n->transitions) node_net_[t->id()] = n;
   nets_[inst.id()] = std::move(net);
   net_order_.push_back(n);
   for (std::size_t t = 0; t < ci.net->transitions.size(); ++t) {
     const auto ti = static_cast<std::uint32_t>(tis_.size());
-    tis_.push_back(TI{n, static_cast<int>(t)});
+    tis_.push_back(TI{{}, n, static_cast<int>(t)});
     tis_.back().dirty = false;
     mark_dirty(ti);
     const TransitionInfo& info = ci.net->transitions[t];
     for (const ArrowInfo& a : info.in)
-      place_watch_[n->places[static_cast<std::size_t>(a.place)]->id()].push_back(ti);
+      if (!a.remote) place_watch_[n->places[static_cast<std::size_t>(a.place)]->id()].push_back(ti);
   }
 }
 
@@ -629,7 +708,7 @@ Place* Program::place(std::string_view name, const Node* owner) const {
 std::vector<Place*> Program::places() const {
   std::vector<Place*> all;
   for (const NetInst* n : impl_->net_order_)
-    if (impl_->state_.find(n->owner) != nullptr) all.insert(all.end(), n->places.begin(), n->places.end());
+    if (!n->dead) all.insert(all.end(), n->places.begin(), n->places.end());
   return all;
 }
 
@@ -644,6 +723,7 @@ std::uint64_t Program::run_until_quiet(std::uint64_t limit) { return impl_->step
 bool Program::enabled_any() { return impl_->refresh(); }
 std::uint64_t Program::firings() const noexcept { return impl_->firings_; }
 void Program::on_firing(std::function<void(const Firing&)> fn) { impl_->trace_ = std::move(fn); }
+std::size_t Program::watched_properties() const noexcept { return impl_->deps_map_.size(); }
 std::uint64_t Program::condition_tests() const noexcept { return impl_->tests_; }
 const std::vector<std::string>& Program::condition_errors() const noexcept {
   return impl_->condition_errors_;

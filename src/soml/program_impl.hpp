@@ -139,9 +139,19 @@ struct PropSlot {
   PK kind = PK::Other;
 };
 
+// One step of a communication arrow's path: a fixed object, or a reference property of the instance
+// reached so far.
+struct PathStep {
+  const ClassDecl* object = nullptr;  // a static object (its id once created)
+  const MetaProperty* prop = nullptr;
+};
+
 struct ArrowInfo {
   const ArrowDecl* decl = nullptr;
-  int place = -1;  // index into the net's places
+  int place = -1;              // index into the net's places (-1 for a communication arrow)
+  bool remote = false;         // communication arrow: the place is found through `path`
+  std::vector<PathStep> path;  // from the owner of the transition to the remote instance
+  const PlaceDecl* remote_place = nullptr;
   std::int64_t weight = 1;
   bool inhibitor = false;
   bool object = false;  // the place holds object tokens
@@ -168,6 +178,7 @@ struct NetInst {
   std::vector<Place*> places;
   std::vector<Transition*> transitions;
   std::uint32_t first_ti = 0;  // index of its first transition in the executor's list
+  bool dead = false;           // its owner, a place or a transition was deleted: it fires no more
 };
 
 struct ClassInfo {
@@ -270,7 +281,13 @@ class ProgramImpl {
   // executor state
   std::unordered_map<std::uint64_t, std::unique_ptr<NetInst>> nets_;  // owner id -> net
   std::vector<NetInst*> net_order_;
+  struct DepKey {
+    std::uint64_t id;
+    const MetaProperty* prop;
+    bool operator==(const DepKey&) const = default;
+  };
   struct TI {
+    std::vector<DepKey> deps;  // what its last test read (sorted): where it is listed in deps_map_
     NetInst* net;
     int t;
     bool dirty = true;
@@ -282,11 +299,6 @@ class ProgramImpl {
   std::vector<std::uint32_t> dirty_;
   std::vector<std::uint32_t> enabled_;
   std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> place_watch_;  // place id -> TIs
-  struct DepKey {
-    std::uint64_t id;
-    const MetaProperty* prop;
-    bool operator==(const DepKey&) const = default;
-  };
   struct DepHash {
     std::size_t operator()(const DepKey& k) const noexcept {
       return std::hash<std::uint64_t>()(k.id * 0x9E3779B97F4A7C15ULL ^
@@ -295,7 +307,11 @@ class ProgramImpl {
   };
   std::unordered_map<DepKey, std::vector<std::uint32_t>, DepHash> deps_map_;
   std::vector<std::pair<std::uint64_t, const MetaProperty*>> dep_scratch_;
+  std::vector<Place*> remote_scratch_;
   Connection listener_;
+  Connection deleted_listener_;
+  std::unordered_map<std::uint64_t, NetInst*> node_net_;  // owner, place and transition ids -> net
+  void on_deleted(SimStateInstance& inst);
   std::uint64_t rng_ = 1;
   std::uint64_t firings_ = 0;
   std::uint64_t tests_ = 0;
@@ -303,7 +319,7 @@ class ProgramImpl {
   std::function<void(const Firing&)> trace_;
 
   void mark_dirty(std::uint32_t ti) {
-    if (!tis_[ti].dirty) {
+    if (!tis_[ti].dirty && !tis_[ti].net->dead) {
       tis_[ti].dirty = true;
       if (dirty_.empty() && on_dirty_) on_dirty_();
       dirty_.push_back(ti);
@@ -312,9 +328,12 @@ class ProgramImpl {
   void on_change(SimStateInstance& inst, const MetaProperty& p);
   NetInst* net_of(std::uint64_t owner) const {
     auto it = nets_.find(owner);
-    return it == nets_.end() ? nullptr : it->second.get();
+    return it == nets_.end() || it->second->dead ? nullptr : it->second.get();
   }
   bool test(TI& ti);
+  // The remote place of a communication arrow (null when the path meets a null reference); records what
+  // it read as dependencies while a test runs.
+  Place* remote_place(const ArrowInfo& a, std::uint64_t owner);
   void fire(std::uint32_t ti);
   void set_enabled(std::uint32_t ti, bool on);
 };

@@ -139,6 +139,90 @@ arrow alarm -> armed;
   EXPECT_EQ(p.root().get<std::int64_t>("alarms"), 1);
 }
 
+TEST_F(Exec, OnlyWhatTheLastTestReadIsWatched) {
+  Program& p = load(R"(
+class Tok : Node { int n = 0; }
+object line {
+  place<Tok> in;
+  place<Tok> out;
+  transition pass { when mark.n > 0; }
+  arrow in -> pass;
+  arrow pass -> out;
+  void add(int k) { for (int i = 0; i < k; i++) { shared<Tok> t = new Tok(); t.n = 1; in.put(t); } }
+}
+)");
+  vsd::Node* line = p.object("line");
+  for (int round = 0; round < 20; ++round) {
+    line->call("add", {vsd::Value(std::int64_t{5})});
+    EXPECT_EQ(p.run_until_quiet(), 5u);
+  }
+  EXPECT_EQ(p.place("out", line)->objects().size(), 100u);
+  EXPECT_LE(p.watched_properties(), 1u) << "tokens that left are not watched any more";
+}
+
+TEST_F(Exec, CommunicationArrowsDepositAndTakeTokensInOtherObjectsNets) {
+  Program& p = load(R"(
+class Station : Node {
+  int taken = 0;
+  place inbox;
+  place done;
+  transition take { do { taken += 1; } }
+  arrow inbox -> take;
+  arrow take -> done;
+}
+object dispatcher {
+  shared<Station> target;
+  place jobs = 3;
+  place collected;
+  transition send;
+  transition collect;
+  arrow jobs -> send;
+  arrow send ~> target.inbox;
+  arrow target.done ~> collect;
+  arrow collect -> collected;
+}
+object s1 : Station;
+object s2 : Station;
+)");
+  vsd::Node* dispatcher = p.object("dispatcher");
+  EXPECT_EQ(p.run_until_quiet(), 0u) << "a null reference on the path disables";
+  dispatcher->set("target", vsd::Value(vsd::SharedRef<vsd::Node>(p.object("s1"))));
+  EXPECT_EQ(p.run_until_quiet(), 9u);  // 3 x (send, take, collect)
+  EXPECT_EQ(p.object("s1")->get<std::int64_t>("taken"), 3);
+  EXPECT_EQ(p.place("collected", dispatcher)->tokens(), 3);
+  EXPECT_EQ(p.place("done", p.object("s1"))->tokens(), 0);
+  // Re-routing through the reference property: more jobs go to s2.
+  dispatcher->set("target", vsd::Value(vsd::SharedRef<vsd::Node>(p.object("s2"))));
+  p.place("jobs", dispatcher)->set_tokens(2);
+  EXPECT_EQ(p.run_until_quiet(), 6u);
+  EXPECT_EQ(p.object("s2")->get<std::int64_t>("taken"), 2);
+  EXPECT_EQ(p.place("collected", dispatcher)->tokens(), 5);
+}
+
+TEST_F(Exec, DeletingANetsNodesStopsThatNetOnly) {
+  Program& p = load(R"(
+class Cell : Node {
+  place a = 3;
+  place b;
+  transition t;
+  arrow a -> t;
+  arrow t -> b;
+}
+object c1 : Cell;
+object c2 : Cell;
+)");
+  vsd::Node* c1 = p.object("c1");
+  vsd::Node* c2 = p.object("c2");
+  vsd::soml::Place* b2 = p.place("b", c2);
+  env.main_state().destroy(*c1);  // C++ deletes a net object with its places and transitions
+  EXPECT_EQ(p.run_until_quiet(), 3u);
+  EXPECT_EQ(b2->tokens(), 3);
+  b2->set_tokens(0);
+  env.main_state().destroy(*p.place("a", c2));  // one place of the other net
+  EXPECT_EQ(p.run_until_quiet(), 0u);
+  EXPECT_EQ(p.places().size(), 0u);
+}
+
 TEST_F(Exec, SeededChoiceIsReproducible) {
   const std::string text = R"(
 place a = 20;

@@ -89,6 +89,8 @@ class Program {
   void on_firing(std::function<void(const Firing&)> fn);
   /// @brief Condition evaluations so far (to see that conditions are not polled).
   [[nodiscard]] std::uint64_t condition_tests() const noexcept;
+  /// @brief (instance, property) pairs that some transition's last test read and that are watched now.
+  [[nodiscard]] std::size_t watched_properties() const noexcept;
   /// @brief Run-time errors of conditions so far (a failing condition counts as not enabled).
   [[nodiscard]] const std::vector<std::string>& condition_errors() const noexcept;
 
