@@ -17,6 +17,9 @@ PACKAGES=(
   # vsd::scene: URDF and mesh loading
   liburdfdom-dev
   libassimp-dev
+  # vsd::collision: FCL 0.7 (narrow and broad phase) and libccd (its GJK/EPA for convex pairs)
+  libfcl-dev
+  libccd-dev
   # tests and benchmarks
   libgtest-dev
   libgmock-dev
