@@ -319,14 +319,21 @@ struct CollisionWorld::Impl {
   void for_hulls_below(Id id, F&& fn) {
     auto* top = state.find<vsd::Node>(id);
     if (top == nullptr) return;
-    std::vector<vsd::Node*> todo{top};
-    while (!todo.empty()) {
-      vsd::Node* n = todo.back();
-      todo.pop_back();
+    if (top->children().empty()) {  // the common case, a moved hull: no walk
+      if (auto* h = top->as<Hull>()) fn(*h);
+      return;
+    }
+    // An explicit stack (trees may be deeper than the call stack), kept between calls.
+    const std::size_t base = walk.size();
+    walk.push_back(top);
+    while (walk.size() > base) {
+      vsd::Node* n = walk.back();
+      walk.pop_back();
       if (auto* h = n->as<Hull>()) fn(*h);
-      for (vsd::Node* c : n->children()) todo.push_back(c);
+      for (vsd::Node* c : n->children()) walk.push_back(c);
     }
   }
+  std::vector<vsd::Node*> walk;
 
   void sync() {
     ++sync_count;
