@@ -12,7 +12,7 @@ namespace vsd::collision {
 
 inline std::string describe_number(double v) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
+  std::snprintf(buf, sizeof buf, "%.6g", v + 0.0);  // + 0.0: no "-0"
   return buf;
 }
 
