@@ -567,20 +567,44 @@ DistanceResult CollisionWorld::distance(const scene::Hull& a, const scene::Hull&
   impl_->sync();
   Entry& ea = impl_->usable(a);
   Entry& eb = impl_->usable(b);
-  fcl::DistanceRequestd request(true, true);
+  // Unsigned distance with FCL's own GJK (exact for the primitives); overlapping pairs are measured by
+  // the collision query below. Not FCL's signed distance: for a pair its distance solver sees
+  // overlapping but its collision check finds no penetrating contact (touching or concentric shapes),
+  // FCL 0.7 asserts (index != -1 in distance-inl.h), or without assertions reads a contact that is not
+  // there. vsd-collide hit that with a sphere inside another sphere.
+  fcl::DistanceRequestd request(true, false);
   request.gjk_solver_type = fcl::GST_INDEP;
   fcl::DistanceResultd result;
+  DistanceResult r;
   try {
     fcl::distance(ea.object.get(), eb.object.get(), request, result);
+    r.distance = result.min_distance;
+    r.point_a = result.nearest_points[0];
+    r.point_b = result.nearest_points[1];
+    if (!(r.distance > 0)) {
+      // Overlapping or touching: minus the deepest penetration, at its contact point (which need not lie
+      // on either surface, as with FCL's signed distance).
+      fcl::CollisionRequestd creq(8, true);
+      fcl::CollisionResultd cres;
+      fcl::collide(ea.object.get(), eb.object.get(), creq, cres);
+      r.distance = 0;
+      if (cres.numContacts() > 0) {
+        std::size_t deepest = 0;
+        for (std::size_t i = 1; i < cres.numContacts(); ++i)
+          if (cres.getContact(i).penetration_depth > cres.getContact(deepest).penetration_depth) deepest = i;
+        r.distance = -std::max(0.0, cres.getContact(deepest).penetration_depth);
+        r.point_a = r.point_b = cres.getContact(deepest).pos;
+      }
+      if (!r.point_a.allFinite() || !r.point_b.allFinite()) {
+        // touching without a usable point: the midpoint of the two origins
+        r.point_a = r.point_b = (ea.object->getTranslation() + eb.object->getTranslation()) / 2;
+      }
+    }
   } catch (const std::exception& ex) {
     throw Error("collision: FCL failed on the distance of " + describe_pair(a, b) + ": " + ex.what());
   }
-  DistanceResult r;
-  r.distance = result.min_distance;
-  r.point_a = result.nearest_points[0];
-  r.point_b = result.nearest_points[1];
-  if (!std::isfinite(r.distance))
-    throw Error("collision: FCL returned a non-finite distance for " + describe_pair(a, b));
+  if (!std::isfinite(r.distance) || !r.point_a.allFinite() || !r.point_b.allFinite())
+    throw Error("collision: FCL returned a non-finite distance or nearest point for " + describe_pair(a, b));
   return r;
 }
 

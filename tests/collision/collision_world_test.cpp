@@ -146,7 +146,21 @@ TEST_F(CollisionTest, OverlappingHullsHaveANegativeDistance) {
   Hull& a = hull(sphere(1), at(0), "a");
   Hull& b = hull(sphere(1), at(1.5), "b");
   CollisionWorld w(s);
-  EXPECT_LT(w.distance(a, b).distance, 0);
+  EXPECT_NEAR(w.distance(a, b).distance, -0.5, 1e-6);
+  // A sphere inside another, concentric: FCL 0.7's signed distance asserts on this pair (found by
+  // vsd-collide under ASan); ours is finite and negative.
+  Hull& inner = hull(sphere(0.1), at(0), "inner");
+  DistanceResult d = w.distance(a, inner);
+  EXPECT_LT(d.distance, 0);
+  EXPECT_TRUE(d.point_a.allFinite() && d.point_b.allFinite());
+  // boxes exactly touching, and a box inside a box
+  Hull& p = hull(box(1, 1, 1), at(10), "p");
+  Hull& q = hull(box(1, 1, 1), at(11), "q");
+  Hull& r = hull(box(0.2, 0.2, 0.2), at(10), "r");
+  EXPECT_NEAR(w.distance(p, q).distance, 0, 1e-9);
+  EXPECT_LT(w.distance(p, r).distance, 0);
+  EXPECT_LE(w.distance(r, q).distance, 0.4 + 1e-6);
+  EXPECT_NEAR(w.distance(r, q).distance, 0.4, 1e-6);
 }
 
 // ---- contacts ------------------------------------------------------------------------------------------

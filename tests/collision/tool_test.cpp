@@ -63,6 +63,11 @@ TEST(CollideTool, OptionsSelectSameLinkPairsVisualHullsAndDistances) {
   EXPECT_TRUE(has(r.out, "contact block/body - gripper/look")) << r.out;
   EXPECT_FALSE(has(r.out, "gripper/finger - gripper/look")) << r.out;  // same link
 
+  // every pair, the concentric finger and look spheres included (FCL's signed distance asserts there)
+  r = run({file, "--visual", "--same-link", "--distances"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "distance gripper/look - gripper/finger: -0.55")) << r.out;
+
   r = run({file, "--distances"});
   ASSERT_EQ(r.code, 0) << r.err;
   // the finger's sphere (r 5 cm at 1.09 m) hangs 5 cm above the block's top face (0.99 m)

@@ -60,8 +60,8 @@ struct Contact {
 
 /// @brief The result of a distance query, in world coordinates.
 struct DistanceResult {
-  /// Distance between the surfaces; negative (minus the penetration depth, as far as FCL computes it)
-  /// when the hulls overlap.
+  /// Distance between the surfaces; when the hulls overlap, minus the deepest penetration depth, and
+  /// both points are that contact's point (which need not lie on either surface).
   double distance = 0;
   Eigen::Vector3d point_a = Eigen::Vector3d::Zero();  ///< nearest point on the first hull
   Eigen::Vector3d point_b = Eigen::Vector3d::Zero();  ///< nearest point on the second hull
