@@ -22,6 +22,9 @@ PACKAGES=(
   # vsd::dist: Cyclone DDS (C API) and its IDL compiler idlc
   cyclonedds-dev
   cyclonedds-tools
+  # vsd::collision: FCL 0.7 (narrow and broad phase) and libccd (its GJK/EPA for convex pairs)
+  libfcl-dev
+  libccd-dev
   # tests and benchmarks
   libgtest-dev
   libgmock-dev

@@ -50,6 +50,12 @@ Node3D* Node3D::frame_parent() const noexcept {
 void Node3D::invalidate_below(vsd::Node& node) {
   // Iterative: trees may be deeper than the stack. A dirty Node3D has only dirty Node3Ds below it (a clean
   // node's frame parent is always clean), so the walk stops there.
+  auto* top = node.as<Node3D>();
+  if (top != nullptr && !top->world_clean_) return;  // dirty already: so is everything below
+  if (node.children().empty()) {                     // a leaf (a moved hull): no walk
+    if (top != nullptr) top->world_clean_ = false;
+    return;
+  }
   std::vector<vsd::Node*> todo{&node};
   while (!todo.empty()) {
     vsd::Node* n = todo.back();
@@ -63,6 +69,18 @@ void Node3D::invalidate_below(vsd::Node& node) {
 }
 
 const Eigen::Isometry3d& Node3D::update_world_frame() const {
+  if (tracked_) {
+    // The common case after a move: the frame parent is clean (or there is none), so this node is the
+    // whole dirty chain; no chain to collect.
+    const Node3D* p = frame_parent();
+    if (p == nullptr || p->world_clean_) {
+      world_ = p != nullptr ? p->world_ * frame_ : frame_;
+      world_.makeAffine();
+      ++world_updates_;
+      world_clean_ = true;
+      return world_;
+    }
+  }
   // The dirty chain from this node up to the first clean ancestor (or the top), then top-down.
   std::vector<const Node3D*> chain;
   const Node3D* top_parent = nullptr;

@@ -103,6 +103,10 @@ class SimState : public Instance {
   void start_recording();
   /// @brief True while recording.
   [[nodiscard]] bool recording() const noexcept { return recording_; }
+  /// @brief True while a bundle is being applied (or the state torn down): listeners that derive
+  /// changes of their own from what they hear (e.g. vsd::scene::SpatialView) hold back, since the
+  /// bundle carries those changes already.
+  [[nodiscard]] bool applying() const noexcept { return applying_ > 0; }
   /// @brief The changes recorded so far; recording goes on with an empty bundle.
   Transaction take_recording();
   /// @brief Stops recording and returns what was recorded.

@@ -1,0 +1,22 @@
+/** @file
+ *  @brief The vsd-collide command-line tool as a library function (the executable is a thin main).
+ *
+ *  `vsd-collide FILE [--package-path DIR]... [--no-meshes] [--visual] [--same-link] [--distances]`
+ *  loads a URDF (.urdf, .xml) or a scene saved by vsd::io (.json, .vsds), builds a CollisionWorld over
+ *  its hulls and prints the pairs in contact (points, depth, normal), and with --distances the distance
+ *  between every pair of hulls. Hulls left out (degenerate geometry, a mesh that was not found) are
+ *  listed as warnings. Exit codes: 0 done, 1 the file could not be loaded, 2 usage error.
+ */
+#pragma once
+
+#include <iosfwd>
+#include <span>
+#include <string_view>
+
+namespace vsd::collision {
+
+/// @brief Runs the tool with @p args (without the program name), printing to @p out and @p err.
+/// @return the exit code.
+int run_tool(std::span<const std::string_view> args, std::ostream& out, std::ostream& err);
+
+}  // namespace vsd::collision

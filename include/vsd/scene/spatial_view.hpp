@@ -1,0 +1,108 @@
+/** @file
+ *  @brief SpatialView: nodes arranged by spatial relations ("lies on", "grabbed by", "attached to"),
+ *  independent of the spanning tree, and kept in force through the SimState's signals.
+ *
+ *  The spanning tree says who owns whom; where things are is often another matter. A cup lies on a
+ *  tray that lies on a table; a gripper grabs the tray and carries tray and cup away; it releases the
+ *  tray on a shelf. None of that needs the cup or the tray to change parents (which would change what
+ *  saving, deleting or replicating them means). A SpatialView holds these relations as a forest of its
+ *  own — every related object has one support — and keeps them in force:
+ *
+ *  - relate() and release() move nothing: the object's world pose is the same before and after, at the
+ *    moment of grabbing as at the moment of releasing. relate() remembers the object's pose relative to
+ *    its support;
+ *  - when a support moves in the world (its own `frame` changed, an ancestor's, or it was re-parented),
+ *    the objects it carries are moved through Node3D::set_world_frame, so every listener (collision,
+ *    rendering, a recording transaction) sees them move, and what they carry follows in turn;
+ *  - when an object is moved by anyone else (placed, pushed, simulated), it stays related and its pose
+ *    relative to the support is taken over: a cup pushed across a tray still lies on it.
+ *
+ *  While a bundle is applied (undo, a replica's changes) the view holds back: the bundle carries the moves
+ *  it made at the source already; the poses the bundle leaves become the new relative poses.
+ *
+ *  Nothing polls: the view listens to Node3D frame changes, re-parentings and deletions of its SimState.
+ *  Each change costs O(relations × tree depth) while the view holds relations and one branch when it
+ *  holds none. An object or support that is deleted leaves the view (on_removed()). The view is a
+ *  Container: its nodes are the related objects, supports before what they carry.
+ *  The view must not outlive its SimState and belongs to its thread.
+ */
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "vsd/core/container.hpp"
+#include "vsd/core/meta_type.hpp"
+#include "vsd/scene/namespace.hpp"
+
+namespace vsd {
+class SimState;
+}
+
+namespace vsd::scene {
+
+class Node3D;
+
+/// @brief How an object relates to its support (all of them mean "moves with it" to the view; the kind
+/// tells applications what it means: a gripper releases what it grabbed, not what lies on it).
+enum class SpatialRelation : std::uint8_t {
+  LiesOn,     ///< resting on the support (a cup on a table)
+  GrabbedBy,  ///< held by a gripper or a hand
+  AttachedTo  ///< fixed to the support (a sensor on a vehicle)
+};
+VSD_ENUM(SpatialRelation, LiesOn, GrabbedBy, AttachedTo)
+
+class SpatialView : public vsd::Container {
+ public:
+  /// @brief An empty view of the Node3Ds of @p state.
+  explicit SpatialView(SimState& state);
+  ~SpatialView() override;
+
+  /// @brief From now on @p object moves with @p support (replacing a relation it had). Nothing moves.
+  /// @throws vsd::Error when either node belongs to another SimState, when they are the same node, when
+  /// @p support is carried by @p object (directly or through others) or lies below it in the spanning
+  /// tree (the object would have to follow its own motion), or when a world pose is not finite.
+  void relate(Node3D& object, Node3D& support, SpatialRelation relation);
+  /// @brief Ends @p object's relation; it stays where it is. Returns false when it had none.
+  bool release(Node3D& object);
+
+  /// @brief The support of @p object, or nullptr.
+  [[nodiscard]] Node3D* support_of(const Node3D& object) const;
+  /// @brief The relation of @p object to its support, if it has one.
+  [[nodiscard]] std::optional<SpatialRelation> relation_of(const Node3D& object) const;
+  /// @brief @p object's pose in its support's frame, if it has a support.
+  [[nodiscard]] std::optional<Eigen::Isometry3d> offset_of(const Node3D& object) const;
+  /// @brief The objects @p support carries directly, by id.
+  [[nodiscard]] std::vector<Node3D*> carried_by(const Node3D& support) const;
+  /// @brief Everything that moves with @p support through the view (carried directly or indirectly),
+  /// supports before what they carry.
+  [[nodiscard]] std::vector<Node3D*> carried_closure(const Node3D& support) const;
+
+  [[nodiscard]] std::size_t size() const override { return relations_.size(); }
+  [[nodiscard]] bool contains(const vsd::Node& n) const override;
+  /// @brief The related objects, depth first through the relation forest (roots by id).
+  void for_each(const std::function<void(vsd::Node&)>& fn) const override;
+
+ private:
+  struct Relation {
+    Node3D* support;
+    SpatialRelation kind;
+    Eigen::Isometry3d offset;  // object's world pose in the support's frame
+  };
+
+  void on_moved(vsd::Node& node);
+  void refresh_offsets() const;
+  void drop(vsd::Node& node);
+
+  SimState& state_;
+  mutable std::unordered_map<Node3D*, Relation> relations_;  // by object
+  mutable bool stale_ = false;  // a bundle moved things: offsets are recomputed from the poses
+  std::vector<Connection> connections_;
+  int enforcing_ = 0;  // > 0 while the view itself moves objects
+};
+
+}  // namespace vsd::scene
