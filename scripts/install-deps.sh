@@ -17,6 +17,9 @@ PACKAGES=(
   # vsd::scene: URDF and mesh loading
   liburdfdom-dev
   libassimp-dev
+  # vsd::robotics: Orocos KDL, the independent library its tests and benchmarks compare against (not a
+  # dependency of the module itself)
+  liborocos-kdl-dev
   # tests and benchmarks
   libgtest-dev
   libgmock-dev
