@@ -12,6 +12,7 @@
  */
 #pragma once
 
+#include <cstdint>
 #include <string_view>
 
 #include "vsd/core/module.hpp"
@@ -23,8 +24,15 @@ class Module : public vsd::Module {
   [[nodiscard]] std::string_view name() const override { return "robotics"; }
   /// @brief Registers KinematicJoint, KinematicTree, the controllers and their enums.
   void register_types(vsd::Registry& registry) override;
-  /// @brief Uses vsd::scene::Module and tracks every SimState the environment has now.
+  /// @brief Uses vsd::scene::Module, tracks every SimState the environment has now, and adds the periodic
+  /// task "robotics control" (every base step, priority 10) that steps every JointController of every
+  /// SimState of the environment.
   void attach(vsd::Environment& env) override;
+  /// @brief Removes the control task.
+  void detach(vsd::Environment& env) override;
+
+ private:
+  std::uint32_t control_task_ = 0;
 };
 
 }  // namespace vsd::robotics
