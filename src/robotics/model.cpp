@@ -254,6 +254,8 @@ Model::Data Model::make_data() const {
   Data d;
   d.segment.resize(segments_.size());
   d.value.resize(segments_.size());
+  d.sine.resize(segments_.size());
+  d.cosine.resize(segments_.size());
   return d;
 }
 
@@ -261,78 +263,97 @@ void Model::forward(std::span<const double> q, Data& data) const {
   if (q.size() != layout_.size())
     fail("joint vector has " + std::to_string(q.size()) + " values; the model has " +
          std::to_string(layout_.size()));
-  if (data.segment.size() != segments_.size()) data = make_data();
+  if (data.segment.size() != segments_.size() || data.sine.size() != segments_.size()) data = make_data();
   forward(q.data(), data);
 }
 
 void Model::forward(const double* q, Data& data) const noexcept {
+  // Plain scalar arithmetic on the column-major arrays: for 3x3 matrices it schedules better than
+  // Eigen's SSE2 packets, which do not fit rows of three.
   const std::size_t n = segments_.size();
   Frame* out = data.segment.data();
   double* values = data.value.data();
+  double* sines = data.sine.data();
+  double* cosines = data.cosine.data();
+  // Values and their sines and cosines first: independent of each other, so the processor overlaps
+  // them (one after the other inside the frame recursion they would be a chain of latencies).
   for (std::size_t i = 0; i < n; ++i) {
     const Segment& s = segments_[i];
-    Frame& f = out[i];
-    if (s.parent < 0) {
-      f = s.pre;
-    } else {
-      const Frame& p = out[s.parent];
-      if (s.pre_identity) {
-        f = p;
-      } else {
-        f.rotation.noalias() = p.rotation * s.pre.rotation;
-        f.translation.noalias() = p.rotation * s.pre.translation;
-        f.translation += p.translation;
-      }
-    }
     const double v = s.dof >= 0 ? s.multiplier * q[s.dof] + s.offset : 0.0;
     values[i] = v;
+  }
+  detail::sincos_batch(values, sines, cosines, n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Segment& s = segments_[i];
+    double* r = out[i].rotation.data();  // r[c * 3 + row]
+    double* t = out[i].translation.data();
+    const double v = values[i];
+    // Rotation of the frame after pre, times the joint's motion, in local (pre) coordinates first.
+    double a[9];  // pre rotation * motion rotation, column-major
+    const double* pr = s.pre.rotation.data();
+    const double sn = sines[i], cs = cosines[i];
     switch (s.motion) {
-      case Motion::None:
+      case Motion::RotX:
+        for (int k = 0; k < 3; ++k) {
+          a[k] = pr[k];
+          a[3 + k] = cs * pr[3 + k] + sn * pr[6 + k];
+          a[6 + k] = cs * pr[6 + k] - sn * pr[3 + k];
+        }
         break;
-      case Motion::RotX: {
-        double sn, cs;
-        detail::sincos(v, sn, cs);
-        const Eigen::Vector3d c1 = f.rotation.col(1), c2 = f.rotation.col(2);
-        f.rotation.col(1) = cs * c1 + sn * c2;
-        f.rotation.col(2) = cs * c2 - sn * c1;
+      case Motion::RotY:
+        for (int k = 0; k < 3; ++k) {
+          a[k] = cs * pr[k] - sn * pr[6 + k];
+          a[3 + k] = pr[3 + k];
+          a[6 + k] = sn * pr[k] + cs * pr[6 + k];
+        }
         break;
-      }
-      case Motion::RotY: {
-        double sn, cs;
-        detail::sincos(v, sn, cs);
-        const Eigen::Vector3d c0 = f.rotation.col(0), c2 = f.rotation.col(2);
-        f.rotation.col(0) = cs * c0 - sn * c2;
-        f.rotation.col(2) = sn * c0 + cs * c2;
+      case Motion::RotZ:
+        for (int k = 0; k < 3; ++k) {
+          a[k] = cs * pr[k] + sn * pr[3 + k];
+          a[3 + k] = cs * pr[3 + k] - sn * pr[k];
+          a[6 + k] = pr[6 + k];
+        }
         break;
-      }
-      case Motion::RotZ: {
-        double sn, cs;
-        detail::sincos(v, sn, cs);
-        const Eigen::Vector3d c0 = f.rotation.col(0), c1 = f.rotation.col(1);
-        f.rotation.col(0) = cs * c0 + sn * c1;
-        f.rotation.col(1) = cs * c1 - sn * c0;
-        break;
-      }
       case Motion::Rot: {
-        double sn, cs;
-        detail::sincos(v, sn, cs);
-        const Eigen::Vector3d& a = s.axis;
+        const Eigen::Vector3d& ax = s.axis;
         Eigen::Matrix3d k;
-        k << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
-        const Eigen::Matrix3d r =
-            Eigen::Matrix3d::Identity() * cs + sn * k + (1.0 - cs) * (a * a.transpose());
-        const Eigen::Matrix3d m = f.rotation * r;
-        f.rotation = m;
+        k << 0, -ax.z(), ax.y(), ax.z(), 0, -ax.x(), -ax.y(), ax.x(), 0;
+        const Eigen::Matrix3d m =
+            s.pre.rotation * (Eigen::Matrix3d::Identity() * cs + sn * k + (1.0 - cs) * (ax * ax.transpose()));
+        for (int k2 = 0; k2 < 9; ++k2) a[k2] = m.data()[k2];
         break;
       }
-      case Motion::Trans:
-        f.translation.noalias() += f.rotation * (s.axis * v);
+      default:
+        for (int k = 0; k < 9; ++k) a[k] = pr[k];
         break;
     }
+    // Local translation: pre.p (+ pre.R axis v for a prismatic joint).
+    double lt[3] = {s.pre.translation[0], s.pre.translation[1], s.pre.translation[2]};
+    if (s.motion == Motion::Trans) {
+      for (int k = 0; k < 3; ++k)
+        lt[k] += v * (pr[k] * s.axis[0] + pr[3 + k] * s.axis[1] + pr[6 + k] * s.axis[2]);
+    }
     if (!s.post_identity) {
-      f.translation.noalias() += f.rotation * s.post.translation;
-      const Eigen::Matrix3d m = f.rotation * s.post.rotation;
-      f.rotation = m;
+      // lt += a * post.p; a = a * post.R
+      const double* pp = s.post.translation.data();
+      const double* po = s.post.rotation.data();
+      for (int k = 0; k < 3; ++k) lt[k] += a[k] * pp[0] + a[3 + k] * pp[1] + a[6 + k] * pp[2];
+      double b[9];
+      for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 3; ++k)
+          b[c * 3 + k] = a[k] * po[c * 3] + a[3 + k] * po[c * 3 + 1] + a[6 + k] * po[c * 3 + 2];
+      for (int k = 0; k < 9; ++k) a[k] = b[k];
+    }
+    if (s.parent < 0) {
+      for (int k = 0; k < 9; ++k) r[k] = a[k];
+      for (int k = 0; k < 3; ++k) t[k] = lt[k];
+    } else {
+      const double* pr2 = out[s.parent].rotation.data();
+      const double* pt = out[s.parent].translation.data();
+      for (int k = 0; k < 3; ++k) t[k] = pt[k] + pr2[k] * lt[0] + pr2[3 + k] * lt[1] + pr2[6 + k] * lt[2];
+      for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 3; ++k)
+          r[c * 3 + k] = pr2[k] * a[c * 3] + pr2[3 + k] * a[c * 3 + 1] + pr2[6 + k] * a[c * 3 + 2];
     }
   }
 }

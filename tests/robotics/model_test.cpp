@@ -369,6 +369,19 @@ TEST(SinCos, MatchesTheLibrary) {
     ASSERT_NEAR(s, std::sin(x), 4e-16) << x;
     ASSERT_NEAR(c, std::cos(x), 4e-16) << x;
   }
+  // The batch form gives the same values, and falls back to the library for large arguments.
+  std::vector<double> xs, ss(1000), cs(1000);
+  for (int i = 0; i < 1000; ++i) xs.push_back(std::uniform_real_distribution<double>(-20, 20)(rng));
+  robotics::detail::sincos_batch(xs.data(), ss.data(), cs.data(), xs.size());
+  for (std::size_t i = 0; i < xs.size(); ++i) {
+    double s1, c1;
+    robotics::detail::sincos(xs[i], s1, c1);
+    ASSERT_EQ(ss[i], s1) << xs[i];
+    ASSERT_EQ(cs[i], c1) << xs[i];
+  }
+  xs[7] = 2e5;
+  robotics::detail::sincos_batch(xs.data(), ss.data(), cs.data(), xs.size());
+  EXPECT_EQ(ss[7], std::sin(2e5));
   double s, c;
   robotics::detail::sincos(1e6, s, c);
   EXPECT_EQ(s, std::sin(1e6));

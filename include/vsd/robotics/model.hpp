@@ -83,8 +83,9 @@ class Model {
  public:
   /// @brief Per-evaluation results, kept apart from the model: one per thread.
   struct Data {
-    std::vector<Frame> segment;  ///< frame of every segment in the base frame
-    std::vector<double> value;   ///< value of every segment's joint (mimics applied)
+    std::vector<Frame> segment;        ///< frame of every segment in the base frame
+    std::vector<double> value;         ///< value of every segment's joint (mimics applied)
+    std::vector<double> sine, cosine;  ///< of every segment's value (scratch of forward())
   };
 
   /// @brief Compiles the tree below @p base (every descendant Node3D; a node without a KinematicJoint is
