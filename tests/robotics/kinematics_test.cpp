@@ -194,6 +194,24 @@ TEST(Kinematics, SavedAndLoadedLikeAnyContent) {
   EXPECT_DOUBLE_EQ(j3->position(), -0.4);
 }
 
+TEST(Kinematics, ReplicatedThroughTransactions) {
+  Robot r("ur5_robot.urdf");
+  SimState& replica = r.env.create_state("replica");
+  replica.copy_from(r.env.main_state());
+  track(replica);
+  r.env.main_state().start_recording();
+  r.tree->set_positions(std::vector<double>{0.1, -0.2, 0.3, -0.4, 0.5, -0.6});
+  replica.apply(r.env.main_state().stop_recording());
+  auto trees = replica.index().of<KinematicTree>();
+  ASSERT_EQ(trees.size(), 1u);
+  EXPECT_EQ(trees[0]->positions(), (std::vector<double>{0.1, -0.2, 0.3, -0.4, 0.5, -0.6}));
+  auto* wrist = static_cast<scene::Node3D*>(trees[0]->find_joint("wrist_3_joint")->owner());
+  EXPECT_TRUE(wrist->world_frame().isApprox(r.link("wrist_3_link").world_frame(), 1e-12));
+  // The replica is as active as its source: its own joint values move its links.
+  trees[0]->find_joint("wrist_3_joint")->set_position(1.0);
+  EXPECT_TRUE(wrist->frame().isApprox(trees[0]->find_joint("wrist_3_joint")->motion_frame()));
+}
+
 TEST(Kinematics, SceneJointWithoutChildIsAnError) {
   Environment env;
   env.use<Module>();
