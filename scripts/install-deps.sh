@@ -25,6 +25,9 @@ PACKAGES=(
   # vsd::collision: FCL 0.7 (narrow and broad phase) and libccd (its GJK/EPA for convex pairs)
   libfcl-dev
   libccd-dev
+  # vsd::robotics: Orocos KDL, the independent library its tests and benchmarks compare against (not a
+  # dependency of the module itself)
+  liborocos-kdl-dev
   # tests and benchmarks
   libgtest-dev
   libgmock-dev

@@ -1,0 +1,154 @@
+/** @file
+ *  @brief Model: a kinematic tree or chain compiled into flat arrays, apart from the per-step Data —
+ *  forward kinematics of every body, the geometric Jacobian of any body.
+ *
+ *  The joint-vector layout is explicit: `layout()` lists the model's independent values (degrees of
+ *  freedom) in order. A rotary or prismatic joint contributes one value, a universal joint two (named
+ *  "<joint>" and "<joint>#2"), a fixed joint none, and a mimic joint none either: its value is
+ *  `multiplier * q[master] + offset`, and its motion adds `multiplier` times its own column to the
+ *  master's Jacobian column. Joints appear in depth-first order from the base (for a chain: base to tip).
+ *
+ *  A Model is a value: compile it from the database (KinematicTree::model() does so and recompiles only
+ *  when the topology changes), keep one Data per thread or per evaluation, and call forward(), then
+ *  pose()/jacobian(). Nothing here touches the database.
+ */
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vsd/robotics/joint.hpp"
+
+namespace vsd::scene {
+class Node3D;
+}
+
+namespace vsd::robotics {
+
+/// @brief A rigid transform as rotation matrix and translation (what the compiled model computes with).
+struct Frame {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  /// @brief As an Eigen isometry.
+  [[nodiscard]] Eigen::Isometry3d isometry() const {
+    Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
+    f.linear() = rotation;
+    f.translation() = translation;
+    return f;
+  }
+  /// @brief From an Eigen isometry.
+  static Frame from(const Eigen::Isometry3d& f) { return Frame{f.linear(), f.translation()}; }
+};
+
+/// @brief One entry of the joint-vector layout.
+struct DofInfo {
+  std::string name;  ///< joint name ("<joint>#2" for the second value of a universal joint)
+  KinematicJointType type = KinematicJointType::Rotary;
+  bool has_limits = false;
+  double lower = 0.0;
+  double upper = 0.0;
+  double velocity_limit = 0.0;      ///< 0: not given
+  double acceleration_limit = 0.0;  ///< 0: not given
+  /// The database joint it comes from (null for a Model built from data); valid while the joint lives.
+  const KinematicJoint* joint = nullptr;
+  /// 0, or 1 for the second value of a universal joint.
+  int axis_index = 0;
+};
+
+/// @brief A joint of a Model built from data (not from the database): a body attached to a parent body.
+struct JointSpec {
+  std::string name;  ///< the joint's name (layout entries are named after it)
+  std::string body;  ///< the name of the body it moves (the child)
+  int parent = -1;   ///< the parent body's index (-1: the base)
+  KinematicJointType type = KinematicJointType::Rotary;
+  JointPlacement placement;                          ///< pre, post, axis
+  Eigen::Vector3d axis2 = Eigen::Vector3d::UnitY();  ///< universal joints
+  bool has_limits = false;
+  double lower = 0.0, upper = 0.0, velocity_limit = 0.0, acceleration_limit = 0.0;
+  int mimic = -1;  ///< index (in the spec list) of the joint it mimics, or -1
+  double mimic_multiplier = 1.0, mimic_offset = 0.0;
+  /// True: the joint contributes its values to the layout but has no body (the master of a mimic joint
+  /// that is not on a compiled chain).
+  bool value_only = false;
+  /// The database joint it comes from, when compiled from the database.
+  const KinematicJoint* source = nullptr;
+};
+
+class Model {
+ public:
+  /// @brief Per-evaluation results, kept apart from the model: one per thread.
+  struct Data {
+    std::vector<Frame> segment;        ///< frame of every segment in the base frame
+    std::vector<double> value;         ///< value of every segment's joint (mimics applied)
+    std::vector<double> sine, cosine;  ///< of every segment's value (scratch of forward())
+  };
+
+  /// @brief Compiles the tree below @p base (every descendant Node3D; a node without a KinematicJoint is
+  /// fixed at its `frame`), or, with @p tip, only the chain from @p base down to @p tip.
+  /// @throws vsd::Error when @p tip is not below @p base, or a joint is malformed (zero axis, lower > upper,
+  /// a DH universal joint, a mimic cycle).
+  static Model compile(const scene::Node3D& base, const scene::Node3D* tip = nullptr);
+  /// @brief Builds a model from plain data (bodies in order; a parent precedes its children).
+  /// @throws vsd::Error as compile() does, and for a parent index out of range.
+  static Model build(std::span<const JointSpec> joints);
+
+  /// @brief Number of independent joint values.
+  [[nodiscard]] int dof() const noexcept { return static_cast<int>(layout_.size()); }
+  /// @brief The joint-vector layout (see the file comment).
+  [[nodiscard]] std::span<const DofInfo> layout() const noexcept { return layout_; }
+  /// @brief Number of bodies (every node of the tree or chain below the base).
+  [[nodiscard]] int body_count() const noexcept { return static_cast<int>(body_segment_.size()); }
+  /// @brief Name of body @p i.
+  [[nodiscard]] const std::string& body_name(int i) const {
+    return body_name_.at(static_cast<std::size_t>(i));
+  }
+  /// @brief Index of the body named @p name, or -1.
+  [[nodiscard]] int find_body(std::string_view name) const noexcept;
+  /// @brief Index of the last body (the tip of a chain).
+  [[nodiscard]] int tip() const noexcept { return body_count() - 1; }
+
+  /// @brief A Data sized for this model.
+  [[nodiscard]] Data make_data() const;
+  /// @brief Forward kinematics of every body for joint vector @p q (dof() values, layout order).
+  void forward(const double* q, Data& data) const noexcept;
+  /// @brief Forward kinematics; @throws vsd::Error when @p q does not have dof() values.
+  void forward(std::span<const double> q, Data& data) const;
+  /// @brief Pose of body @p body in the base frame (after forward()).
+  [[nodiscard]] const Frame& pose(const Data& data, int body) const noexcept {
+    return data.segment[static_cast<std::size_t>(body_segment_[static_cast<std::size_t>(body)])];
+  }
+  /// @brief Geometric Jacobian of body @p body's origin in the base frame (after forward()): 6 x dof(),
+  /// linear velocity rows first, then angular. Columns of joints not on the body's path are zero.
+  void jacobian(const Data& data, int body,
+                Eigen::Ref<Eigen::Matrix<double, 6, Eigen::Dynamic>> out) const noexcept;
+  /// @brief Clamps @p q into the joint limits.
+  void clamp(double* q) const noexcept;
+
+ private:
+  enum class Motion : std::uint8_t { None, RotX, RotY, RotZ, Rot, Trans };
+  struct Segment {
+    Frame pre;
+    Frame post;
+    Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+    Eigen::Vector3d axis_post =
+        Eigen::Vector3d::UnitZ();  // post.R^T axis: the axis seen from the segment frame
+    Eigen::Vector3d origin_post = Eigen::Vector3d::Zero();  // -post.R^T post.p: the joint origin, likewise
+    int parent = -1;                                        // segment index, -1: base
+    int dof = -1;  // layout index of the value that drives it, -1: none
+    double multiplier = 1.0, offset = 0.0;
+    Motion motion = Motion::None;
+    bool pre_identity = false;
+    bool post_identity = true;
+  };
+  std::vector<Segment> segments_;
+  std::vector<DofInfo> layout_;
+  std::vector<int> body_segment_;
+  std::vector<std::string> body_name_;
+};
+
+}  // namespace vsd::robotics

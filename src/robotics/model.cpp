@@ -1,0 +1,387 @@
+// The compiled kinematic model: build from specs (or from the database), FK of all segments, Jacobians.
+#include "vsd/robotics/model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include "vsd/core/error.hpp"
+#include "vsd/robotics/detail/sincos.hpp"
+#include "vsd/scene/node3d.hpp"
+
+namespace vsd::robotics {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& msg) { throw vsd::Error(msg); }
+
+bool is_identity(const Frame& f) { return f.rotation.isIdentity(0.0) && f.translation.isZero(0.0); }
+
+// Follows the mimic relation of spec @p i to a joint that mimics nobody; composes multiplier and offset.
+struct Resolved {
+  int master = -1;
+  double multiplier = 1.0;
+  double offset = 0.0;
+};
+Resolved resolve_mimic(std::span<const JointSpec> specs, int i) {
+  Resolved r{i, 1.0, 0.0};
+  std::size_t steps = 0;
+  while (specs[static_cast<std::size_t>(r.master)].mimic >= 0) {
+    const JointSpec& s = specs[static_cast<std::size_t>(r.master)];
+    if (s.mimic >= static_cast<int>(specs.size()))
+      fail("joint '" + s.name + "': mimics joint index " + std::to_string(s.mimic) + ", out of range");
+    // q_s = m * q_master + o, and q_i = r.multiplier * q_s + r.offset.
+    r.offset += r.multiplier * s.mimic_offset;
+    r.multiplier *= s.mimic_multiplier;
+    r.master = s.mimic;
+    if (++steps > specs.size()) fail("joint '" + specs[static_cast<std::size_t>(i)].name + "': mimic cycle");
+  }
+  return r;
+}
+
+}  // namespace
+
+Model Model::build(std::span<const JointSpec> specs) {
+  Model m;
+  const int n = static_cast<int>(specs.size());
+  // Validation first: nothing half built escapes.
+  std::vector<int> spec_body(specs.size(), -1);
+  int bodies = 0;
+  for (int i = 0; i < n; ++i) {
+    const JointSpec& s = specs[static_cast<std::size_t>(i)];
+    if (s.value_only) continue;
+    if (s.parent < -1 || s.parent >= bodies)
+      fail("joint '" + s.name + "': parent body index " + std::to_string(s.parent) +
+           " is not an earlier body (there are " + std::to_string(bodies) + ")");
+    spec_body[static_cast<std::size_t>(i)] = bodies++;
+    if (s.type != KinematicJointType::Fixed && !(s.placement.axis.norm() > 1e-12))
+      fail("joint '" + s.name + "': zero axis");
+    if (s.type == KinematicJointType::Universal && !(s.axis2.norm() > 1e-12))
+      fail("joint '" + s.name + "': zero second axis");
+    if (s.has_limits && !(s.lower <= s.upper))
+      fail("joint '" + s.name + "': lower limit " + std::to_string(s.lower) + " above upper limit " +
+           std::to_string(s.upper));
+    if (s.mimic >= 0 && s.type == KinematicJointType::Universal)
+      fail("joint '" + s.name + "': a universal joint cannot mimic another");
+  }
+  // Layout: the values of every joint that mimics nobody, in order.
+  std::vector<int> first_dof(specs.size(), -1);
+  for (int i = 0; i < n; ++i) {
+    const JointSpec& s = specs[static_cast<std::size_t>(i)];
+    if (s.type == KinematicJointType::Fixed || s.mimic >= 0) continue;
+    first_dof[static_cast<std::size_t>(i)] = static_cast<int>(m.layout_.size());
+    const int count = s.type == KinematicJointType::Universal ? 2 : 1;
+    for (int k = 0; k < count; ++k) {
+      DofInfo d;
+      d.name = k == 0 ? s.name : s.name + "#2";
+      d.type = s.type == KinematicJointType::Universal ? KinematicJointType::Rotary : s.type;
+      d.has_limits = s.has_limits;
+      d.lower = s.lower;
+      d.upper = s.upper;
+      d.velocity_limit = s.velocity_limit;
+      d.acceleration_limit = s.acceleration_limit;
+      d.joint = s.source;
+      d.axis_index = k;
+      m.layout_.push_back(std::move(d));
+    }
+  }
+  // Segments: one per body (a universal joint adds one in front for its first axis).
+  std::vector<int> body_seg;
+  for (int i = 0; i < n; ++i) {
+    const JointSpec& s = specs[static_cast<std::size_t>(i)];
+    if (s.value_only) continue;
+    const int parent_seg = s.parent < 0 ? -1 : body_seg[static_cast<std::size_t>(s.parent)];
+    auto motion_of = [](KinematicJointType t, const Eigen::Vector3d& a) {
+      if (t == KinematicJointType::Fixed) return Motion::None;
+      if (t == KinematicJointType::Prismatic) return Motion::Trans;
+      if (a == Eigen::Vector3d::UnitX()) return Motion::RotX;
+      if (a == Eigen::Vector3d::UnitY()) return Motion::RotY;
+      if (a == Eigen::Vector3d::UnitZ()) return Motion::RotZ;
+      return Motion::Rot;
+    };
+    Segment seg;
+    seg.parent = parent_seg;
+    seg.pre = Frame::from(s.placement.pre);
+    seg.post = Frame::from(s.placement.post);
+    seg.axis = s.type == KinematicJointType::Fixed ? Eigen::Vector3d::UnitZ() : s.placement.axis.normalized();
+    seg.motion = motion_of(s.type, seg.axis);
+    if (s.type != KinematicJointType::Fixed) {
+      if (s.mimic >= 0) {
+        const Resolved r = resolve_mimic(specs, i);
+        const JointSpec& master = specs[static_cast<std::size_t>(r.master)];
+        if (master.type == KinematicJointType::Fixed)
+          fail("joint '" + s.name + "': mimics fixed joint '" + master.name + "'");
+        seg.dof = first_dof[static_cast<std::size_t>(r.master)];
+        seg.multiplier = r.multiplier;
+        seg.offset = r.offset;
+      } else {
+        seg.dof = first_dof[static_cast<std::size_t>(i)];
+      }
+    }
+    if (s.type == KinematicJointType::Universal) {
+      Segment second;
+      second.post = seg.post;
+      second.axis = s.axis2.normalized();
+      second.motion = motion_of(KinematicJointType::Rotary, second.axis);
+      second.dof = seg.dof + 1;
+      seg.post = Frame{};
+      m.segments_.push_back(seg);
+      second.parent = static_cast<int>(m.segments_.size()) - 1;
+      m.segments_.push_back(second);
+    } else {
+      m.segments_.push_back(seg);
+    }
+    body_seg.push_back(static_cast<int>(m.segments_.size()) - 1);
+    m.body_name_.push_back(s.body);
+  }
+  for (Segment& seg : m.segments_) {
+    seg.pre_identity = is_identity(seg.pre);
+    seg.post_identity = is_identity(seg.post);
+    seg.axis_post = seg.post.rotation.transpose() * seg.axis;
+    seg.origin_post = -(seg.post.rotation.transpose() * seg.post.translation);
+  }
+  m.body_segment_ = std::move(body_seg);
+  return m;
+}
+
+Model Model::compile(const scene::Node3D& base, const scene::Node3D* tip) {
+  std::vector<const scene::Node3D*> nodes;
+  std::vector<int> parents;
+  std::unordered_map<const scene::Node3D*, int> index;
+  if (tip != nullptr) {
+    std::vector<const scene::Node3D*> up;
+    const scene::Node3D* n = tip;
+    for (; n != nullptr && n != &base; n = n->frame_parent()) up.push_back(n);
+    if (n == nullptr) fail("node '" + tip->name() + "' is not below '" + base.name() + "'");
+    for (auto it = up.rbegin(); it != up.rend(); ++it) {
+      parents.push_back(static_cast<int>(nodes.size()) - 1);
+      nodes.push_back(*it);
+    }
+  } else {
+    // Depth first; plain Nodes in between are transparent, as for frames.
+    struct Item {
+      const vsd::Node* node;
+      int parent;
+    };
+    std::vector<Item> todo;
+    auto push_children = [&todo](const vsd::Node& n, int parent) {
+      const auto& ch = n.children();
+      for (std::size_t k = ch.size(); k-- > 0;) todo.push_back(Item{ch[k], parent});
+    };
+    push_children(base, -1);
+    while (!todo.empty()) {
+      const Item item = todo.back();
+      todo.pop_back();
+      int here = item.parent;
+      if (const auto* n3 = item.node->as<scene::Node3D>()) {
+        here = static_cast<int>(nodes.size());
+        nodes.push_back(n3);
+        parents.push_back(item.parent);
+      }
+      push_children(*item.node, here);
+    }
+  }
+  for (std::size_t i = 0; i < nodes.size(); ++i) index[nodes[i]] = static_cast<int>(i);
+
+  std::vector<JointSpec> specs;
+  specs.reserve(nodes.size());
+  std::unordered_map<const KinematicJoint*, int> spec_of;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    JointSpec s;
+    s.body = nodes[i]->name();
+    s.parent = parents[i];
+    const KinematicJoint* j = nodes[i]->find_extension<KinematicJoint>();
+    if (j == nullptr) {
+      s.name = nodes[i]->name();
+      s.type = KinematicJointType::Fixed;
+      s.placement.pre = nodes[i]->frame();
+    } else {
+      s.name = j->name().empty() ? nodes[i]->name() : j->name();
+      s.type = j->type();
+      if (j->dh() != DhConvention::None && j->type() == KinematicJointType::Universal)
+        fail("joint '" + s.name + "': a universal joint cannot be given by DH parameters");
+      s.placement = j->placement();
+      s.axis2 = j->axis2();
+      s.has_limits = j->has_limits();
+      s.lower = j->lower();
+      s.upper = j->upper();
+      s.velocity_limit = j->velocity_limit();
+      s.acceleration_limit = j->acceleration_limit();
+      s.mimic_multiplier = j->mimic_multiplier();
+      s.mimic_offset = j->mimic_offset();
+      s.source = j;
+      spec_of[j] = static_cast<int>(i);
+    }
+    specs.push_back(std::move(s));
+  }
+  // Mimic relations; a master outside the compiled part still drives its followers (a value-only entry).
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const KinematicJoint* j = specs[i].source;
+    if (j == nullptr || j->mimic().get() == nullptr) continue;
+    const KinematicJoint* master = j->mimic().get();
+    auto it = spec_of.find(master);
+    if (it == spec_of.end()) {
+      JointSpec v;
+      v.name = master->name();
+      v.type = master->type();
+      v.placement.axis = Eigen::Vector3d::UnitZ();
+      v.has_limits = master->has_limits();
+      v.lower = master->lower();
+      v.upper = master->upper();
+      v.velocity_limit = master->velocity_limit();
+      v.acceleration_limit = master->acceleration_limit();
+      v.value_only = true;
+      v.source = master;
+      if (master->mimic().get() != nullptr)
+        fail("joint '" + j->name() + "': mimics '" + master->name() +
+             "', which is outside the compiled chain and mimics another joint itself");
+      specs.push_back(std::move(v));
+      it = spec_of.emplace(master, static_cast<int>(specs.size()) - 1).first;
+    }
+    specs[i].mimic = it->second;
+  }
+  return build(specs);
+}
+
+int Model::find_body(std::string_view name) const noexcept {
+  for (std::size_t i = 0; i < body_name_.size(); ++i)
+    if (body_name_[i] == name) return static_cast<int>(i);
+  return -1;
+}
+
+Model::Data Model::make_data() const {
+  Data d;
+  d.segment.resize(segments_.size());
+  d.value.resize(segments_.size());
+  d.sine.resize(segments_.size());
+  d.cosine.resize(segments_.size());
+  return d;
+}
+
+void Model::forward(std::span<const double> q, Data& data) const {
+  if (q.size() != layout_.size())
+    fail("joint vector has " + std::to_string(q.size()) + " values; the model has " +
+         std::to_string(layout_.size()));
+  if (data.segment.size() != segments_.size() || data.sine.size() != segments_.size()) data = make_data();
+  forward(q.data(), data);
+}
+
+void Model::forward(const double* q, Data& data) const noexcept {
+  // Plain scalar arithmetic on the column-major arrays: for 3x3 matrices it schedules better than
+  // Eigen's SSE2 packets, which do not fit rows of three.
+  const std::size_t n = segments_.size();
+  Frame* out = data.segment.data();
+  double* values = data.value.data();
+  double* sines = data.sine.data();
+  double* cosines = data.cosine.data();
+  // Values and their sines and cosines first: independent of each other, so the processor overlaps
+  // them (one after the other inside the frame recursion they would be a chain of latencies).
+  for (std::size_t i = 0; i < n; ++i) {
+    const Segment& s = segments_[i];
+    const double v = s.dof >= 0 ? s.multiplier * q[s.dof] + s.offset : 0.0;
+    values[i] = v;
+  }
+  detail::sincos_batch(values, sines, cosines, n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Segment& s = segments_[i];
+    double* r = out[i].rotation.data();  // r[c * 3 + row]
+    double* t = out[i].translation.data();
+    const double v = values[i];
+    // Rotation of the frame after pre, times the joint's motion, in local (pre) coordinates first.
+    double a[9];  // pre rotation * motion rotation, column-major
+    const double* pr = s.pre.rotation.data();
+    const double sn = sines[i], cs = cosines[i];
+    switch (s.motion) {
+      case Motion::RotX:
+        for (int k = 0; k < 3; ++k) {
+          a[k] = pr[k];
+          a[3 + k] = cs * pr[3 + k] + sn * pr[6 + k];
+          a[6 + k] = cs * pr[6 + k] - sn * pr[3 + k];
+        }
+        break;
+      case Motion::RotY:
+        for (int k = 0; k < 3; ++k) {
+          a[k] = cs * pr[k] - sn * pr[6 + k];
+          a[3 + k] = pr[3 + k];
+          a[6 + k] = sn * pr[k] + cs * pr[6 + k];
+        }
+        break;
+      case Motion::RotZ:
+        for (int k = 0; k < 3; ++k) {
+          a[k] = cs * pr[k] + sn * pr[3 + k];
+          a[3 + k] = cs * pr[3 + k] - sn * pr[k];
+          a[6 + k] = pr[6 + k];
+        }
+        break;
+      case Motion::Rot: {
+        const Eigen::Vector3d& ax = s.axis;
+        Eigen::Matrix3d k;
+        k << 0, -ax.z(), ax.y(), ax.z(), 0, -ax.x(), -ax.y(), ax.x(), 0;
+        const Eigen::Matrix3d m =
+            s.pre.rotation * (Eigen::Matrix3d::Identity() * cs + sn * k + (1.0 - cs) * (ax * ax.transpose()));
+        for (int k2 = 0; k2 < 9; ++k2) a[k2] = m.data()[k2];
+        break;
+      }
+      default:
+        for (int k = 0; k < 9; ++k) a[k] = pr[k];
+        break;
+    }
+    // Local translation: pre.p (+ pre.R axis v for a prismatic joint).
+    double lt[3] = {s.pre.translation[0], s.pre.translation[1], s.pre.translation[2]};
+    if (s.motion == Motion::Trans) {
+      for (int k = 0; k < 3; ++k)
+        lt[k] += v * (pr[k] * s.axis[0] + pr[3 + k] * s.axis[1] + pr[6 + k] * s.axis[2]);
+    }
+    if (!s.post_identity) {
+      // lt += a * post.p; a = a * post.R
+      const double* pp = s.post.translation.data();
+      const double* po = s.post.rotation.data();
+      for (int k = 0; k < 3; ++k) lt[k] += a[k] * pp[0] + a[3 + k] * pp[1] + a[6 + k] * pp[2];
+      double b[9];
+      for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 3; ++k)
+          b[c * 3 + k] = a[k] * po[c * 3] + a[3 + k] * po[c * 3 + 1] + a[6 + k] * po[c * 3 + 2];
+      for (int k = 0; k < 9; ++k) a[k] = b[k];
+    }
+    if (s.parent < 0) {
+      for (int k = 0; k < 9; ++k) r[k] = a[k];
+      for (int k = 0; k < 3; ++k) t[k] = lt[k];
+    } else {
+      const double* pr2 = out[s.parent].rotation.data();
+      const double* pt = out[s.parent].translation.data();
+      for (int k = 0; k < 3; ++k) t[k] = pt[k] + pr2[k] * lt[0] + pr2[3 + k] * lt[1] + pr2[6 + k] * lt[2];
+      for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 3; ++k)
+          r[c * 3 + k] = pr2[k] * a[c * 3] + pr2[3 + k] * a[c * 3 + 1] + pr2[6 + k] * a[c * 3 + 2];
+    }
+  }
+}
+
+void Model::jacobian(const Data& data, int body,
+                     Eigen::Ref<Eigen::Matrix<double, 6, Eigen::Dynamic>> out) const noexcept {
+  out.setZero();
+  const Eigen::Vector3d& tip =
+      data.segment[static_cast<std::size_t>(body_segment_[static_cast<std::size_t>(body)])].translation;
+  for (int i = body_segment_[static_cast<std::size_t>(body)]; i >= 0;
+       i = segments_[static_cast<std::size_t>(i)].parent) {
+    const Segment& s = segments_[static_cast<std::size_t>(i)];
+    if (s.dof < 0 || s.motion == Motion::None) continue;
+    const Frame& f = data.segment[static_cast<std::size_t>(i)];
+    const Eigen::Vector3d z = f.rotation * s.axis_post;
+    if (s.motion == Motion::Trans) {
+      out.col(s.dof).head<3>() += s.multiplier * z;
+    } else {
+      const Eigen::Vector3d o = f.translation + f.rotation * s.origin_post;
+      out.col(s.dof).head<3>() += s.multiplier * z.cross(tip - o);
+      out.col(s.dof).tail<3>() += s.multiplier * z;
+    }
+  }
+}
+
+void Model::clamp(double* q) const noexcept {
+  for (std::size_t i = 0; i < layout_.size(); ++i)
+    if (layout_[i].has_limits) q[i] = std::clamp(q[i], layout_[i].lower, layout_[i].upper);
+}
+
+}  // namespace vsd::robotics

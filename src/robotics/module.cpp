@@ -1,0 +1,41 @@
+#include "vsd/robotics/module.hpp"
+
+#include "vsd/core/environment.hpp"
+#include "vsd/core/registry.hpp"
+#include "vsd/core/sim_state.hpp"
+#include "vsd/robotics/controller.hpp"
+#include "vsd/robotics/joint.hpp"
+#include "vsd/robotics/kinematic_tree.hpp"
+#include "vsd/scene/module.hpp"
+
+namespace vsd::robotics {
+
+void Module::register_types(vsd::Registry& registry) {
+  registry.add_type<KinematicJointType>();
+  registry.add_type<DhConvention>();
+  registry.add<KinematicJoint>();
+  registry.add<KinematicTree>();
+  registry.add_type<ControlMode>();
+  registry.add_type<Interpolation>();
+  registry.add<JointController>();
+}
+
+void Module::attach(vsd::Environment& env) {
+  env.use<scene::Module>();
+  for (SimState* s : env.states()) track(*s);
+  vsd::Environment* e = &env;
+  control_task_ = env.scheduler().add_periodic(
+      "robotics control", env.scheduler().base_step(),
+      [e](const vsd::StepInfo& info) {
+        for (SimState* s : e->states())
+          for (JointController* c : s->index().of<JointController>()) c->step(info.dt);
+      },
+      10);
+}
+
+void Module::detach(vsd::Environment& env) {
+  if (control_task_ != 0) env.scheduler().remove(control_task_);
+  control_task_ = 0;
+}
+
+}  // namespace vsd::robotics
