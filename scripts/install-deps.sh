@@ -17,6 +17,8 @@ PACKAGES=(
   # vsd::scene: URDF and mesh loading
   liburdfdom-dev
   libassimp-dev
+  # vsd::physics: rigid-body dynamics (ODE 0.16, double precision)
+  libode-dev
   # tests and benchmarks
   libgtest-dev
   libgmock-dev
