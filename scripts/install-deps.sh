@@ -19,6 +19,8 @@ PACKAGES=(
   libassimp-dev
   # vsd::physics: rigid-body dynamics (ODE 0.16, double precision)
   libode-dev
+  # examples/physics/falling_objects draws its PNG with gnuplot (skipped with a message without it)
+  gnuplot-nox
   # tests and benchmarks
   libgtest-dev
   libgmock-dev

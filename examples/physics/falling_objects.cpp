@@ -148,11 +148,13 @@ int main(int argc, char** argv) {
     const auto script = out / "falling_objects.gp";
     std::ofstream gp(script);
     gp << "set terminal png size 900,500\nset output '" << (out / "falling_objects.png").string() << "'\n"
-       << "set datafile separator ','\nset xlabel 'time (s)'\nset ylabel 'height (m)'\nset key outside\n"
+       << "set datafile separator ','\nset key autotitle columnhead\nset xlabel 'time (s)'\nset ylabel "
+          "'height (m)'\nset key outside\n"
        << "set title 'objects falling onto a table (vsd::physics)'\nplot ";
     for (std::size_t i = 0; i < drops.size(); ++i)
-      gp << (i ? ", " : "") << "'" << csv_path.string() << "' using 1:(strcol(2) eq '" << drops[i].name
-         << "' ? $5 : NaN) with lines title '" << drops[i].name << "'";
+      // Rows come in time order, one per object in drop order: every n-th row from row i is object i.
+      gp << (i ? ", " : "") << "'" << csv_path.string() << "' every " << drops.size() << "::" << i
+         << " using 1:5 with lines lw 2 title '" << drops[i].name << "'";
     gp << '\n';
     gp.close();
     if (std::system(("gnuplot '" + script.string() + "'").c_str()) == 0) {
