@@ -345,6 +345,37 @@ TEST_F(SimulationTest, ToolSimulatesASavedSceneAndReportsErrors) {
   std::filesystem::remove(path);
 }
 
+std::string two_link_urdf(const char* type) {
+  return std::string(R"(<robot name="r">
+  <link name="base"><inertial><mass value="2"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="arm"><inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="0.01" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="j" type=")") +
+         type + R"("><parent link="base"/><child link="arm"/><origin xyz="0 0 1"/>
+    <axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+</robot>)";
+}
+
+TEST_F(SimulationTest, MakeDynamicTurnsAUrdfIntoBodiesAndJoints) {
+  auto r = scene::load_urdf_text(s.database(), two_link_urdf("revolute"), "two.urdf", ".");
+  EXPECT_EQ(make_dynamic(*r.scene), 2u);
+  sim().sync();
+  EXPECT_EQ(sim().stats().bodies, 2u);
+  EXPECT_EQ(sim().stats().joints, 2u);  // the hinge and the base held to the world
+  auto* hinge = r.scene->find_link("arm")->find_extension<Joint>();
+  ASSERT_NE(hinge, nullptr);
+  EXPECT_EQ(hinge->kind(), JointKind::Hinge);
+  EXPECT_TRUE(hinge->has_limits());
+  EXPECT_NEAR(sim().mass_of(*r.scene->find_link("arm")->find_extension<RigidBody>()).center.x(), 0.5, 1e-12);
+  env.run_for(3.0);  // the arm falls about y until it rests on its limit; the base stays
+  EXPECT_NEAR(std::abs(hinge->position()), 1.0, 0.02);
+  EXPECT_NEAR(r.scene->find_link("base")->world_frame().translation().norm(), 0.0, 1e-3);
+  // A planar joint: an error naming it, and nothing made.
+  auto bad = scene::load_urdf_text(s.database(), two_link_urdf("planar"), "planar.urdf", ".");
+  EXPECT_THAT([&] { make_dynamic(*bad.scene); },
+              ::testing::ThrowsMessage<vsd::Error>(HasSubstr("joint 'j'")));
+  EXPECT_EQ(bad.scene->find_link("arm")->find_extension<RigidBody>(), nullptr);
+}
+
 TEST_F(SimulationTest, JointsWithLimitsAndMotors) {
   world->set_gravity(Eigen::Vector3d::Zero());
   auto& g = geometry(GeometryKind::Box, Eigen::Vector3d(1, 0.1, 0.1));
