@@ -28,6 +28,10 @@ PACKAGES=(
   # vsd::robotics: Orocos KDL, the independent library its tests and benchmarks compare against (not a
   # dependency of the module itself)
   liborocos-kdl-dev
+  # vsd::physics: rigid-body dynamics (ODE 0.16, double precision)
+  libode-dev
+  # examples/physics/falling_objects draws its PNG with gnuplot (skipped with a message without it)
+  gnuplot-nox
   # tests and benchmarks
   libgtest-dev
   libgmock-dev

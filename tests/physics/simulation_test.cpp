@@ -1,0 +1,437 @@
+// vsd::physics and the database: bodies and joints follow the database through signals, the step writes
+// poses back through the setters, changes made by others reach ODE, and bad input is a vsd::Error.
+#include <gmock/gmock.h>
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <string_view>
+#include <vector>
+
+#include "fixture.hpp"
+#include "vsd/io.hpp"
+
+// Only to check that ODE's handlers are redirected (process wide, installed by the first Simulation).
+#include <ode/ode.h>
+
+namespace vsd::physics::test {
+namespace {
+
+using scene::GeometryKind;
+using ::testing::HasSubstr;
+
+class SimulationTest : public PhysicsTest {};
+
+TEST_F(SimulationTest, ModuleRegistersClassesAndRunsAsASchedulerTask) {
+  EXPECT_EQ(RigidBody::static_meta().name(), "physics::RigidBody");
+  EXPECT_NE(env.registry().find_class("physics::World"), nullptr);
+  EXPECT_NE(env.module<scene::Module>(), nullptr);  // used by the physics module
+  auto& box = hull(geometry(GeometryKind::Box, Eigen::Vector3d(1, 1, 1)), at(0, 0, 10));
+  body(box);
+  env.scheduler().set_base_step(0.01);
+  env.step();
+  EXPECT_LT(box.frame().translation().z(), 10.0);
+  EXPECT_NEAR(world->time(), 0.01, 1e-12);
+  EXPECT_EQ(sim().stats().steps, 10u);  // World.step 1 ms: ten ODE steps per scheduler step
+}
+
+TEST_F(SimulationTest, EveryListenerSeesTheMotion) {
+  auto& box = hull(geometry(GeometryKind::Box, Eigen::Vector3d(1, 1, 1)), at(0, 0, 10));
+  auto& rb = body(box);
+  int frames = 0;
+  int velocities = 0;
+  auto c1 = box.on_changed().connect([&](SimStateInstance&, const MetaProperty& p) {
+    if (p.name() == "frame") ++frames;
+  });
+  auto c2 = rb.on_changed().connect([&](SimStateInstance&, const MetaProperty& p) {
+    if (p.name() == "linear_velocity") ++velocities;
+  });
+  env.step();
+  env.step();
+  EXPECT_EQ(frames, 2);
+  EXPECT_EQ(velocities, 2);
+  EXPECT_LT(rb.linear_velocity().z(), 0.0);
+  // The world frame cache of the node (and of its children) is current.
+  EXPECT_NEAR(box.world_frame().translation().z(), box.frame().translation().z(), 1e-15);
+}
+
+TEST_F(SimulationTest, BodiesAndJointsAppearAndDisappearThroughSignals) {
+  auto& g = geometry(GeometryKind::Sphere, Eigen::Vector3d::Zero(), 0.5);
+  auto& a = hull(g, at(0, 0, 5), nullptr, nullptr, "a");
+  auto& ra = body(a);
+  sim().sync();
+  EXPECT_EQ(sim().stats().bodies, 1u);
+  EXPECT_EQ(sim().stats().geoms, 1u);
+  auto& b = hull(g, at(2, 0, 5), nullptr, nullptr, "b");
+  auto& rb = body(b);
+  auto& j = s.create<Joint>();
+  j.set_kind(JointKind::Ball);
+  j.set_other(&a);
+  b.add_extension(j);
+  sim().sync();
+  EXPECT_EQ(sim().stats().bodies, 2u);
+  EXPECT_EQ(sim().stats().joints, 1u);
+  EXPECT_TRUE(sim().simulates(rb));
+  // Deleting the node deletes its extensions: the body and its joint leave ODE at once.
+  s.destroy(b);
+  EXPECT_EQ(sim().stats().bodies, 1u);
+  EXPECT_EQ(sim().stats().joints, 0u);
+  // Removing the RigidBody makes the hull static scenery: still a geom, no body.
+  a.remove_extension(ra);
+  sim().sync();
+  EXPECT_EQ(sim().stats().bodies, 0u);
+  EXPECT_EQ(sim().stats().geoms, 1u);
+  const auto z = a.frame().translation().z();
+  env.step();
+  EXPECT_EQ(a.frame().translation().z(), z);
+}
+
+TEST_F(SimulationTest, AFrameSetByTheUserTeleportsTheBodyAndKeepsItsVelocity) {
+  auto& box = hull(geometry(GeometryKind::Box, Eigen::Vector3d(1, 1, 1)), at(0, 0, 10));
+  auto& rb = body(box);
+  world->set_gravity(Eigen::Vector3d::Zero());
+  rb.set_linear_velocity(Eigen::Vector3d(1, 0, 0));
+  env.step();
+  EXPECT_NEAR(box.frame().translation().x(), 0.01, 1e-12);
+  box.set_frame(at(5, 5, 5));
+  env.step();
+  EXPECT_NEAR(box.frame().translation().x(), 5.01, 1e-12);
+  EXPECT_NEAR(box.frame().translation().y(), 5.0, 1e-12);
+  EXPECT_EQ(sim().stats().rebuilds, 1u);  // a teleport is no rebuild
+  // Moving an ancestor moves the body with it.
+  auto& group = s.create<scene::Node3D>();
+  scene_root().add_child(group);
+  group.add_child(box);
+  env.step();
+  group.set_frame(at(0, 100, 0));
+  env.step();
+  EXPECT_NEAR(box.world_frame().translation().y(), 105.0, 1e-9);
+}
+
+TEST_F(SimulationTest, MassAndVelocityChangesReachOde) {
+  auto& box = hull(geometry(GeometryKind::Box, Eigen::Vector3d(1, 2, 4)), at(0, 0, 10));
+  auto& rb = body(box);
+  sim().sync();
+  EXPECT_NEAR(sim().mass_of(rb).mass, 8000.0, 1e-9);  // 8 m^3 of the default density 1000 kg/m^3
+  EXPECT_NEAR(sim().mass_of(rb).inertia(0, 0), 8000.0 * (4 + 16) / 12.0, 1e-6);
+  rb.set_mass(2.0);
+  sim().sync();
+  EXPECT_NEAR(sim().mass_of(rb).mass, 2.0, 1e-12);
+  EXPECT_NEAR(sim().mass_of(rb).inertia(0, 0), 2.0 * (4 + 16) / 12.0, 1e-12);
+  // A force of 2 N on 2 kg against no gravity: 1 m/s^2 for one scheduler step, then the accumulator is clear.
+  world->set_gravity(Eigen::Vector3d::Zero());
+  rb.add_force(Eigen::Vector3d(2, 0, 0));
+  env.step();
+  EXPECT_NEAR(rb.linear_velocity().x(), 0.01, 1e-12);
+  EXPECT_TRUE(rb.force().isZero());
+  env.step();
+  EXPECT_NEAR(rb.linear_velocity().x(), 0.01, 1e-12);
+  rb.set_linear_velocity(Eigen::Vector3d(0, -3, 0));
+  env.step();
+  EXPECT_NEAR(rb.linear_velocity().y(), -3.0, 1e-12);
+  EXPECT_NEAR(rb.linear_velocity().x(), 0.0, 1e-12);
+  // A force off the centre of mass also turns the body.
+  sim().add_force_at(rb, Eigen::Vector3d(0, 1, 0), box.world_frame() * Eigen::Vector3d(0.5, 0, 0));
+  EXPECT_NEAR(rb.torque().z(), 0.5, 1e-12);
+  env.step();
+  EXPECT_GT(rb.angular_velocity().z(), 0.0);
+}
+
+TEST_F(SimulationTest, ExplicitInertiaAndAnOffCentreHull) {
+  // A body node with a hull placed off its origin: the centre of mass is the hull's centre.
+  auto& n = s.create<scene::Node3D>();
+  n.set_frame(at(0, 0, 3));
+  scene_root().add_child(n);
+  auto& rb = s.create<RigidBody>();
+  n.add_extension(rb);
+  hull(geometry(GeometryKind::Sphere, Eigen::Vector3d::Zero(), 0.1), at(1, 0, 0), nullptr, &n);
+  sim().sync();
+  EXPECT_TRUE(sim().mass_of(rb).center.isApprox(Eigen::Vector3d(1, 0, 0)));
+  rb.set_mass(3.0);
+  rb.set_inertia_diagonal(Eigen::Vector3d(1, 2, 2.5));
+  rb.set_center_of_mass(Eigen::Vector3d(0.5, 0, 0));
+  sim().sync();
+  EXPECT_EQ(sim().mass_of(rb).mass, 3.0);
+  EXPECT_EQ(sim().mass_of(rb).inertia(1, 1), 2.0);
+  EXPECT_TRUE(sim().mass_of(rb).center.isApprox(Eigen::Vector3d(0.5, 0, 0)));
+  // Free fall of the whole node: its frame keeps its orientation, the node origin falls with the body.
+  env.step();
+  EXPECT_LT(n.frame().translation().z(), 3.0);
+  EXPECT_NEAR(n.frame().translation().x(), 0.0, 1e-12);
+}
+
+TEST_F(SimulationTest, ErrorsAreVsdErrorsNamingTheCulprit) {
+  auto& n = s.create<scene::Node3D>();
+  n.set_name("lonely");
+  scene_root().add_child(n);
+  auto& rb = s.create<RigidBody>();
+  n.add_extension(rb);
+  EXPECT_THAT([&] { env.step(); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("/scene/lonely")));
+  EXPECT_THAT([&] { sim().sync(); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("no mass")));
+  rb.set_mass(-1.0);
+  EXPECT_THAT([&] { sim().sync(); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("mass must be >= 0")));
+  rb.set_mass(1.0);
+  rb.set_inertia_diagonal(Eigen::Vector3d(1, 1, 5));  // violates the triangle inequality
+  EXPECT_THAT([&] { sim().sync(); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("not physical")));
+  rb.set_inertia_diagonal(Eigen::Vector3d(1, 1, 1));
+  sim().sync();
+  EXPECT_TRUE(sim().simulates(rb));
+  // NaN from outside: frame, velocity, force.
+  n.set_frame(at(std::nan(""), 0, 0));
+  EXPECT_THAT([&] { env.step(); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("non-finite frame")));
+  n.set_frame(at(0, 0, 0));
+  rb.set_linear_velocity(Eigen::Vector3d(INFINITY, 0, 0));
+  EXPECT_THAT([&] { env.step(); },
+              ::testing::ThrowsMessage<vsd::Error>(HasSubstr("velocities must be finite")));
+  rb.set_linear_velocity(Eigen::Vector3d::Zero());
+  rb.set_force(Eigen::Vector3d(0, std::nan(""), 0));
+  EXPECT_THAT([&] { env.step(); },
+              ::testing::ThrowsMessage<vsd::Error>(HasSubstr("force and torque must be finite")));
+  rb.set_force(Eigen::Vector3d::Zero());
+  env.step();  // fixed: runs again
+  EXPECT_LT(n.frame().translation().z(), 0.0);
+  // A plane on a body, a World with a bad step.
+  auto& plane = hull(geometry(GeometryKind::Plane), at(0, 0, 0), nullptr, &n, "floor");
+  EXPECT_THAT([&] { sim().sync(); },
+              ::testing::ThrowsMessage<vsd::Error>(HasSubstr("cannot belong to a rigid body")));
+  s.destroy(plane);
+  world->set_step(0.0);
+  EXPECT_THAT([&] { sim().sync(); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("step must be > 0")));
+  world->set_step(0.001);
+  sim().sync();
+}
+
+TEST_F(SimulationTest, ABodyOrJointOutsideEveryWorldAndAJointAcrossWorldsAreErrors) {
+  auto& g = geometry(GeometryKind::Sphere, Eigen::Vector3d::Zero(), 0.5);
+  // A second world below its own node.
+  auto& other_root = s.create<scene::Node3D>();
+  other_root.set_name("elsewhere");
+  s.database().add_child(other_root);
+  auto& w2 = s.create<World>();
+  other_root.add_extension(w2);
+  auto& a = hull(g, at(0, 0, 0), nullptr, nullptr, "a");
+  body(a);
+  auto& b = hull(g, at(3, 0, 0), nullptr, &other_root, "b");
+  body(b);
+  sim().sync();
+  EXPECT_EQ(sim().stats().worlds, 2u);
+  auto& j = s.create<Joint>();
+  j.set_other(&a);
+  b.add_extension(j);
+  EXPECT_THAT([&] { env.step(); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("different worlds")));
+  b.remove_extension(j);
+  sim().sync();
+  // Removing the second world puts b into the root's world.
+  other_root.remove_extension(w2);
+  sim().sync();
+  EXPECT_EQ(sim().stats().worlds, 1u);
+  EXPECT_EQ(sim().stats().bodies, 2u);
+  s.destroy(b);
+  // A joint on a node without a body, a joint to itself, a ball with limits.
+  auto& k = s.create<Joint>();
+  scene_root().add_extension(k);
+  EXPECT_THAT([&] { sim().sync(); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("has no RigidBody")));
+  scene_root().remove_extension(k);
+  auto& self = s.create<Joint>();
+  self.set_other(&a);
+  a.add_extension(self);
+  EXPECT_THAT([&] { sim().sync(); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("two different bodies")));
+  self.set_other(nullptr);
+  self.set_kind(JointKind::Ball);
+  self.set_has_limits(true);
+  EXPECT_THAT([&] { sim().sync(); },
+              ::testing::ThrowsMessage<vsd::Error>(HasSubstr("limits and motors apply")));
+  self.set_has_limits(false);
+  sim().sync();
+  EXPECT_EQ(sim().stats().joints, 1u);
+  // Without any World the body is an error, not silently ignored.
+  s.database().remove_extension(*world);
+  EXPECT_THAT([&] { sim().sync(); },
+              ::testing::ThrowsMessage<vsd::Error>(HasSubstr("is in no physics world")));
+  EXPECT_EQ(sim().stats().worlds, 0u);
+  EXPECT_EQ(sim().stats().bodies, 0u);
+}
+
+TEST_F(SimulationTest, RunawayForcesAndVelocitiesAreRefusedAndTheDatabaseKeepsItsState) {
+  auto& box = hull(geometry(GeometryKind::Box, Eigen::Vector3d(1, 1, 1)), at(0, 0, 5));
+  auto& rb = body(box);
+  env.step();
+  const Eigen::Isometry3d before = box.frame();
+  rb.set_force(Eigen::Vector3d(1e308, 1e308, 0));
+  EXPECT_THAT([&] { env.step(); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("more than 1e8")));
+  EXPECT_TRUE(box.frame().isApprox(before));
+  rb.set_force(Eigen::Vector3d::Zero());
+  rb.set_angular_velocity(Eigen::Vector3d(0, 0, 1e9));
+  EXPECT_THAT([&] { env.step(); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("below 1e8")));
+  rb.set_angular_velocity(Eigen::Vector3d::Zero());
+  env.step();
+  EXPECT_TRUE(box.frame().matrix().allFinite());
+  EXPECT_LT(box.frame().translation().z(), before.translation().z());
+}
+
+TEST_F(SimulationTest, OdeErrorHandlerThrowsAVsdErrorInsteadOfAborting) {
+  sim().sync();  // ODE is initialised and its handlers are ours while a Simulation lives
+  EXPECT_THAT([] { dError(7, "bad thing %d", 3); },
+              ::testing::ThrowsMessage<vsd::Error>(HasSubstr("ODE error: ODE 7: bad thing 3")));
+  EXPECT_THAT(
+      [] { dDebug(8, "broken %s", "invariant"); },
+      ::testing::ThrowsMessage<vsd::Error>(HasSubstr("ODE internal check failed: ODE 8: broken invariant")));
+  // Messages are warnings of the simulation that runs into them (here: none is running, so they are kept
+  // aside).
+  dMessage(9, "just saying");
+  SUCCEED();
+}
+
+TEST_F(SimulationTest, MeshHullsAreSkippedWithAWarning) {
+  auto& mesh = geometry(GeometryKind::Mesh);
+  hull(mesh, at(0, 0, 0), nullptr, nullptr, "statue");
+  sim().sync();
+  ASSERT_EQ(sim().warnings().size(), 1u);
+  EXPECT_THAT(sim().warnings()[0], HasSubstr("statue"));
+  EXPECT_EQ(sim().stats().geoms, 0u);
+}
+
+TEST_F(SimulationTest, BodiesSaveAndLoadThroughVsdIoAndGoOnIdentically) {
+  auto& g = geometry(GeometryKind::Box, Eigen::Vector3d(0.2, 0.3, 0.4));
+  auto& box = hull(g, at(0, 0, 10));
+  auto& rb = body(box);
+  rb.set_angular_velocity(Eigen::Vector3d(0, 0, 2));
+  for (int i = 0; i < 5; ++i) env.step();
+  const auto bytes = vsd::io::save_bytes(s, vsd::io::Format::Binary);
+  for (int i = 0; i < 5; ++i) env.step();
+
+  vsd::Environment env2;
+  env2.use<Module>();
+  vsd::io::load_bytes(env2.main_state(), bytes);
+  auto bodies = env2.main_state().index().all<RigidBody>();
+  ASSERT_EQ(bodies.size(), 1u);
+  EXPECT_TRUE(bodies[0]->angular_velocity().isApprox(Eigen::Vector3d(0, 0, 2)));
+  EXPECT_NEAR(bodies[0]->linear_velocity().z(), rb.linear_velocity().z() + 9.81 * 0.05,
+              1e-9);  // 5 steps earlier
+  for (int i = 0; i < 5; ++i) env2.step();
+  const auto* box2 = bodies[0]->node();
+  ASSERT_NE(box2, nullptr);
+  EXPECT_TRUE(box2->frame().isApprox(box.frame(), 1e-12));
+  EXPECT_TRUE(bodies[0]->linear_velocity().isApprox(rb.linear_velocity(), 1e-12));
+}
+
+TEST_F(SimulationTest, ToolSimulatesASavedSceneAndReportsErrors) {
+  auto& box = hull(geometry(GeometryKind::Box, Eigen::Vector3d(0.2, 0.2, 0.2)), at(1, 2, 3), nullptr, nullptr,
+                   "crate");
+  body(box);
+  ground();
+  const auto path = std::filesystem::temp_directory_path() / "vsd_physics_tool_test.json";
+  vsd::io::save(s, path, vsd::io::Format::Text);
+  std::ostringstream out;
+  std::ostringstream err;
+  const std::string file = path.string();
+  const std::vector<std::string_view> args{file, "--steps", "2000", "--dt", "0.001"};
+  EXPECT_EQ(run_tool(args, out, err), 0) << err.str();
+  EXPECT_THAT(out.str(), HasSubstr("simulated 2 s (2000 steps of 0.001 s): 1 bodies"));
+  EXPECT_THAT(out.str(),
+              HasSubstr("/scene/crate: position 1.000000 2.000000 0.09"));  // resting on the ground
+  // A body without mass in the file: the error, exit code 1.
+  auto& n = s.create<scene::Node3D>();
+  n.set_name("ghost");
+  scene_root().add_child(n);
+  n.add_extension(s.create<RigidBody>());
+  vsd::io::save(s, path, vsd::io::Format::Text);
+  std::ostringstream out2;
+  std::ostringstream err2;
+  EXPECT_EQ(run_tool(args, out2, err2), 1);
+  EXPECT_THAT(err2.str(), HasSubstr("/scene/ghost"));
+  const std::vector<std::string_view> bad{"--steps", "x"};
+  EXPECT_EQ(run_tool(bad, out2, err2), 2);
+  std::filesystem::remove(path);
+}
+
+std::string two_link_urdf(const char* type) {
+  return std::string(R"(<robot name="r">
+  <link name="base"><inertial><mass value="2"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="arm"><inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="0.01" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="j" type=")") +
+         type + R"("><parent link="base"/><child link="arm"/><origin xyz="0 0 1"/>
+    <axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+</robot>)";
+}
+
+TEST_F(SimulationTest, MakeDynamicTurnsAUrdfIntoBodiesAndJoints) {
+  auto r = scene::load_urdf_text(s.database(), two_link_urdf("revolute"), "two.urdf", ".");
+  EXPECT_EQ(make_dynamic(*r.scene), 2u);
+  sim().sync();
+  EXPECT_EQ(sim().stats().bodies, 2u);
+  EXPECT_EQ(sim().stats().joints, 2u);  // the hinge and the base held to the world
+  auto* hinge = r.scene->find_link("arm")->find_extension<Joint>();
+  ASSERT_NE(hinge, nullptr);
+  EXPECT_EQ(hinge->kind(), JointKind::Hinge);
+  EXPECT_TRUE(hinge->has_limits());
+  EXPECT_NEAR(sim().mass_of(*r.scene->find_link("arm")->find_extension<RigidBody>()).center.x(), 0.5, 1e-12);
+  env.run_for(3.0);  // the arm falls about y until it rests on its limit; the base stays
+  EXPECT_NEAR(std::abs(hinge->position()), 1.0, 0.02);
+  EXPECT_NEAR(r.scene->find_link("base")->world_frame().translation().norm(), 0.0, 1e-3);
+  // A planar joint: an error naming it, and nothing made.
+  auto bad = scene::load_urdf_text(s.database(), two_link_urdf("planar"), "planar.urdf", ".");
+  EXPECT_THAT([&] { make_dynamic(*bad.scene); },
+              ::testing::ThrowsMessage<vsd::Error>(HasSubstr("joint 'j'")));
+  EXPECT_EQ(bad.scene->find_link("arm")->find_extension<RigidBody>(), nullptr);
+}
+
+TEST_F(SimulationTest, JointsWithLimitsAndMotors) {
+  world->set_gravity(Eigen::Vector3d::Zero());
+  auto& g = geometry(GeometryKind::Box, Eigen::Vector3d(1, 0.1, 0.1));
+  auto& arm = hull(g, at(0.5, 0, 1), nullptr, nullptr, "arm");
+  body(arm, 1.0);
+  auto& hinge = s.create<Joint>();
+  hinge.set_kind(JointKind::Hinge);
+  hinge.set_anchor(Eigen::Vector3d(-0.5, 0, 0));  // at the arm's end, about z
+  hinge.set_axis(Eigen::Vector3d::UnitZ());
+  hinge.set_motor_velocity(1.0);
+  hinge.set_motor_max_force(100.0);
+  hinge.set_has_limits(true);
+  hinge.set_lower(-0.5);
+  hinge.set_upper(0.3);
+  arm.add_extension(hinge);
+  env.step();
+  EXPECT_NEAR(hinge.rate(), 1.0, 1e-3);  // the motor reaches its velocity at once (100 N m on 0.33 kg m^2)
+  for (int i = 0; i < 100; ++i) env.step();
+  EXPECT_NEAR(hinge.position(), 0.3, 0.01);  // held at the upper limit
+  EXPECT_NEAR(hinge.rate(), 0.0, 1e-2);
+  // The arm turned about the anchor, which stayed where it was.
+  const Eigen::Vector3d anchor = arm.world_frame() * Eigen::Vector3d(-0.5, 0, 0);
+  EXPECT_TRUE(anchor.isApprox(Eigen::Vector3d(0, 0, 1), 1e-3));
+  // Reverse the motor: it runs to the lower limit.
+  hinge.set_motor_velocity(-2.0);
+  for (int i = 0; i < 100; ++i) env.step();
+  EXPECT_NEAR(hinge.position(), -0.5, 0.01);
+
+  // A slider with a motor, a fixed joint and a universal joint between two bodies.
+  auto& cart = hull(g, at(0, 5, 1), nullptr, nullptr, "cart");
+  body(cart, 2.0);
+  auto& slider = s.create<Joint>();
+  slider.set_kind(JointKind::Slider);
+  slider.set_axis(Eigen::Vector3d::UnitX());
+  slider.set_motor_velocity(0.5);
+  slider.set_motor_max_force(50.0);
+  cart.add_extension(slider);
+  auto& rider = hull(g, at(0, 5, 2), nullptr, nullptr, "rider");
+  body(rider, 1.0);
+  auto& weld = s.create<Joint>();
+  weld.set_kind(JointKind::Fixed);
+  weld.set_other(&cart);
+  rider.add_extension(weld);
+  for (int i = 0; i < 100; ++i) env.step();  // one second
+  EXPECT_NEAR(slider.position(), 0.5, 0.01);
+  EXPECT_NEAR(rider.world_frame().translation().x() - cart.world_frame().translation().x(), 0.0, 1e-3);
+  EXPECT_NEAR(rider.world_frame().translation().z(), 2.0, 1e-3);
+  weld.set_kind(JointKind::Universal);
+  weld.set_axis(Eigen::Vector3d::UnitX());
+  weld.set_axis2(Eigen::Vector3d::UnitY());
+  env.step();
+  EXPECT_EQ(sim().stats().joints, 3u);
+  // Deleting a joint releases the body.
+  s.destroy(slider);
+  EXPECT_EQ(sim().stats().joints, 2u);
+}
+
+}  // namespace
+}  // namespace vsd::physics::test
