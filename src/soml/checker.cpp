@@ -172,9 +172,6 @@ class CheckerImpl {
   };
   Endpoint resolve_endpoint(const std::vector<std::string>& path, SourceLoc loc, const ScopeDecl& scope,
                             const std::string& role);
-  static const ScopeDecl* parent_scope(const Decl& d) {
-    return d.parent != nullptr ? &static_cast<const ScopeDecl&>(*d.parent) : nullptr;
-  }
   static ClassRef class_of(const ScopeDecl& s) {
     return s.is_class_like() ? ClassRef{&s.as<ClassDecl>(), nullptr} : ClassRef{};
   }

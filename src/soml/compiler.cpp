@@ -43,19 +43,6 @@ void not_supported(const ProgramImpl& p, SourceLoc loc, const std::string& what)
 
 namespace {
 
-const ScopeDecl* parent_scope(const Decl& d) {
-  return d.parent != nullptr ? &static_cast<const ScopeDecl&>(*d.parent) : nullptr;
-}
-
-// True for an instance that exists once per program (the script, objects not inside a class or net).
-bool is_static_instance(const Decl& d) {
-  if (d.kind == DeclKind::Script) return true;
-  if (d.kind != DeclKind::Object) return false;
-  for (const Decl* p = d.parent; p != nullptr; p = p->parent)
-    if (p->kind != DeclKind::Object && p->kind != DeclKind::Script) return false;
-  return true;
-}
-
 class Compiler {
  public:
   Compiler(ProgramImpl& p, Function& f, const ScopeDecl* scope, int nlocals)

@@ -18,18 +18,6 @@ using K = Type::Kind;
 
 namespace {
 
-const ScopeDecl* parent_scope(const Decl& d) {
-  return d.parent != nullptr ? &static_cast<const ScopeDecl&>(*d.parent) : nullptr;
-}
-
-bool is_static_instance(const Decl& d) {
-  if (d.kind == DeclKind::Script) return true;
-  if (d.kind != DeclKind::Object) return false;
-  for (const Decl* p = d.parent; p != nullptr; p = p->parent)
-    if (p->kind != DeclKind::Object && p->kind != DeclKind::Script) return false;
-  return true;
-}
-
 // "Outer::Inner" for nested declarations (the script object's members are top level).
 std::string qualified(const Decl& d) {
   std::string s = d.name;

@@ -296,6 +296,21 @@ struct ScopeDecl : Decl {
   std::vector<DeclPtr> members;
 };
 
+/// @brief The scope that declares @p d (every parent is a ScopeDecl), or null for the script.
+[[nodiscard]] inline const ScopeDecl* parent_scope(const Decl& d) noexcept {
+  return d.parent != nullptr ? &static_cast<const ScopeDecl&>(*d.parent) : nullptr;
+}
+
+/// @brief True for an instance that exists once per program: the script object, and objects not
+/// inside a class or net (only inside objects and the script).
+[[nodiscard]] inline bool is_static_instance(const Decl& d) noexcept {
+  if (d.kind == DeclKind::Script) return true;
+  if (d.kind != DeclKind::Object) return false;
+  for (const Decl* p = d.parent; p != nullptr; p = p->parent)
+    if (p->kind != DeclKind::Object && p->kind != DeclKind::Script) return false;
+  return true;
+}
+
 /// @brief Class, object, net and the script object.
 struct ClassDecl : ScopeDecl {
   using ScopeDecl::ScopeDecl;
