@@ -280,6 +280,55 @@ TEST(Signal, ListenerDisconnectingALaterListenerDuringEmitPreventsItsCall) {
   EXPECT_THAT(order, ElementsAre(1, 3));
 }
 
+// Listeners of one type (the same lambda, the same member function) run inline, one after the other,
+// without an indirect call each; these check that such runs keep order and still see disconnections.
+struct Recorder {
+  std::vector<int>* order;
+  int tag;
+  std::vector<vsd::Connection>* to_cut = nullptr;  // disconnected by this listener when set
+  void on(int) {
+    order->push_back(tag);
+    if (to_cut != nullptr)
+      for (auto& c : *to_cut) c.disconnect();
+  }
+};
+
+TEST(Signal, SameTypedListenersKeepConnectionOrderBetweenOtherTypes) {
+  IntSignal sig;
+  std::vector<int> order;
+  std::vector<Recorder> rs;
+  for (int i = 0; i < 6; ++i) rs.push_back(Recorder{&order, i});
+  std::vector<vsd::Connection> cs;
+  cs.push_back(sig.connect<&Recorder::on>(rs[0]));
+  cs.push_back(sig.connect<&Recorder::on>(rs[1]));
+  cs.push_back(sig.connect([&](int) { order.push_back(100); }));  // another type breaks the run
+  for (int i = 2; i < 6; ++i) cs.push_back(sig.connect<&Recorder::on>(rs[static_cast<std::size_t>(i)]));
+  sig.emit(0);
+  EXPECT_THAT(order, ElementsAre(0, 1, 100, 2, 3, 4, 5));
+}
+
+TEST(Signal, SameTypedListenerDisconnectingTheNextOnesDuringEmitPreventsTheirCalls) {
+  IntSignal sig;
+  std::vector<int> order;
+  std::vector<Recorder> rs;
+  for (int i = 0; i < 5; ++i) rs.push_back(Recorder{&order, i});
+  std::vector<vsd::Connection> before;
+  std::vector<vsd::Connection> cut;  // listeners 2 and 3, cut by listener 1 in the middle of the run
+  before.push_back(sig.connect<&Recorder::on>(rs[0]));
+  before.push_back(sig.connect<&Recorder::on>(rs[1]));
+  cut.push_back(sig.connect<&Recorder::on>(rs[2]));
+  cut.push_back(sig.connect<&Recorder::on>(rs[3]));
+  before.push_back(sig.connect<&Recorder::on>(rs[4]));
+  rs[1].to_cut = &cut;
+  sig.emit(0);
+  EXPECT_THAT(order, ElementsAre(0, 1, 4));
+  EXPECT_EQ(sig.size(), 3u);
+  order.clear();
+  rs[1].to_cut = nullptr;
+  sig.emit(0);
+  EXPECT_THAT(order, ElementsAre(0, 1, 4));
+}
+
 TEST(Signal, ListenerDisconnectingAnEarlierListenerDuringEmit) {
   IntSignal sig;
   std::vector<int> order;

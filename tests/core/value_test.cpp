@@ -239,7 +239,7 @@ TEST(Value, AsWrongTypeThrowsNamingBothTypes) {
   EXPECT_THAT(e2, HasSubstr("string"));
   EXPECT_THAT(e2, HasSubstr("vector<double>"));
 
-  const vsd::Value empty;
+  const vsd::Value empty{};
   const std::string e3 = error_of([&] { (void)empty.as<double>(); });
   EXPECT_THAT(e3, HasSubstr("double"));
   EXPECT_THAT(e3, HasSubstr("nothing"));

@@ -31,7 +31,7 @@ namespace detail {
 /// that a connection can outlive its signal and a signal can die in the middle of its own emit.
 struct SignalCore {
   struct Slot {
-    void (*fn)() = nullptr;  // type-erased thunk (void(*)() is the generic function pointer)
+    void (*fn)() = nullptr;  // type-erased runner (void(*)() is the generic function pointer), see dispatch()
     void* ctx = nullptr;
     void (*drop)(void*) = nullptr;  // destroys a heap-held functor, if any
     std::uint32_t id = 0;
@@ -40,7 +40,7 @@ struct SignalCore {
   std::vector<Slot> slots;            // never reallocated while an emit walks it
   std::vector<Slot> pending;          // connected during an emit; joins `slots` when the outermost emit ends
   void** live = nullptr;              // the owning signal's "live" pointer, null once the signal is gone
-  void (*noop)() = nullptr;           // a thunk that does nothing, for slots blanked during an emit
+  void (*noop)() = nullptr;           // a runner that skips its slot, for slots blanked during an emit
   void (*on_first)(void*) = nullptr;  // called when the signal gains a listener after having none
   void* on_first_ctx = nullptr;
   std::uint32_t refs = 1;
@@ -101,8 +101,6 @@ class Signal;
 /// @brief A signal whose listeners take `Args...`. Not copyable and not movable: listeners refer to it.
 template <class... Args>
 class Signal<void(Args...)> {
-  using Thunk = void (*)(void*, Args...);
-
  public:
   Signal() noexcept = default;
   Signal(const Signal&) = delete;
@@ -143,16 +141,10 @@ class Signal<void(Args...)> {
       // pointer) is kept in the slot itself: no allocation, one load less per call.
       void* ctx = nullptr;
       std::memcpy(&ctx, &f, sizeof(Fn));
-      Thunk thunk = [](void* c, Args... a) {
-        alignas(Fn) unsigned char buf[sizeof(Fn)];
-        std::memcpy(buf, &c, sizeof(Fn));  // a trivially copyable functor comes to life by its bytes
-        (*std::launder(reinterpret_cast<Fn*>(buf)))(a...);
-      };
-      return add(thunk, ctx, nullptr);
+      return add(&run<&call_inline<Fn>>, ctx, nullptr);
     } else {
       auto* held = new Fn(std::forward<F>(f));
-      Thunk thunk = [](void* ctx, Args... a) { (*static_cast<Fn*>(ctx))(a...); };
-      return add(thunk, held, [](void* p) { delete static_cast<Fn*>(p); });
+      return add(&run<&call_held<Fn>>, held, [](void* p) { delete static_cast<Fn*>(p); });
     }
   }
 
@@ -167,27 +159,59 @@ class Signal<void(Args...)> {
   /// @brief Connects a member function of @p object without allocating: `sig.connect<&C::on_x>(obj)`.
   template <auto Member, class C>
   Connection connect(C& object) {
-    Thunk thunk = [](void* ctx, Args... a) { (static_cast<C*>(ctx)->*Member)(a...); };
-    return add(thunk, &object, nullptr);
+    return add(&run<&call_member<Member, C>>, &object, nullptr);
   }
 
  private:
-  static void noop(void*, Args...) {}
+  using Slot = detail::SignalCore::Slot;
+  using Call = void (*)(void*, Args...);
+  // A runner calls the listener of slot `s` and then, inline, those of the slots right after it that
+  // have the same runner (listeners of one type: the same lambda, functor class or member function).
+  // It returns the first slot it did not run. So a signal whose listeners are of one kind costs one
+  // indirect call per emit, not one per listener, and the listener's body is inlined into the loop.
+  using Run = const Slot* (*)(const Slot*, const Slot*, Args...);
+
+  template <class Fn>
+  static void call_inline(void* c, Args... a) {
+    alignas(Fn) unsigned char buf[sizeof(Fn)];
+    std::memcpy(buf, &c, sizeof(Fn));  // a trivially copyable functor comes to life by its bytes
+    (*std::launder(reinterpret_cast<Fn*>(buf)))(a...);
+  }
+  template <class Fn>
+  static void call_held(void* c, Args... a) {
+    (*static_cast<Fn*>(c))(a...);
+  }
+  template <auto Member, class C>
+  static void call_member(void* c, Args... a) {
+    (static_cast<C*>(c)->*Member)(a...);
+  }
+  template <Call call>
+  static const Slot* run(const Slot* s, const Slot* end, Args... a) {
+    const auto self = reinterpret_cast<void (*)()>(static_cast<Run>(&run<call>));
+    // s->fn is read again for every slot: a listener that disconnects the next one blanks it (its
+    // runner becomes the skipping one), which ends this run before that slot.
+    do {
+      call(s->ctx, a...);
+      ++s;
+    } while (s != end && s->fn == self);
+    return s;
+  }
+  static const Slot* skip(const Slot* s, const Slot*, Args...) { return s + 1; }
 
   detail::SignalCore* core() {
     if (core_ == nullptr) {
       core_ = new detail::SignalCore;
       core_->live = reinterpret_cast<void**>(&live_);
-      core_->noop = reinterpret_cast<void (*)()>(static_cast<Thunk>(&noop));
+      core_->noop = reinterpret_cast<void (*)()>(static_cast<Run>(&skip));
     }
     return core_;
   }
 
-  Connection add(Thunk thunk, void* ctx, void (*drop)(void*)) {
+  Connection add(Run runner, void* ctx, void (*drop)(void*)) {
     detail::SignalCore* c = core();
     const bool first = live_ == nullptr;
     const std::uint32_t id = c->next_id++;
-    const detail::SignalCore::Slot slot{reinterpret_cast<void (*)()>(thunk), ctx, drop, id};
+    const Slot slot{reinterpret_cast<void (*)()>(runner), ctx, drop, id};
     if (c->depth > 0) {  // an emit is walking `slots`: do not move it under its feet
       c->pending.push_back(slot);
       c->dirty = true;
@@ -209,9 +233,10 @@ class Signal<void(Args...)> {
     };
     ++core->depth;
     Depth guard{core};
-    // No test per slot: a slot disconnected during an emit calls a no-op until it is swept.
-    for (const auto *s = core->slots.data(), *end = s + core->slots.size(); s != end; ++s)
-      reinterpret_cast<Thunk>(s->fn)(s->ctx, args...);
+    // No test for dead slots: a slot disconnected during an emit has the skipping runner until it is
+    // swept. `slots` is never reallocated during an emit (connections made now wait in `pending`).
+    for (const Slot *s = core->slots.data(), *end = s + core->slots.size(); s != end;)
+      s = reinterpret_cast<Run>(s->fn)(s, end, args...);
   }
 
   detail::SignalCore* core_ = nullptr;
