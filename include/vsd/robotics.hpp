@@ -1,10 +1,16 @@
 /** @file
  *  @brief vsd::robotics: kinematic chains and trees as database extensions of 3D nodes, the compiled
- *  model (forward kinematics, Jacobians), inverse kinematics and the vsd-robot tool (link vsd::robotics).
+ *  model (forward kinematics, Jacobians), inverse kinematics, controllers, hardware adapters (UDP, fieldbus)
+ *  and the vsd-robot tool (link vsd::robotics).
  */
 #pragma once
 
 #include "vsd/robotics/controller.hpp"
+#include "vsd/robotics/fieldbus_adapter.hpp"
+#include "vsd/robotics/fieldbus_drive.hpp"
+#include "vsd/robotics/fri_protocol.hpp"
+#include "vsd/robotics/hardware_adapter.hpp"
+#include "vsd/robotics/hardware_binding.hpp"
 #include "vsd/robotics/ik.hpp"
 #include "vsd/robotics/joint.hpp"
 #include "vsd/robotics/kinematic_tree.hpp"
@@ -12,4 +18,5 @@
 #include "vsd/robotics/module.hpp"
 #include "vsd/robotics/tool.hpp"
 #include "vsd/robotics/trajectory.hpp"
+#include "vsd/robotics/udp_adapter.hpp"
 #include "vsd/scene.hpp"

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "vsd/core/error.hpp"
+#include "vsd/robotics/hardware_binding.hpp"
 
 namespace vsd::robotics {
 
@@ -33,6 +34,21 @@ void JointController::step(double dt) {
   if (mode() == ControlMode::Idle || !(dt > 0)) return;
   KinematicTree* t = tree();
   if (t == nullptr) return stop("no KinematicTree on the controller's node");
+  // Bound to hardware: hold while the adapters do not deliver (the binding sends hold commands), and
+  // replan from the measured positions once they do again.
+  HardwareBinding* hw = owner()->find_extension<HardwareBinding>();
+  if (hw != nullptr && !hw->active()) hw = nullptr;
+  if (hw != nullptr) {
+    if (hw->holding()) {
+      // Whether the target is reached is not known while the robot does not report.
+      if (mode() == ControlMode::Position || mode() == ControlMode::Cartesian) set_done(false);
+      return;
+    }
+    if (hw->synchronisations() != seen_synchronisations_) {
+      seen_synchronisations_ = hw->synchronisations();
+      trajectory_.reset();
+    }
+  }
   const Model& m = t->model();
   const auto n = static_cast<std::size_t>(m.dof());
   std::vector<double> q = t->positions();
@@ -101,6 +117,7 @@ void JointController::step(double dt) {
       break;
     }
   }
+  if (hw != nullptr) return hw->command(q, qd);  // the binding writes what the robot measures
   t->set_positions(q);
   const std::vector<DofInfo> layout(m.layout().begin(), m.layout().end());
   for (std::size_t i = 0; i < n; ++i)

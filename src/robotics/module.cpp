@@ -4,6 +4,7 @@
 #include "vsd/core/registry.hpp"
 #include "vsd/core/sim_state.hpp"
 #include "vsd/robotics/controller.hpp"
+#include "vsd/robotics/hardware_binding.hpp"
 #include "vsd/robotics/joint.hpp"
 #include "vsd/robotics/kinematic_tree.hpp"
 #include "vsd/scene/module.hpp"
@@ -18,6 +19,8 @@ void Module::register_types(vsd::Registry& registry) {
   registry.add_type<ControlMode>();
   registry.add_type<Interpolation>();
   registry.add<JointController>();
+  registry.add_type<BindingStatus>();
+  registry.add<HardwareBinding>();
 }
 
 void Module::attach(vsd::Environment& env) {
@@ -27,8 +30,11 @@ void Module::attach(vsd::Environment& env) {
   control_task_ = env.scheduler().add_periodic(
       "robotics control", env.scheduler().base_step(),
       [e](const vsd::StepInfo& info) {
-        for (SimState* s : e->states())
+        // Controllers compute the commands, then the bindings send them and read the robots back.
+        for (SimState* s : e->states()) {
           for (JointController* c : s->index().of<JointController>()) c->step(info.dt);
+          for (HardwareBinding* b : s->index().of<HardwareBinding>()) b->cycle(info.dt);
+        }
       },
       10);
 }

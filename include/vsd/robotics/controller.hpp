@@ -7,6 +7,10 @@
  *  commands the robot by setting them; a changed target replans from where the joints are. Limits: each
  *  joint's velocity and acceleration limits, or the controller's defaults where a joint has none; positions
  *  stay within the joint limits. A target of the wrong size stops the controller with `fault` set.
+ *
+ *  With an active HardwareBinding on the same node the step's result goes to the binding as the command
+ *  (the binding writes the measured state into the joints); while the binding holds, the controller does
+ *  not advance, and after it held it replans from the measured positions.
  */
 #pragma once
 
@@ -72,6 +76,7 @@ class JointController : public vsd::Extension {
   std::optional<JointTrajectory> trajectory_;
   std::vector<double> planned_for_;
   double elapsed_ = 0.0;
+  std::uint64_t seen_synchronisations_ = 0;
 };
 
 }  // namespace vsd::robotics

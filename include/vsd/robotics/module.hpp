@@ -26,7 +26,7 @@ class Module : public vsd::Module {
   void register_types(vsd::Registry& registry) override;
   /// @brief Uses vsd::scene::Module, tracks every SimState the environment has now, and adds the periodic
   /// task "robotics control" (every base step, priority 10) that steps every JointController of every
-  /// SimState of the environment.
+  /// SimState of the environment, then cycles every HardwareBinding (send the commands, read the robots).
   void attach(vsd::Environment& env) override;
   /// @brief Removes the control task.
   void detach(vsd::Environment& env) override;
