@@ -453,7 +453,7 @@ TEST_F(CollisionTest, RayCastReturnsTheFirstHitWithItsNormal) {
   EXPECT_THROW((void)w.ray_cast(Eigen::Vector3d(NAN, 0, 0), Eigen::Vector3d::UnitX()), vsd::Error);
 }
 
-// A closed, bumpy sphere mesh (radius 2 +- 0.3) of 2 * n * (n - 1) triangles.
+// A closed, bumpy sphere mesh (radius 2 +- 0.3) of 4 * n * (n - 1) triangles.
 void bumpy_sphere(Geometry& g, int n) {
   std::vector<Eigen::Vector3d> v;
   std::vector<std::int32_t> f;
@@ -506,7 +506,7 @@ std::optional<double> brute_force(const Geometry& g, const Eigen::Isometry3d& po
 TEST_F(CollisionTest, RayCastOnAMeshDescendsItsTreeAndAgreesWithEveryTriangle) {
   auto& g = s.create<Geometry>();
   keep(g);
-  bumpy_sphere(g, 40);  // 3,120 triangles
+  bumpy_sphere(g, 40);  // 6,240 triangles
   Eigen::Isometry3d pose = rotated_z(0.7, Eigen::Vector3d(1, -2, 3));
   pose.rotate(Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitX()));
   Hull& blob = hull(g, pose, "blob");
