@@ -15,6 +15,8 @@
 #include "vsd/scene/module.hpp"
 #include "vsd/scene/node3d.hpp"
 #include "vsd/scene/scene.hpp"
+#include "vsd/scene/spatial_view.hpp"
+#include "vsd/scene/support.hpp"
 #include "vsd/scene/texture_map.hpp"
 #include "vsd/scene/tool.hpp"
 #include "vsd/scene/urdf_loader.hpp"

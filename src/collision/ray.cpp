@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace vsd::collision {
 
@@ -146,19 +147,60 @@ std::optional<ShapeHit> ray_hit_shape(const Ray& ray, const fcl::CollisionGeomet
       break;
     }
     case fcl::BV_OBBRSS: {
+      // Down FCL's own bounding-volume tree of the mesh (built for collision anyway): only the boxes the
+      // ray enters before the best hit so far are opened, nearer child first, so a ray costs about
+      // O(log n) box tests and a handful of triangle tests instead of n triangle tests.
       const auto& m = static_cast<const fcl::BVHModel<fcl::OBBRSSd>&>(shape);
-      double best = inf;
+      if (m.getNumBVs() <= 0 || m.num_tris <= 0) return std::nullopt;
+      double best = ray.max_distance;
+      bool found = false;
       Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-      for (int i = 0; i < m.num_tris; ++i) {
-        const fcl::Triangle& t = m.tri_indices[i];
-        const Eigen::Vector3d &a = m.vertices[t[0]], &b = m.vertices[t[1]], &c = m.vertices[t[2]];
-        if (auto hit = triangle_hit(o, d, a, b, c); hit && *hit < best) {
-          best = *hit;
-          normal = (b - a).cross(c - a).normalized();
-          if (normal.dot(d) > 0) normal = -normal;  // facing the ray
+      // Where the ray enters node i's oriented box (its OBB, padded by a relative 1e-9 so that rounding in
+      // the fit never loses a triangle on its surface); false when it misses it or enters beyond best.
+      const auto enters = [&](int i, double& t) {
+        const fcl::OBBd& b = m.getBV(i).bv.obb;
+        const Eigen::Vector3d bo = b.axis.transpose() * (o - b.To);
+        const Eigen::Vector3d bd = b.axis.transpose() * d;
+        const Eigen::Vector3d h =
+            b.extent.array() + 1e-9 * (b.extent.maxCoeff() + b.To.cwiseAbs().maxCoeff());
+        Span span;
+        for (int k = 0; k < 3; ++k) clip_slab(span, bo, bd, k, -h[k], h[k]);
+        if (span.empty() || span.t1 < 0) return false;
+        t = std::max(span.t0, 0.0);
+        return t <= best;
+      };
+      struct Entry {
+        int node;
+        double t;
+      };
+      std::vector<Entry> stack;
+      stack.reserve(64);
+      if (double t = 0; enters(0, t)) stack.push_back({0, t});
+      while (!stack.empty()) {
+        const Entry e = stack.back();
+        stack.pop_back();
+        if (e.t > best) continue;  // a nearer hit was found since it was pushed
+        const auto& node = m.getBV(e.node);
+        if (node.isLeaf()) {
+          const fcl::Triangle& tri = m.tri_indices[node.primitiveId()];
+          const Eigen::Vector3d &a = m.vertices[tri[0]], &b = m.vertices[tri[1]], &c = m.vertices[tri[2]];
+          if (auto hit = triangle_hit(o, d, a, b, c); hit && (*hit < best || (!found && *hit <= best))) {
+            best = *hit;
+            found = true;
+            normal = (b - a).cross(c - a).normalized();
+            if (normal.dot(d) > 0) normal = -normal;  // facing the ray
+          }
+          continue;
         }
+        Entry first{node.leftChild(), 0}, second{node.rightChild(), 0};
+        bool in_first = enters(first.node, first.t), in_second = enters(second.node, second.t);
+        if (in_first && in_second && first.t < second.t) {  // the nearer one on top of the stack
+          std::swap(first, second);
+        }
+        if (in_first) stack.push_back(first);
+        if (in_second) stack.push_back(second);
       }
-      if (best == inf || best > ray.max_distance) return std::nullopt;
+      if (!found) return std::nullopt;
       return ShapeHit{best, ray.origin + best * ray.direction, r * normal};
     }
     default:

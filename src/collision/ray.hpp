@@ -1,5 +1,6 @@
 // Ray casts against FCL shapes (FCL 0.7 has no ray query): closed forms in the shape's frame for the
-// primitives, Moeller-Trumbore for triangle meshes (private to vsd::collision).
+// primitives, Moeller-Trumbore on the triangles of a mesh's FCL bounding-volume tree (OBBRSS) that the ray
+// enters (private to vsd::collision).
 #pragma once
 
 #include <fcl/geometry/collision_geometry.h>

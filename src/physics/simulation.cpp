@@ -6,6 +6,8 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <unordered_map>
@@ -69,6 +71,25 @@ Eigen::Matrix3d from_ode(const dReal* r) {
   return m;
 }
 
+// The ODE triangle data of one scene::Geometry (scaled vertices, indices, and their mass properties per
+// unit density), shared by every trimesh geom of a hull with that geometry. ODE keeps pointers into the
+// arrays, so they live as long as the last geom built from them (each GeomRec holds a reference); a
+// changed geometry gets a new MeshData, and the geoms built from the old one are rebuilt.
+struct MeshData {
+  std::vector<dReal> vertices;  // x, y, z per vertex, scaled
+  std::vector<dTriIndex> indices;
+  dTriMeshDataID data = nullptr;
+  double volume = 0.0;                                      // signed (> 0 for a closed, outward mesh)
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();       // of the enclosed volume
+  Eigen::Matrix3d second_moment = Eigen::Matrix3d::Zero();  // integral of x x^T over the volume
+  MeshData() = default;
+  MeshData(const MeshData&) = delete;
+  MeshData& operator=(const MeshData&) = delete;
+  ~MeshData() {
+    if (data != nullptr) dGeomTriMeshDataDestroy(data);
+  }
+};
+
 // What a geom is; a change of any of it means a new ODE geom.
 struct Shape {
   GeometryKind kind = GeometryKind::Mesh;
@@ -76,6 +97,7 @@ struct Shape {
   double radius = 0.0;
   double length = 0.0;
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  std::shared_ptr<const MeshData> mesh;  // meshes only
   bool operator==(const Shape&) const = default;
 };
 
@@ -177,6 +199,8 @@ struct Simulation::Impl {
   std::unordered_map<const Node3D*, BodyRec*> body_by_node;
   std::unordered_map<const Hull*, std::unique_ptr<GeomRec>> geoms;
   std::unordered_map<const Joint*, std::unique_ptr<JointRec>> joints;
+  // Trimesh data by geometry: built on first use, dropped when the geometry changes or goes.
+  std::unordered_map<const scene::Geometry*, std::shared_ptr<const MeshData>> meshes;
   std::vector<BodyRec*> order;  // bodies, parents before children (write-back order)
 
   bool dirty = true;                     // layout must be rebuilt
@@ -218,11 +242,20 @@ struct Simulation::Impl {
                               }));
     connections.push_back(state->on_property_changed(Joint::static_meta(), true)
                               .connect([this](SimStateInstance&, const MetaProperty& p) {
-                                if (&p != &Joint::vsd_prop_position() && &p != &Joint::vsd_prop_rate())
+                                if (&p != &Joint::vsd_prop_position() && &p != &Joint::vsd_prop_rate() &&
+                                    &p != &Joint::vsd_prop_position2() && &p != &Joint::vsd_prop_rate2())
                                   dirty = true;
                               }));
     connections.push_back(state->on_property_changed(scene::Geometry::static_meta(), true)
-                              .connect([this](SimStateInstance&, const MetaProperty&) { dirty = true; }));
+                              .connect([this](SimStateInstance& i, const MetaProperty&) {
+                                meshes.erase(i.as<scene::Geometry>());
+                                dirty = true;
+                              }));
+    connections.push_back(
+        idx.on_deleted(scene::Geometry::static_meta(), true).connect([this](SimStateInstance& i) {
+          meshes.erase(i.as<scene::Geometry>());
+          dirty = true;
+        }));
     // Density decides derived masses; friction and restitution are read at contact time.
     connections.push_back(state->on_property_changed(scene::Material::static_meta(), true)
                               .connect([this](SimStateInstance&, const MetaProperty& p) {
@@ -388,11 +421,73 @@ struct Simulation::Impl {
         out.normal = g->normal().normalized();
         break;
       case GeometryKind::Mesh:
-        warn("collision hull " + describe(h) + ": meshes are not simulated by vsd::physics yet (" +
-             g->describe() + "); it does not collide");
-        return false;
+        if (!g->has_mesh_data()) {  // e.g. a URDF mesh whose file was missing: the loader warned already
+          warn("collision hull " + describe(h) + ": its mesh has no vertices (" + g->describe() +
+               "); it does not collide");
+          return false;
+        }
+        out.mesh = mesh_data(h, *g);
+        break;
     }
     return true;
+  }
+
+  // The shared trimesh data of @p g, built (and validated) on first use.
+  std::shared_ptr<const MeshData> mesh_data(const Hull& h, const scene::Geometry& g) {
+    if (auto it = meshes.find(&g); it != meshes.end()) return it->second;
+    auto bad = [&](const std::string& what) {
+      detail_throw("collision hull " + describe(h) + ", geometry " + g.describe() + ": " + what);
+    };
+    const auto& v = g.vertices();
+    const auto& f = g.facets();
+    if (f.empty()) bad("a mesh needs triangles (its facet list is empty)");
+    if (f.size() % 3 != 0)
+      bad("the facet list holds " + std::to_string(f.size()) + " indices, not a multiple of 3");
+    if (!finite(g.scale()) || g.scale().cwiseAbs().minCoeff() == 0.0)
+      bad("the mesh scale must be finite and non-zero");
+    if (v.size() > static_cast<std::size_t>(std::numeric_limits<int>::max() / 3))
+      bad("too many vertices for ODE");
+    auto m = std::make_shared<MeshData>();
+    m->vertices.reserve(v.size() * 3);
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (!finite(v[i])) bad("vertex " + std::to_string(i) + " is not finite");
+      const Eigen::Vector3d p = v[i].cwiseProduct(g.scale());
+      m->vertices.insert(m->vertices.end(), {p.x(), p.y(), p.z()});
+    }
+    m->indices.reserve(f.size());
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      if (f[i] < 0 || static_cast<std::size_t>(f[i]) >= v.size())
+        bad("facet " + std::to_string(i / 3) + " refers to vertex " + std::to_string(f[i]) +
+            ", but there are " + std::to_string(v.size()) + " vertices");
+      m->indices.push_back(static_cast<dTriIndex>(f[i]));
+    }
+    // A negative scale mirrors the mesh and turns its facets inside out: reverse them back.
+    if (g.scale().prod() < 0.0)
+      for (std::size_t i = 0; i < m->indices.size(); i += 3) std::swap(m->indices[i + 1], m->indices[i + 2]);
+    // Volume, centroid and second moment by the divergence theorem: the signed tetrahedra from the origin
+    // to each facet (for a tetrahedron 0, a, b, c of volume V: integral of x x^T = V/20 (sum of x_i x_i^T
+    // + s s^T), s = a + b + c).
+    Eigen::Vector3d first = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < m->indices.size(); i += 3) {
+      const auto at = [&](std::size_t k) {
+        const dReal* p = &m->vertices[3 * static_cast<std::size_t>(m->indices[i + k])];
+        return Eigen::Vector3d(p[0], p[1], p[2]);
+      };
+      const Eigen::Vector3d a = at(0), b = at(1), c = at(2), sum = a + b + c;
+      const double vol = a.dot(b.cross(c)) / 6.0;
+      m->volume += vol;
+      first += vol * sum / 4.0;
+      m->second_moment +=
+          vol / 20.0 * (a * a.transpose() + b * b.transpose() + c * c.transpose() + sum * sum.transpose());
+    }
+    if (m->volume != 0.0) m->centroid = first / m->volume;
+    m->data = dGeomTriMeshDataCreate();
+    dGeomTriMeshDataBuildDouble(m->data, m->vertices.data(), 3 * sizeof(dReal), static_cast<int>(v.size()),
+                                m->indices.data(), static_cast<int>(m->indices.size()),
+                                3 * sizeof(dTriIndex));
+    std::shared_ptr<const MeshData> shared = std::move(m);
+    meshes.emplace(&g, shared);
+    return shared;
   }
 
   static Eigen::Isometry3d relative(const Node3D& body, const Node3D& hull) {
@@ -448,6 +543,23 @@ struct Simulation::Impl {
           case GeometryKind::Capsule:
             dMassSetCapsule(&m, rho, 3, g.shape.radius, g.shape.length);
             break;
+          case GeometryKind::Mesh: {
+            const MeshData& md = *g.shape.mesh;
+            // An open or inside-out mesh has no (or a negative) volume: its mass would be nonsense.
+            if (!(md.volume > 0.0))
+              detail_throw("collision hull " + describe(*g.hull) + ", geometry " +
+                           g.hull->geometry()->describe() + ": the mesh encloses no positive volume (" +
+                           std::to_string(md.volume) +
+                           " m^3): it must be closed with its facets wound counter-clockwise seen from "
+                           "outside, or the body needs an explicit mass and inertia_diagonal");
+            // dMass holds the inertia about the body origin (here the mesh origin) with the centre c.
+            const Eigen::Matrix3d c2 = rho * md.second_moment;
+            const Eigen::Matrix3d inertia = Eigen::Matrix3d::Identity() * c2.trace() - c2;
+            dMassSetParameters(&m, rho * md.volume, md.centroid.x(), md.centroid.y(), md.centroid.z(),
+                               inertia(0, 0), inertia(1, 1), inertia(2, 2), inertia(0, 1), inertia(0, 2),
+                               inertia(1, 2));
+            break;
+          }
           default:
             continue;
         }
@@ -477,7 +589,7 @@ struct Simulation::Impl {
       } else {
         bad("no mass: set RigidBody.mass and inertia_diagonal, or give the body collision hulls (role "
             "Collision) "
-            "with primitive geometry");
+            "with primitive or closed mesh geometry");
       }
     }
     // ODE's own check (positive definite inertia, triangle inequalities of the principal moments).
@@ -623,6 +735,18 @@ struct Simulation::Impl {
       if (j.kind() != JointKind::Slider && (j.lower() < -M_PI || j.upper() > M_PI))
         bad("angle limits must lie in [-pi, pi]");
     }
+    if (!std::isfinite(j.lower2()) || !std::isfinite(j.upper2()) || !std::isfinite(j.motor_velocity2()) ||
+        !std::isfinite(j.motor_max_force2()) || j.motor_max_force2() < 0.0)
+      bad("second-axis limits and motor values must be finite, motor_max_force2 >= 0");
+    if (j.kind() != JointKind::Universal && (j.has_limits2() || j.motor_max_force2() > 0.0))
+      bad("second-axis limits and motors (has_limits2, motor_max_force2) apply to universal joints only");
+    if (j.has_limits2()) {
+      if (j.lower2() > j.upper2()) bad("lower2 limit above upper2 limit");
+      // ODE's second universal angle is an elevation out of the plane normal to axis 1: it never leaves
+      // [-pi/2, pi/2], so a stop beyond that would never be reached.
+      if (j.lower2() < -M_PI / 2 || j.upper2() > M_PI / 2)
+        bad("second-axis angle limits must lie in [-pi/2, pi/2]");
+    }
     return {&j, oit->second, other, wi};
   }
 
@@ -685,6 +809,7 @@ struct Simulation::Impl {
   }
 
   static dGeomID make_geom(dSpaceID space, const Shape& s) {
+    if (s.kind == GeometryKind::Mesh) return dCreateTriMesh(space, s.mesh->data, nullptr, nullptr, nullptr);
     switch (s.kind) {
       case GeometryKind::Box:
         return dCreateBox(space, s.size.x(), s.size.y(), s.size.z());
@@ -699,7 +824,7 @@ struct Simulation::Impl {
       case GeometryKind::Mesh:
         break;
     }
-    return nullptr;  // not reached: meshes are skipped by shape_of()
+    return nullptr;  // not reached: meshes are made above
   }
 
   void set_joint_params(JointRec& j) {
@@ -722,9 +847,18 @@ struct Simulation::Impl {
       case JointKind::Slider:
         params(&dJointSetSliderParam);
         break;
-      case JointKind::Universal:
+      case JointKind::Universal: {
         params(&dJointSetUniversalParam);
+        const double lo2 = e.has_limits2() ? e.lower2() : -dInfinity;
+        const double hi2 = e.has_limits2() ? e.upper2() : dInfinity;
+        dJointSetUniversalParam(j.joint, dParamLoStop2, -dInfinity);
+        dJointSetUniversalParam(j.joint, dParamHiStop2, dInfinity);
+        dJointSetUniversalParam(j.joint, dParamLoStop2, lo2);
+        dJointSetUniversalParam(j.joint, dParamHiStop2, hi2);
+        dJointSetUniversalParam(j.joint, dParamVel2, e.motor_velocity2());
+        dJointSetUniversalParam(j.joint, dParamFMax2, e.motor_max_force2());
         break;
+      }
       default:
         break;
     }
@@ -1177,6 +1311,8 @@ struct Simulation::Impl {
         case JointKind::Universal:
           pos = dJointGetUniversalAngle1(j->joint);
           rate = dJointGetUniversalAngle1Rate(j->joint);
+          j->ext->set_position2(dJointGetUniversalAngle2(j->joint));
+          j->ext->set_rate2(dJointGetUniversalAngle2Rate(j->joint));
           break;
         default:
           continue;
@@ -1221,6 +1357,10 @@ SimulationStats Simulation::stats() const noexcept {
   s.bodies = impl_->bodies.size();
   s.joints = impl_->joints.size();
   s.geoms = impl_->geoms.size();
+  std::unordered_set<const MeshData*> meshes;
+  for (const auto& [k, g] : impl_->geoms)
+    if (g->shape.mesh) meshes.insert(g->shape.mesh.get());
+  s.meshes = meshes.size();
   return s;
 }
 

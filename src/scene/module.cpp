@@ -8,6 +8,7 @@
 #include "vsd/scene/material.hpp"
 #include "vsd/scene/node3d.hpp"
 #include "vsd/scene/scene.hpp"
+#include "vsd/scene/support.hpp"
 #include "vsd/scene/texture_map.hpp"
 
 namespace vsd::scene {
@@ -26,6 +27,8 @@ void Module::register_types(vsd::Registry& registry) {
   registry.add<Link>();
   registry.add<Joint>();
   registry.add<Scene>();
+  registry.add_type<SpatialRelation>();
+  registry.add<Support>();
 }
 
 }  // namespace vsd::scene

@@ -8,6 +8,7 @@
 #include "vsd/core/error.hpp"
 #include "vsd/core/sim_state.hpp"
 #include "vsd/scene/node3d.hpp"
+#include "vsd/scene/support.hpp"
 
 namespace vsd::scene {
 
@@ -26,10 +27,26 @@ std::string name_of(const Node3D& n) { return "'" + n.name() + "' (id " + std::t
 SpatialView::SpatialView(SimState& state) : state_(state) {
   connections_.push_back(state.on_property_changed(Node3D::static_meta(), true)
                              .connect([this](SimStateInstance& inst, const MetaProperty& p) {
+                               // An attached or detached extension may be a Support.
+                               if (&p == &vsd::NamedModelInstance::vsd_prop_extensions()) {
+                                 rescan(static_cast<Node3D&>(inst));
+                                 return;
+                               }
                                if (relations_.empty()) return;
                                if (&p == &Node3D::vsd_prop_frame() || p.name() == "frame")
                                  on_moved(static_cast<vsd::Node&>(inst));
                              }));
+  connections_.push_back(state.on_property_changed(Support::static_meta(), true)
+                             .connect([this](SimStateInstance& i, const MetaProperty&) {
+                               if (auto* owner = static_cast<Support&>(i).owner())
+                                 if (auto* object = owner->as<Node3D>()) rescan(*object);
+                             }));
+  connections_.push_back(
+      state.index().on_deleted(Support::static_meta(), true).connect([this](SimStateInstance& i) {
+        auto& sup = static_cast<Support&>(i);
+        if (auto* owner = sup.owner())
+          if (auto* object = owner->as<Node3D>()) rescan(*object, &sup);
+      }));
   // A re-parented node may have moved in the world (its frame is now relative to another parent). A move
   // between parents attaches before it detaches, so the new parent is known only at the removal.
   const auto reparented = [this](vsd::Node&, vsd::Node& child) {
@@ -41,38 +58,108 @@ SpatialView::SpatialView(SimState& state) : state_(state) {
       state.index().on_deleted(Node3D::static_meta(), true).connect([this](SimStateInstance& i) {
         if (!relations_.empty()) drop(static_cast<vsd::Node&>(i));
       }));
+  // What the SimState holds already (a loaded file, a copied replica). Supports carried by others are put
+  // in force after theirs (by id, as a file or a replica orders them), which keeps the cycle check exact.
+  std::vector<Support*> sups = state.index().all<Support>();
+  std::sort(sups.begin(), sups.end(), [](const Support* a, const Support* b) { return a->id() < b->id(); });
+  for (Support* sup : sups)
+    if (auto* owner = sup->owner())
+      if (auto* object = owner->as<Node3D>()) rescan(*object);
 }
 
 SpatialView::~SpatialView() = default;
+
+std::string SpatialView::refusal(const Node3D& object, const Node3D& support) const {
+  if (&object == &support) return name_of(object) + " cannot be its own support";
+  for (const Node3D* s = &support; s != nullptr; s = support_of(*s))
+    if (s == &object)
+      return name_of(support) + " is carried by " + name_of(object) + ", so it cannot carry it";
+  if (at_or_below(support, object))
+    return name_of(support) + " lies below " + name_of(object) +
+           " in the spanning tree, so it cannot carry it";
+  return {};
+}
+
+void SpatialView::rescan(Node3D& object, const Support* ignore) {
+  const Support* sup = nullptr;
+  for (const vsd::Extension* e : object.extensions())
+    if (const auto* x = e->as<Support>(); x != nullptr && x != ignore && x->support().get() != nullptr) {
+      sup = x;
+      break;
+    }
+  if (sup == nullptr) {
+    remove(object);
+    return;
+  }
+  Node3D& support = *sup->support();
+  auto it = relations_.find(&object);
+  if (it != relations_.end() && it->second.support == &support) {  // same support: the kind may have changed
+    it->second.kind = sup->relation();
+    return;
+  }
+  // Checked against the relations without this object's own (it is being replaced).
+  std::optional<Relation> old;
+  if (it != relations_.end()) {
+    old = it->second;
+    relations_.erase(it);
+  }
+  if (std::string why = refusal(object, support); !why.empty() || &support.state() != &state_) {
+    if (why.empty()) why = name_of(support) + " belongs to another SimState";
+    std::string text = "spatial view: the Support of " + name_of(object) + " is not in force: " + why;
+    if (std::find(warnings_.begin(), warnings_.end(), text) == warnings_.end())
+      warnings_.push_back(std::move(text));
+    if (old) removed_.emit(object);
+    return;
+  }
+  if (stale_) refresh_offsets();
+  // The relative pose now (the view keeps it equal to the current one); during a bundle the poses may be
+  // half applied: every later change of the bundle recomputes it (on_moved).
+  Eigen::Isometry3d offset = Eigen::Isometry3d::Identity();
+  const Eigen::Isometry3d& sw = support.world_frame();
+  const Eigen::Isometry3d& ow = object.world_frame();
+  if (sw.matrix().allFinite() && ow.matrix().allFinite()) offset = sw.inverse() * ow;
+  relations_[&object] = Relation{&support, sup->relation(), offset};
+  if (!old) added_.emit(object);
+}
+
+void SpatialView::remove(Node3D& object) {
+  if (!relations_.contains(&object)) return;
+  removed_.emit(object);
+  relations_.erase(&object);  // by key: a listener may have changed the map
+}
 
 void SpatialView::relate(Node3D& object, Node3D& support, SpatialRelation relation) {
   if (&object.state() != &state_ || &support.state() != &state_)
     throw Error("spatial view: " + name_of(object) + " and " + name_of(support) +
                 " must belong to the view's SimState");
-  if (&object == &support) throw Error("spatial view: " + name_of(object) + " cannot be its own support");
-  for (Node3D* s = &support; s != nullptr; s = support_of(*s))
-    if (s == &object)
-      throw Error("spatial view: " + name_of(support) + " is carried by " + name_of(object) +
-                  ", so it cannot carry it");
-  if (at_or_below(support, object))
-    throw Error("spatial view: " + name_of(support) + " lies below " + name_of(object) +
-                " in the spanning tree, so it cannot carry it");
+  if (std::string why = refusal(object, support); !why.empty()) throw Error("spatial view: " + why);
   const Eigen::Isometry3d& sw = support.world_frame();
   const Eigen::Isometry3d& ow = object.world_frame();
   if (!sw.matrix().allFinite() || !ow.matrix().allFinite())
     throw Error("spatial view: the world poses of " + name_of(object) + " and " + name_of(support) +
                 " must be finite to relate them");
   if (stale_) refresh_offsets();
-  const bool added = !relations_.contains(&object);
-  relations_[&object] = Relation{&support, relation, sw.inverse() * ow};
-  if (added) added_.emit(object);
+  // The database is the truth: write the Support; the listeners put it in force.
+  Support* sup = object.find_extension<Support>();
+  if (sup == nullptr) {
+    sup = &state_.create<Support>();
+    sup->set_support(&support);
+    sup->set_relation(relation);
+    object.add_extension(*sup);
+  } else {
+    sup->set_relation(relation);
+    sup->set_support(&support);
+  }
 }
 
 bool SpatialView::release(Node3D& object) {
-  auto it = relations_.find(&object);
-  if (it == relations_.end()) return false;
-  removed_.emit(object);
-  relations_.erase(&object);  // by key: a listener may have changed the map
+  if (!relations_.contains(&object)) return false;
+  // Every Support of the object goes (a file may hold more than one); the listeners end the relation.
+  std::vector<Support*> sups;
+  for (vsd::Extension* e : object.extensions())
+    if (auto* x = e->as<Support>()) sups.push_back(x);
+  for (Support* x : sups) state_.destroy(*x);
+  remove(object);
   return true;
 }
 
@@ -145,7 +232,11 @@ void SpatialView::on_moved(vsd::Node& node) {
   // An applied bundle (undo, a replica's changes) already carries the moves the view would make, in an
   // order of its own: hold back, and take the poses it leaves as the new relative poses.
   if (state_.applying()) {
-    stale_ = true;
+    // Recomputed at every change of the bundle (not lazily after it: the first change after the bundle
+    // may be a support's move, and offsets taken then would already contain it), so the last change
+    // leaves them equal to the poses the bundle leaves.
+    Node3D::invalidate_below(node);
+    refresh_offsets();
     return;
   }
   if (stale_) refresh_offsets();

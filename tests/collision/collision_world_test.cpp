@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <optional>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -448,6 +451,120 @@ TEST_F(CollisionTest, RayCastReturnsTheFirstHitWithItsNormal) {
   // bad rays
   EXPECT_THROW((void)w.ray_cast(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()), vsd::Error);
   EXPECT_THROW((void)w.ray_cast(Eigen::Vector3d(NAN, 0, 0), Eigen::Vector3d::UnitX()), vsd::Error);
+}
+
+// A closed, bumpy sphere mesh (radius 2 +- 0.3) of 4 * n * (n - 1) triangles.
+void bumpy_sphere(Geometry& g, int n) {
+  std::vector<Eigen::Vector3d> v;
+  std::vector<std::int32_t> f;
+  v.emplace_back(0, 0, 2);
+  for (int i = 1; i < n; ++i)
+    for (int j = 0; j < 2 * n; ++j) {
+      const double th = M_PI * i / n, ph = M_PI * j / n;
+      const double r = 2 + 0.3 * std::sin(5 * th) * std::cos(3 * ph);
+      v.emplace_back(r * std::sin(th) * std::cos(ph), r * std::sin(th) * std::sin(ph), r * std::cos(th));
+    }
+  v.emplace_back(0, 0, -2);
+  const auto ring = [&](int i, int j) { return 1 + (i - 1) * 2 * n + (j % (2 * n)); };
+  for (int j = 0; j < 2 * n; ++j) {
+    f.insert(f.end(), {0, ring(1, j), ring(1, j + 1)});
+    f.insert(f.end(), {static_cast<std::int32_t>(v.size() - 1), ring(n - 1, j + 1), ring(n - 1, j)});
+  }
+  for (int i = 1; i + 1 < n; ++i)
+    for (int j = 0; j < 2 * n; ++j) {
+      f.insert(f.end(), {ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
+      f.insert(f.end(), {ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
+    }
+  g.set_kind(GeometryKind::Mesh);
+  g.set_vertices(v);
+  g.set_facets(f);
+}
+
+// Every triangle of @p g placed at @p pose, in world coordinates: the nearest hit (Moeller-Trumbore).
+std::optional<double> brute_force(const Geometry& g, const Eigen::Isometry3d& pose, const Eigen::Vector3d& o,
+                                  const Eigen::Vector3d& d) {
+  std::optional<double> best;
+  const auto& v = g.vertices();
+  const auto& f = g.facets();
+  for (std::size_t i = 0; i < f.size(); i += 3) {
+    const Eigen::Vector3d a = pose * v[f[i]], b = pose * v[f[i + 1]], c = pose * v[f[i + 2]];
+    const Eigen::Vector3d e1 = b - a, e2 = c - a, p = d.cross(e2);
+    const double det = e1.dot(p);
+    if (std::abs(det) < 1e-14 * e1.norm() * e2.norm()) continue;
+    const Eigen::Vector3d t0 = o - a;
+    const double u = t0.dot(p) / det;
+    if (u < 0 || u > 1) continue;
+    const Eigen::Vector3d q = t0.cross(e1);
+    const double w = d.dot(q) / det;
+    if (w < 0 || u + w > 1) continue;
+    const double t = e2.dot(q) / det;
+    if (t >= 0 && (!best || t < *best)) best = t;
+  }
+  return best;
+}
+
+TEST_F(CollisionTest, RayCastOnAMeshDescendsItsTreeAndAgreesWithEveryTriangle) {
+  auto& g = s.create<Geometry>();
+  keep(g);
+  bumpy_sphere(g, 40);  // 6,240 triangles
+  Eigen::Isometry3d pose = rotated_z(0.7, Eigen::Vector3d(1, -2, 3));
+  pose.rotate(Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitX()));
+  Hull& blob = hull(g, pose, "blob");
+  CollisionWorld w(s);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const Eigen::Vector3d centre = pose.translation();
+  int hits = 0;
+  for (int k = 0; k < 1500; ++k) {
+    // From outside towards a point near the surface (some miss), or from inside outwards.
+    const bool inside = k % 5 == 0;
+    const Eigen::Vector3d o =
+        centre + (inside ? 0.5 : 6.0) * Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
+    const Eigen::Vector3d target = centre + 2.4 * Eigen::Vector3d(u(rng), u(rng), u(rng));
+    const Eigen::Vector3d d = (target - o).normalized();
+    const auto expected = brute_force(g, pose, o, d);
+    const auto hit = w.ray_cast(o, d);
+    ASSERT_EQ(hit.has_value(), expected.has_value()) << "ray " << k;
+    if (!hit) continue;
+    ++hits;
+    EXPECT_EQ(hit->hull, &blob);
+    EXPECT_NEAR(hit->distance, *expected, 1e-9) << "ray " << k;
+    EXPECT_LT(hit->normal.dot(d), 0.0);  // facing the ray
+    // Cut just short of the hit: nothing; just beyond: the same hit.
+    EXPECT_FALSE(w.ray_cast(o, d, *expected - 1e-6)) << "ray " << k;
+    EXPECT_TRUE(w.ray_cast(o, d, *expected + 1e-6)) << "ray " << k;
+  }
+  EXPECT_GT(hits, 1000);
+  EXPECT_LT(hits, 1500);
+}
+
+TEST_F(CollisionTest, RaysThroughTheEdgesAndVerticesOfAFlatMeshAreNotLost) {
+  // A flat 40 x 40 grid (a tree box of zero height): rays straight down through vertices and edges.
+  auto& g = s.create<Geometry>();
+  keep(g);
+  std::vector<Eigen::Vector3d> v;
+  std::vector<std::int32_t> f;
+  constexpr int n = 40;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) v.emplace_back(i * 0.25, j * 0.25, 0);
+  const auto id = [](int i, int j) { return i * (n + 1) + j; };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      f.insert(f.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+  g.set_kind(GeometryKind::Mesh);
+  g.set_vertices(v);
+  g.set_facets(f);
+  hull(g, at(0, 0, 1), "floor");
+  CollisionWorld w(s);
+  for (int i = 0; i <= 2 * n; ++i)
+    for (int j = 0; j <= 2 * n; j += 7) {
+      const Eigen::Vector3d o(i * 0.125, j * 0.125, 5);
+      const auto hit = w.ray_cast(o, -Eigen::Vector3d::UnitZ());
+      ASSERT_TRUE(hit) << o.transpose();
+      EXPECT_NEAR(hit->distance, 4, 1e-12);
+      EXPECT_LT((hit->normal - Eigen::Vector3d::UnitZ()).norm(), 1e-12);
+    }
+  EXPECT_FALSE(w.ray_cast(Eigen::Vector3d(10.01, 5, 5), -Eigen::Vector3d::UnitZ()));  // beside the grid
 }
 
 // ---- degenerate input ------------------------------------------------------------------------------------

@@ -282,15 +282,6 @@ TEST_F(SimulationTest, OdeErrorHandlerThrowsAVsdErrorInsteadOfAborting) {
   SUCCEED();
 }
 
-TEST_F(SimulationTest, MeshHullsAreSkippedWithAWarning) {
-  auto& mesh = geometry(GeometryKind::Mesh);
-  hull(mesh, at(0, 0, 0), nullptr, nullptr, "statue");
-  sim().sync();
-  ASSERT_EQ(sim().warnings().size(), 1u);
-  EXPECT_THAT(sim().warnings()[0], HasSubstr("statue"));
-  EXPECT_EQ(sim().stats().geoms, 0u);
-}
-
 TEST_F(SimulationTest, BodiesSaveAndLoadThroughVsdIoAndGoOnIdentically) {
   auto& g = geometry(GeometryKind::Box, Eigen::Vector3d(0.2, 0.3, 0.4));
   auto& box = hull(g, at(0, 0, 10));
@@ -431,6 +422,120 @@ TEST_F(SimulationTest, JointsWithLimitsAndMotors) {
   // Deleting a joint releases the body.
   s.destroy(slider);
   EXPECT_EQ(sim().stats().joints, 2u);
+}
+
+// A universal joint holding a rod to the static world at its end: axis 1 (x) is fixed in the rod, axis 2
+// (y) in the world. Without gravity only the motors act, so each angle follows its motor and stops at
+// its limit; the rod's pose is then the rotation about y by the second angle, checkable by hand.
+TEST_F(SimulationTest, UniversalJointSecondAxisHasLimitsAndAMotor) {
+  world->set_gravity(Eigen::Vector3d::Zero());
+  auto& g = geometry(GeometryKind::Box, Eigen::Vector3d(0.1, 0.1, 1));
+  auto& rod = hull(g, at(0, 0, 0.5), nullptr, nullptr, "rod");
+  body(rod, 1.0);
+  auto& u = s.create<Joint>();
+  u.set_kind(JointKind::Universal);
+  u.set_anchor(Eigen::Vector3d(0, 0, -0.5));  // the rod's lower end, at the world origin
+  u.set_axis(Eigen::Vector3d::UnitX());
+  u.set_axis2(Eigen::Vector3d::UnitY());
+  u.set_motor_velocity2(0.5);
+  u.set_motor_max_force2(100.0);
+  u.set_has_limits2(true);
+  u.set_lower2(-0.2);
+  u.set_upper2(0.4);
+  rod.add_extension(u);
+  env.step();
+  EXPECT_NEAR(u.rate2(), 0.5, 1e-3);  // 100 N m on about 0.34 kg m^2: the motor's velocity at once
+  EXPECT_NEAR(u.rate(), 0.0, 1e-6);   // nothing drives the first axis
+  for (int i = 0; i < 40; ++i) env.step();
+  EXPECT_NEAR(u.position2(), 0.5 * 0.41, 0.01);  // 41 scheduler steps of 10 ms at 0.5 rad/s
+  for (int i = 0; i < 100; ++i) env.step();
+  EXPECT_NEAR(u.position2(), 0.4, 0.01);  // held at the upper stop
+  EXPECT_NEAR(u.rate2(), 0.0, 1e-2);
+  EXPECT_NEAR(u.position(), 0.0, 1e-6);
+  // The rod turned about the world's y axis through the anchor by the second angle (ODE's sign).
+  const Eigen::AngleAxisd turned(rod.world_frame().rotation());
+  EXPECT_NEAR(turned.angle(), 0.4, 0.01);
+  EXPECT_NEAR(std::abs(turned.axis().y()), 1.0, 1e-6);
+  EXPECT_TRUE((rod.world_frame() * Eigen::Vector3d(0, 0, -0.5)).isZero(1e-3));
+  // Reversed, the motor runs to the lower stop; the first axis, with a motor of its own, turns meanwhile.
+  u.set_motor_velocity2(-1.0);
+  u.set_motor_velocity(0.3);
+  u.set_motor_max_force(100.0);
+  for (int i = 0; i < 150; ++i) env.step();
+  EXPECT_NEAR(u.position2(), -0.2, 0.01);
+  EXPECT_NEAR(u.rate(), 0.3, 1e-2);
+  // Without the stop the motor keeps its velocity past the old limit.
+  u.set_has_limits2(false);
+  u.set_motor_velocity(0.0);
+  u.set_motor_velocity2(-0.5);
+  for (int i = 0; i < 60; ++i) env.step();
+  EXPECT_NEAR(u.rate2(), -0.5, 1e-2);
+  EXPECT_LT(u.position2(), -0.45);
+
+  // The new properties save, load and replicate like the others.
+  SimState& replica = env.create_state("replica");
+  replica.copy_from(s);
+  s.start_recording();
+  u.set_has_limits2(true);
+  u.set_lower2(-0.7);
+  u.set_upper2(0.1);
+  u.set_motor_max_force2(7.0);
+  replica.apply(s.stop_recording());
+  const auto* ru = replica.find(u.id())->as<Joint>();
+  ASSERT_NE(ru, nullptr);
+  EXPECT_TRUE(ru->has_limits2());
+  EXPECT_EQ(ru->lower2(), -0.7);
+  EXPECT_EQ(ru->upper2(), 0.1);
+  EXPECT_EQ(ru->motor_velocity2(), -0.5);
+  EXPECT_EQ(ru->motor_max_force2(), 7.0);
+  vsd::Environment env2;
+  env2.use<Module>();
+  vsd::io::load_bytes(env2.main_state(), vsd::io::save_bytes(s, vsd::io::Format::Text));
+  auto joints = env2.main_state().index().all<Joint>();
+  ASSERT_EQ(joints.size(), 1u);
+  EXPECT_TRUE(joints[0]->has_limits2());
+  EXPECT_EQ(joints[0]->lower2(), -0.7);
+  EXPECT_EQ(joints[0]->upper2(), 0.1);
+  EXPECT_EQ(joints[0]->motor_velocity2(), -0.5);
+  EXPECT_EQ(joints[0]->motor_max_force2(), 7.0);
+  env.remove_state(replica);
+}
+
+TEST_F(SimulationTest, SecondAxisLimitsAndMotorsAreCheckedAndNameTheJoint) {
+  auto& g = geometry(GeometryKind::Box, Eigen::Vector3d(0.1, 0.1, 1));
+  auto& rod = hull(g, at(0, 0, 0.5), nullptr, nullptr, "rod");
+  body(rod, 1.0);
+  auto& j = s.create<Joint>();
+  j.set_name("wrist");
+  j.set_kind(JointKind::Hinge);
+  j.set_has_limits2(true);
+  rod.add_extension(j);
+  auto fails = [&](const char* what) {
+    EXPECT_THAT([&] { sim().sync(); }, ::testing::ThrowsMessage<vsd::Error>(
+                                           ::testing::AllOf(HasSubstr("'wrist'"), HasSubstr(what))));
+  };
+  fails("apply to universal joints only");
+  j.set_has_limits2(false);
+  j.set_motor_max_force2(1.0);
+  fails("apply to universal joints only");
+  j.set_kind(JointKind::Universal);
+  j.set_axis(Eigen::Vector3d::UnitX());
+  j.set_axis2(Eigen::Vector3d::UnitY());
+  j.set_motor_max_force2(-1.0);
+  fails("motor_max_force2 >= 0");
+  j.set_motor_max_force2(1.0);
+  j.set_motor_velocity2(std::nan(""));
+  fails("must be finite");
+  j.set_motor_velocity2(0.0);
+  j.set_has_limits2(true);
+  j.set_lower2(0.5);
+  j.set_upper2(0.1);
+  fails("lower2 limit above upper2");
+  j.set_lower2(-2.0);
+  fails("[-pi/2, pi/2]");
+  j.set_lower2(-1.0);
+  sim().sync();  // now valid
+  EXPECT_EQ(sim().stats().joints, 1u);
 }
 
 }  // namespace

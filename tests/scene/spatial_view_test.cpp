@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "vsd/core.hpp"
+#include "vsd/io.hpp"
 #include "vsd/scene.hpp"
 
 namespace vsd::scene {
@@ -197,6 +198,166 @@ TEST_F(SpatialViewTest, BadRelationsAreRejected) {
   view.relate(c, a, SpatialRelation::LiesOn);
   a.set_frame(pose(0, NAN, 0));
   EXPECT_TRUE(c.world_frame().matrix().allFinite());
+}
+
+// The node named @p name in @p state (the tests' names are unique).
+Node3D& named(SimState& state, const std::string& name) {
+  for (Node3D* n : state.index().all<Node3D>())
+    if (n->name() == name) return *n;
+  throw vsd::Error("no node " + name);
+}
+
+TEST_F(SpatialViewTest, RelationsAreSupportExtensionsWrittenThroughTheSetters) {
+  Node3D& table = node("table", pose(0, 0, 0));
+  Node3D& cup = node("cup", pose(0.1, 0, 0.8));
+  SpatialView view(s);
+  int changes = 0;
+  auto c = s.on_property_changed(Support::static_meta(), true)
+               .connect([&](SimStateInstance&, const MetaProperty&) { ++changes; });
+  view.relate(cup, table, SpatialRelation::LiesOn);
+  auto* sup = cup.find_extension<Support>();
+  ASSERT_NE(sup, nullptr);
+  EXPECT_EQ(sup->support().get(), &table);
+  EXPECT_EQ(sup->relation(), SpatialRelation::LiesOn);
+  EXPECT_GT(changes, 0);
+  // Writing the Support through its setters is the same as relate(): another view (and this one) follow.
+  Node3D& hand = node("hand", pose(0, 0, 1.5));
+  sup->set_relation(SpatialRelation::GrabbedBy);
+  sup->set_support(&hand);
+  EXPECT_EQ(view.support_of(cup), &hand);
+  EXPECT_EQ(view.relation_of(cup), SpatialRelation::GrabbedBy);
+  hand.set_frame(pose(0, 1, 1.5));
+  expect_pose(cup.world_frame(), pose(0, 1, 0) * pose(0.1, 0, 0.8));
+  SpatialView second(s);  // made later: reads the relation from the SimState
+  EXPECT_EQ(second.support_of(cup), &hand);
+  EXPECT_TRUE(second.offset_of(cup)->isApprox(hand.world_frame().inverse() * cup.world_frame(), 1e-12));
+  // Releasing destroys the extension; both views end the relation.
+  EXPECT_TRUE(view.release(cup));
+  EXPECT_EQ(cup.find_extension<Support>(), nullptr);
+  EXPECT_EQ(second.support_of(cup), nullptr);
+  EXPECT_EQ(s.index().all<Support>().size(), 0u);
+}
+
+TEST_F(SpatialViewTest, RelationsSaveAndLoadThroughVsdIo) {
+  Node3D& table = node("table", pose(0, 0, 0));
+  Node3D& tray = node("tray", pose(0, 0, 0.8));
+  Node3D& cup = node("cup", pose(0.1, 0, 0.85, 0.4));
+  Node3D& gripper = node("gripper", pose(5, 5, 2));
+  Node3D& sensor = node("sensor", pose(5, 5, 2.2));
+  {
+    SpatialView view(s);
+    view.relate(tray, table, SpatialRelation::LiesOn);
+    view.relate(cup, tray, SpatialRelation::LiesOn);
+    view.relate(sensor, gripper, SpatialRelation::AttachedTo);
+    view.relate(tray, gripper, SpatialRelation::GrabbedBy);  // replaces "lies on the table"
+  }
+  for (const auto format : {vsd::io::Format::Text, vsd::io::Format::Binary}) {
+    Environment env2;
+    env2.use<Module>();
+    SimState& loaded = env2.main_state();
+    vsd::io::load_bytes(loaded, vsd::io::save_bytes(s, format));
+    SpatialView view(loaded);
+    EXPECT_TRUE(view.warnings().empty());
+    EXPECT_EQ(view.size(), 3u);
+    Node3D &ltray = named(loaded, "tray"), &lcup = named(loaded, "cup"), &lgripper = named(loaded, "gripper");
+    EXPECT_EQ(view.support_of(ltray), &lgripper);
+    EXPECT_EQ(view.relation_of(ltray), SpatialRelation::GrabbedBy);
+    EXPECT_EQ(view.support_of(lcup), &ltray);
+    EXPECT_EQ(view.relation_of(lcup), SpatialRelation::LiesOn);
+    EXPECT_EQ(view.support_of(named(loaded, "sensor")), &lgripper);
+    EXPECT_EQ(view.relation_of(named(loaded, "sensor")), SpatialRelation::AttachedTo);
+    EXPECT_EQ(view.support_of(named(loaded, "table")), nullptr);
+    // In force after loading: the gripper carries tray, cup and sensor; the table carries nothing.
+    lgripper.set_frame(pose(5, 5, 3));
+    expect_pose(lcup.world_frame(), pose(0, 0, 1) * cup.world_frame());
+    expect_pose(named(loaded, "sensor").world_frame(), pose(0, 0, 1) * sensor.world_frame());
+    named(loaded, "table").set_frame(pose(9, 0, 0));
+    expect_pose(ltray.world_frame(), pose(0, 0, 1) * tray.world_frame());
+  }
+}
+
+TEST_F(SpatialViewTest, AReplicaApplyingTheBundlesEndsWithTheSameRelations) {
+  Node3D& table = node("table", pose(0, 0, 0));
+  Node3D& cup = node("cup", pose(0.1, 0, 0.8));
+  Node3D& gripper = node("gripper", pose(0, 0, 1.2));
+  SimState& replica = env.create_state("replica");
+  replica.copy_from(s);
+  SpatialView view(s);
+  SpatialView rview(replica);  // a view at the replica too: it holds back while bundles are applied
+  auto rnode = [&](const Node3D& n) -> Node3D& { return *replica.find(n.id())->as<Node3D>(); };
+  auto sync = [&] {
+    replica.apply(s.stop_recording());
+    std::string diff;
+    EXPECT_TRUE(replica.equals(s, &diff)) << diff;
+    s.start_recording();
+  };
+  s.start_recording();
+  view.relate(cup, table, SpatialRelation::LiesOn);
+  sync();
+  EXPECT_EQ(rview.support_of(rnode(cup)), &rnode(table));
+  EXPECT_EQ(rview.relation_of(rnode(cup)), SpatialRelation::LiesOn);
+  view.relate(cup, gripper, SpatialRelation::GrabbedBy);  // grabbed: the same Support, new values
+  gripper.set_frame(pose(1, 0, 1.5));                     // the cup follows (recorded at the source)
+  sync();
+  EXPECT_EQ(rview.support_of(rnode(cup)), &rnode(gripper));
+  EXPECT_EQ(rview.relation_of(rnode(cup)), SpatialRelation::GrabbedBy);
+  expect_pose(rnode(cup).world_frame(), cup.world_frame());
+  // The replica's view puts the relation in force locally too, with the pose the bundle left.
+  rnode(gripper).set_frame(pose(1, 0, 2.5));
+  expect_pose(rnode(cup).world_frame(), pose(0, 0, 1) * cup.world_frame());
+  rnode(gripper).set_frame(pose(1, 0, 1.5));
+  view.release(cup);
+  sync();
+  EXPECT_EQ(rview.support_of(rnode(cup)), nullptr);
+  EXPECT_EQ(rview.size(), 0u);
+  // Undo at the source brings the relation back, at the source and the replica alike.
+  view.relate(cup, table, SpatialRelation::LiesOn);
+  Transaction t = s.stop_recording();
+  s.apply(t.inverted());
+  EXPECT_EQ(view.support_of(cup), nullptr);
+  s.apply(t);
+  EXPECT_EQ(view.support_of(cup), &table);
+  replica.apply(t);
+  EXPECT_EQ(rview.support_of(rnode(cup)), &rnode(table));
+  env.remove_state(replica);
+}
+
+TEST_F(SpatialViewTest, SupportsTheViewCannotPutInForceAreWarnings) {
+  Node3D& a = node("a", pose(0, 0, 0));
+  Node3D& b = node("b", pose(1, 0, 0), &a);
+  Node3D& c = node("c", pose(2, 0, 0));
+  // Written directly (as a hand-edited file could): a cycle c <-> a, and a support below its object.
+  auto support = [&](Node3D& object, Node3D& on) {
+    auto& x = s.create<Support>();
+    x.set_support(&on);
+    object.add_extension(x);
+  };
+  support(c, a);
+  support(a, c);
+  support(a, b);  // a second Support on a: the first one counts
+  SpatialView view(s);
+  EXPECT_EQ(view.size(), 1u);
+  EXPECT_EQ(view.support_of(c), &a);
+  EXPECT_EQ(view.support_of(a), nullptr);
+  ASSERT_EQ(view.warnings().size(), 1u);
+  EXPECT_NE(
+      view.warnings()[0].find("Support of 'a' (id " + std::to_string(a.id()) + ") is not in force: 'c'"),
+      std::string::npos)
+      << view.warnings()[0];
+  a.set_frame(pose(0, 1, 0));  // no endless chase
+  expect_pose(c.world_frame(), pose(2, 1, 0));
+  // Set through a setter later: below the object in the spanning tree.
+  auto& d = s.create<Support>();
+  d.set_support(&b);
+  b.add_extension(d);  // b's support is b itself
+  EXPECT_EQ(view.support_of(b), nullptr);
+  EXPECT_NE(view.warnings().back().find("cannot be its own support"), std::string::npos)
+      << view.warnings().back();
+  // Deleting the support nulls the reference: the relation ends, the extension stays as data.
+  s.destroy(a);
+  EXPECT_EQ(view.size(), 0u);
+  ASSERT_NE(c.find_extension<Support>(), nullptr);
+  EXPECT_EQ(c.find_extension<Support>()->support().get(), nullptr);
 }
 
 }  // namespace

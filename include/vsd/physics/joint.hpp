@@ -2,7 +2,8 @@
  *  @brief physics::Joint: a dynamic joint (hinge, slider, universal, ball, fixed) between the body it is
  *  attached to (its owner, an extension of a Node3D with a RigidBody) and another body, or the static
  *  world. Anchor and axes are in the owner node's frame; joint positions are measured from the pose the
- *  bodies have when the joint is built (created, loaded, or changed).
+ *  bodies have when the joint is built (created, loaded, or changed). A universal joint has limits and a
+ *  motor on each of its two axes (`..2` for `axis2`).
  *
  *  scene::Joint is the kinematic description a URDF gives; physics::Joint is what ODE simulates. The
  *  function make_dynamic() (vsd/physics/simulation.hpp) turns a loaded URDF scene into bodies and joints.
@@ -49,9 +50,21 @@ class Joint : public vsd::Extension {
   /// (N m or N); a max force of 0 switches the motor off.
   VSD_PROPERTY(double, motor_velocity, 0.0)
   VSD_PROPERTY(double, motor_max_force, 0.0)
+  /// Universal joints only: limits of the angle about `axis2` (rad, in [-pi/2, pi/2]: ODE measures the
+  /// second angle as an elevation), like `has_limits`, `lower` and `upper` for `axis`.
+  VSD_PROPERTY(bool, has_limits2, false)
+  VSD_PROPERTY(double, lower2, 0.0)
+  VSD_PROPERTY(double, upper2, 0.0)
+  /// Universal joints only: the motor about `axis2` (rad/s, N m), like `motor_velocity` and
+  /// `motor_max_force` for `axis`.
+  VSD_PROPERTY(double, motor_velocity2, 0.0)
+  VSD_PROPERTY(double, motor_max_force2, 0.0)
   /// Position (rad or m) and its rate about/along `axis`, written after each step (not saved).
   VSD_PROPERTY(double, position, 0.0, vsd::Distributed)
   VSD_PROPERTY(double, rate, 0.0, vsd::Distributed)
+  /// Universal joints only: angle (rad) and rate about `axis2`, written after each step (not saved).
+  VSD_PROPERTY(double, position2, 0.0, vsd::Distributed)
+  VSD_PROPERTY(double, rate2, 0.0, vsd::Distributed)
 };
 
 }  // namespace vsd::physics

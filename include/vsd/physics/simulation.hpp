@@ -59,6 +59,7 @@ struct SimulationStats {
   std::size_t bodies = 0;
   std::size_t joints = 0;
   std::size_t geoms = 0;     ///< body and static hull geoms
+  std::size_t meshes = 0;    ///< ODE trimesh data sets in use (one per mesh Geometry, shared by its hulls)
   std::size_t contacts = 0;  ///< contact points of the last step
   std::size_t rebuilds = 0;  ///< layout rebuilds so far
   std::uint64_t steps = 0;   ///< ODE steps so far (all worlds)
@@ -89,7 +90,8 @@ class Simulation {
   /// @brief True when @p body currently exists in ODE.
   [[nodiscard]] bool simulates(const RigidBody& body) const noexcept;
   [[nodiscard]] SimulationStats stats() const noexcept;
-  /// @brief ODE's messages and what vsd::physics skipped (e.g. mesh hulls), oldest first.
+  /// @brief ODE's messages and what vsd::physics skipped (e.g. hulls without geometry or with a mesh
+  /// that has no vertices), oldest first.
   [[nodiscard]] const std::vector<std::string>& warnings() const noexcept;
   [[nodiscard]] vsd::SimState& state() const noexcept;
 

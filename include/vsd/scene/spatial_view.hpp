@@ -5,8 +5,8 @@
  *  The spanning tree says who owns whom; where things are is often another matter. A cup lies on a
  *  tray that lies on a table; a gripper grabs the tray and carries tray and cup away; it releases the
  *  tray on a shelf. None of that needs the cup or the tray to change parents (which would change what
- *  saving, deleting or replicating them means). A SpatialView holds these relations as a forest of its
- *  own — every related object has one support — and keeps them in force:
+ *  saving, deleting or replicating them means). The relations form a forest of their own — every related
+ *  object has one support — and a SpatialView keeps them in force:
  *
  *  - relate() and release() move nothing: the object's world pose is the same before and after, at the
  *    moment of grabbing as at the moment of releasing. relate() remembers the object's pose relative to
@@ -20,7 +20,17 @@
  *  While a bundle is applied (undo, a replica's changes) the view holds back: the bundle carries the moves
  *  it made at the source already; the poses the bundle leaves become the new relative poses.
  *
- *  Nothing polls: the view listens to Node3D frame changes, re-parentings and deletions of its SimState.
+ *  The relations are database state: a scene::Support extension on the object (vsd/scene/support.hpp)
+ *  names its support and the kind of relation. relate() and release() write it through the ordinary
+ *  setters (create and attach, set, destroy), so vsd::io saves and loads relations and a replica applying
+ *  the recorded bundles ends with the same ones. The view reads what is in the SimState when it is made
+ *  and follows Support changes through the signals, whoever makes them (a loaded file, a replica's bundle,
+ *  an undo, a setter). A Support that the view cannot put in force — a support carried by its own object,
+ *  or below it in the spanning tree, as a hand-edited file may hold — is ignored with a warning
+ *  (warnings()); every view of one SimState sees the same relations.
+ *
+ *  Nothing polls: the view listens to Node3D frame and extension changes, Support changes, re-parentings
+ *  and deletions of its SimState.
  *  Each change costs O(relations × tree depth) while the view holds relations and one branch when it
  *  holds none. An object or support that is deleted leaves the view (on_removed()). The view is a
  *  Container: its nodes are the related objects, supports before what they carry.
@@ -32,12 +42,14 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "vsd/core/container.hpp"
 #include "vsd/core/meta_type.hpp"
 #include "vsd/scene/namespace.hpp"
+#include "vsd/scene/support.hpp"
 
 namespace vsd {
 class SimState;
@@ -47,27 +59,20 @@ namespace vsd::scene {
 
 class Node3D;
 
-/// @brief How an object relates to its support (all of them mean "moves with it" to the view; the kind
-/// tells applications what it means: a gripper releases what it grabbed, not what lies on it).
-enum class SpatialRelation : std::uint8_t {
-  LiesOn,     ///< resting on the support (a cup on a table)
-  GrabbedBy,  ///< held by a gripper or a hand
-  AttachedTo  ///< fixed to the support (a sensor on a vehicle)
-};
-VSD_ENUM(SpatialRelation, LiesOn, GrabbedBy, AttachedTo)
-
 class SpatialView : public vsd::Container {
  public:
-  /// @brief An empty view of the Node3Ds of @p state.
+  /// @brief A view of the Node3Ds of @p state, holding the relations its Support extensions record.
   explicit SpatialView(SimState& state);
   ~SpatialView() override;
 
   /// @brief From now on @p object moves with @p support (replacing a relation it had). Nothing moves.
+  /// Writes the object's Support extension (made and attached when it has none) through its setters.
   /// @throws vsd::Error when either node belongs to another SimState, when they are the same node, when
   /// @p support is carried by @p object (directly or through others) or lies below it in the spanning
   /// tree (the object would have to follow its own motion), or when a world pose is not finite.
   void relate(Node3D& object, Node3D& support, SpatialRelation relation);
-  /// @brief Ends @p object's relation; it stays where it is. Returns false when it had none.
+  /// @brief Ends @p object's relation (destroys its Support extension); it stays where it is. Returns
+  /// false when it had none.
   bool release(Node3D& object);
 
   /// @brief The support of @p object, or nullptr.
@@ -81,6 +86,9 @@ class SpatialView : public vsd::Container {
   /// @brief Everything that moves with @p support through the view (carried directly or indirectly),
   /// supports before what they carry.
   [[nodiscard]] std::vector<Node3D*> carried_closure(const Node3D& support) const;
+  /// @brief Support extensions the view could not put in force (a cycle, a support below its object),
+  /// each naming the nodes and why, oldest first.
+  [[nodiscard]] const std::vector<std::string>& warnings() const noexcept { return warnings_; }
 
   [[nodiscard]] std::size_t size() const override { return relations_.size(); }
   [[nodiscard]] bool contains(const vsd::Node& n) const override;
@@ -97,12 +105,18 @@ class SpatialView : public vsd::Container {
   void on_moved(vsd::Node& node);
   void refresh_offsets() const;
   void drop(vsd::Node& node);
+  // Puts the Support extensions of @p object in force (or ends its relation), skipping @p ignore.
+  void rescan(Node3D& object, const Support* ignore = nullptr);
+  void remove(Node3D& object);
+  // Why @p support cannot carry @p object ("" when it can).
+  [[nodiscard]] std::string refusal(const Node3D& object, const Node3D& support) const;
 
   SimState& state_;
   mutable std::unordered_map<Node3D*, Relation> relations_;  // by object
   mutable bool stale_ = false;  // a bundle moved things: offsets are recomputed from the poses
   std::vector<Connection> connections_;
   int enforcing_ = 0;  // > 0 while the view itself moves objects
+  std::vector<std::string> warnings_;
 };
 
 }  // namespace vsd::scene
