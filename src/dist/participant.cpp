@@ -95,12 +95,51 @@ void release_domain(std::uint32_t id) {
 struct Message {
   std::uint64_t sender = 0;
   std::uint64_t seq = 0;
+  std::uint64_t clock = 0;
   std::uint64_t target = 0;
   Kind kind{};
   std::vector<std::uint8_t> payload;  // after the envelope
 };
 
 using OwnerKey = std::pair<Id, std::string>;  // property "" is the instance itself
+
+// The total order of bundles and claims: the sender's Lamport clock, then its id. Every replica compares
+// the same two numbers, so every replica decides a race alike.
+struct Stamp {
+  std::uint64_t clock = 0;
+  std::uint64_t who = 0;
+  auto operator<=>(const Stamp&) const = default;
+};
+constexpr Stamp no_limit{~std::uint64_t{0}, ~std::uint64_t{0}};
+
+// The stamp of the last set of one property that was applied (a last-writer-wins register's stamp).
+struct Written {
+  std::string property;
+  Stamp stamp;
+};
+
+// One claim or release of an ownership key, in stamp order.
+struct OwnEvent {
+  Stamp stamp;
+  bool take = true;
+  std::uint64_t seq = 0;  // the claimant's sequence number of the claim
+  bool lost = false;      // a take that lost a race (reported once)
+};
+
+// Who owns a key after the events before @p limit: events apply in stamp order; a take succeeds when
+// nobody (or the claimant) owns the key, a release when the releaser does.
+std::uint64_t replay(const std::vector<OwnEvent>& history, const Stamp& limit) {
+  std::uint64_t owner = 0;
+  for (const OwnEvent& e : history) {
+    if (!(e.stamp < limit)) break;
+    if (e.take) {
+      if (owner == 0) owner = e.stamp.who;
+    } else if (owner == e.stamp.who) {
+      owner = 0;
+    }
+  }
+  return owner;
+}
 
 }  // namespace
 
@@ -111,8 +150,11 @@ struct Participant::Impl {
   bool synced = false;
   bool ever_synced = false;
   std::uint64_t seq = 0;                                     // my last sequence number
+  std::uint64_t clock = 0;                                   // my Lamport clock
   std::unordered_map<std::uint64_t, std::uint64_t> applied;  // sender -> last seq handled
-  std::map<OwnerKey, std::uint64_t> owners;
+  std::unordered_map<Id, std::vector<Written>> written;      // instance -> its registers' stamps
+  std::map<OwnerKey, std::vector<OwnEvent>> claims;          // every claim and release, per key
+  std::uint64_t prefer = 0;  // the participant a resynchronisation asks first (0: anyone)
   std::unordered_map<std::uint64_t, std::string> names;
   std::deque<Message> buffer;  // bundles and claims received while unsynchronised
   std::uint64_t nonce = 0;     // of my pending snapshot request
@@ -184,6 +226,7 @@ struct Participant::Impl {
     vsd_dist_Message m{};
     m.sender = id;
     m.seq = msg_seq;
+    m.clock = clock;
     m.target = target;
     m.kind = static_cast<std::uint8_t>(kind);
     m.payload._buffer = payload.data();
@@ -200,16 +243,41 @@ struct Participant::Impl {
     return st.current_count;
   }
 
-  // ---- ownership ----
-  std::uint64_t owner_of(Id inst, std::string_view prop) const {
-    if (!prop.empty())
-      if (auto it = owners.find(OwnerKey(inst, std::string(prop))); it != owners.end()) return it->second;
-    if (auto it = owners.find(OwnerKey(inst, std::string())); it != owners.end()) return it->second;
-    return 0;
+  // ---- concurrent writes: a last-writer-wins register per property ----
+  const Stamp* written_stamp(Id inst, std::string_view prop) const {
+    auto it = written.find(inst);
+    if (it == written.end()) return nullptr;
+    for (const Written& w : it->second)
+      if (w.property == prop) return &w.stamp;
+    return nullptr;
   }
-  // The first operation of @p t that touches what someone other than @p writer owns.
-  std::optional<Conflict> find_conflict(const Transaction& t, std::uint64_t writer) const {
-    if (owners.empty()) return std::nullopt;
+  void note_write(Id inst, std::string_view prop, const Stamp& stamp) {
+    std::vector<Written>& ws = written[inst];
+    for (Written& w : ws)
+      if (w.property == prop) {
+        w.stamp = stamp;
+        return;
+      }
+    ws.push_back({std::string(prop), stamp});
+  }
+
+  // ---- ownership ----
+  std::uint64_t key_owner(Id inst, std::string_view prop, const Stamp& limit) const {
+    auto it = claims.find(OwnerKey(inst, std::string(prop)));
+    return it == claims.end() ? 0 : replay(it->second, limit);
+  }
+  // The owner of @p prop of @p inst (or of the instance) as of the stamp @p limit.
+  std::uint64_t owner_at(Id inst, std::string_view prop, const Stamp& limit) const {
+    if (claims.empty()) return 0;
+    if (!prop.empty())
+      if (const std::uint64_t o = key_owner(inst, prop, limit); o != 0) return o;
+    return key_owner(inst, {}, limit);
+  }
+  std::uint64_t owner_of(Id inst, std::string_view prop) const { return owner_at(inst, prop, no_limit); }
+  // The first operation of @p t that touches what someone other than @p writer owns as of @p stamp.
+  std::optional<Conflict> find_conflict(const Transaction& t, std::uint64_t writer,
+                                        const Stamp& stamp = no_limit) const {
+    if (claims.empty()) return std::nullopt;
     detail::TxParser parser(t);
     for (detail::TxOp op; parser.next(op);) {
       Conflict c;
@@ -219,17 +287,17 @@ struct Participant::Impl {
         case Transaction::Op::Create:
           continue;
         case Transaction::Op::Delete:
-          for (auto it = owners.lower_bound(OwnerKey(op.id, std::string()));
-               it != owners.end() && it->first.first == op.id; ++it)
-            if (it->second != writer) {
-              c.owner = it->second;
+          for (auto it = claims.lower_bound(OwnerKey(op.id, std::string()));
+               it != claims.end() && it->first.first == op.id; ++it)
+            if (const std::uint64_t o = replay(it->second, stamp); o != 0 && o != writer) {
+              c.owner = o;
               c.property = it->first.second;
               break;
             }
           if (c.owner == 0) continue;
           break;
         default:
-          c.owner = owner_of(op.id, op.name);
+          c.owner = owner_at(op.id, op.name, stamp);
           if (c.owner == 0 || c.owner == writer) continue;
           c.property = std::string(op.name);
           break;
@@ -239,14 +307,27 @@ struct Participant::Impl {
     return std::nullopt;
   }
   void forget_deleted(const Transaction& t) {
-    if (owners.empty()) return;
+    if (claims.empty() && written.empty()) return;
     detail::TxParser parser(t);
     for (detail::TxOp op; parser.next(op);)
-      if (op.op == Transaction::Op::Delete)
-        std::erase_if(owners, [&](const auto& e) { return e.first.first == op.id; });
+      if (op.op == Transaction::Op::Delete) {
+        written.erase(op.id);
+        std::erase_if(claims, [&](const auto& e) { return e.first.first == op.id; });
+      }
   }
   std::string describe(const Conflict& c) const {
     std::string what = "#" + std::to_string(c.instance) + (c.property.empty() ? "" : "." + c.property);
+    switch (c.kind) {
+      case ConflictKind::ConcurrentWrite:
+        return "concurrent writes to " + what + ": the set of " + who(c.writer) + " (bundle " +
+               std::to_string(c.seq) + ") lost to the later stamped one of " + who(c.owner);
+      case ConflictKind::ClaimRace:
+        return "concurrent claims of " + what + ": the claim of " + who(c.writer) + " (claim " +
+               std::to_string(c.seq) + ") lost to the earlier stamped one of " + who(c.owner) +
+               "; rolled back";
+      case ConflictKind::Owned:
+        break;
+    }
     return "write by " + who(c.writer) + " to " + what + ", owned by " + who(c.owner) + ", rejected" +
            (c.seq != 0 ? " (bundle " + std::to_string(c.seq) + ")" : " (undone before it was sent)");
   }
@@ -264,6 +345,7 @@ struct Participant::Impl {
       w.varint(c.instance);
       w.string(c.property);
       w.string(opt.name);
+      w.u8(static_cast<std::uint8_t>(c.kind));
       send(Kind::Report, 0, 0, p);
     }
     conflict_signal.emit(c);
@@ -287,13 +369,22 @@ struct Participant::Impl {
       return false;
     }
     WireBundle wb = encode_bundle(t, state);
-    forget_deleted(t);
-    if (wb.ops == 0) return false;
+    if (wb.ops == 0) {
+      forget_deleted(t);
+      return false;
+    }
     std::vector<std::uint8_t> p;
     p.reserve(envelope_size + wb.bytes.size());
     write_envelope(p);
     p.insert(p.end(), wb.bytes.begin(), wb.bytes.end());
+    ++clock;
     send(Kind::Bundle, ++seq, 0, p);
+    // My sets now hold the bundle's stamp here, as they will at every receiver that applies them.
+    const Stamp stamp{clock, id};
+    detail::TxParser parser(t);
+    for (detail::TxOp op; parser.next(op);)
+      if (op.op == Transaction::Op::Set) note_write(op.id, op.name, stamp);
+    forget_deleted(t);
     ++stats.bundles_sent;
     return true;
   }
@@ -304,6 +395,7 @@ struct Participant::Impl {
     ByteWriter w(p);
     w.fixed(nonce);
     w.string(opt.name);
+    w.fixed(prefer);
     send(Kind::Request, 0, 0, p);
     last_request = std::chrono::steady_clock::now();
   }
@@ -312,6 +404,8 @@ struct Participant::Impl {
     ByteReader r(m.payload.data(), m.payload.size());
     const auto req_nonce = r.fixed<std::uint64_t>();
     names[m.sender] = r.string();
+    if (const auto wanted = r.remaining() >= 8 ? r.fixed<std::uint64_t>() : 0; wanted != 0 && wanted != id)
+      return;   // the joiner asks a particular participant (the owner whose state it must take)
     publish();  // my own changes go out first, so the snapshot's sequence number for me is exact
     WireBundle wb = encode_bundle(state.snapshot(), state);
     std::vector<std::uint8_t> p;
@@ -326,16 +420,33 @@ struct Participant::Impl {
       w.fixed(sender);
       w.varint(s);
     }
-    w.varint(owners.size());
-    for (const auto& [key, who_owns] : owners) {
-      w.fixed(who_owns);
+    w.varint(claims.size());
+    for (const auto& [key, history] : claims) {
       w.varint(key.first);
       w.string(key.second);
+      w.varint(history.size());
+      for (const OwnEvent& e : history) {
+        w.varint(e.stamp.clock);
+        w.fixed(e.stamp.who);
+        w.u8(static_cast<std::uint8_t>((e.take ? 1 : 0) | (e.lost ? 2 : 0)));
+        w.varint(e.seq);
+      }
     }
     w.varint(names.size());
     for (const auto& [pid, n] : names) {
       w.fixed(pid);
       w.string(n);
+    }
+    w.varint(clock);
+    w.varint(written.size());
+    for (const auto& [inst, ws] : written) {
+      w.varint(inst);
+      w.varint(ws.size());
+      for (const Written& x : ws) {
+        w.string(x.property);
+        w.varint(x.stamp.clock);
+        w.fixed(x.stamp.who);
+      }
     }
     p.insert(p.end(), wb.bytes.begin(), wb.bytes.end());
     send(Kind::Snapshot, 0, m.sender, p);
@@ -347,8 +458,9 @@ struct Participant::Impl {
     if (state.recording()) (void)state.take_recording();
   }
 
-  void resync(const std::string& reason, const Message* pending) {
-    log(reason + "; resynchronising from a snapshot");
+  void resync(const std::string& reason, const Message* pending, std::uint64_t from = 0) {
+    log(reason + "; resynchronising from a snapshot" + (from != 0 ? " of " + who(from) : std::string()));
+    prefer = from;
     synced = false;
     buffer.clear();
     if (pending != nullptr) buffer.push_back(*pending);
@@ -379,15 +491,36 @@ struct Participant::Impl {
       const auto sender = r.fixed<std::uint64_t>();
       seqs[sender] = r.varint();
     }
-    std::map<OwnerKey, std::uint64_t> table;
-    for (std::size_t n = r.size_prefix(10); n > 0; --n) {
-      const auto who_owns = r.fixed<std::uint64_t>();
+    std::map<OwnerKey, std::vector<OwnEvent>> table;
+    for (std::size_t n = r.size_prefix(3); n > 0; --n) {
       const Id inst = r.varint();
-      table[OwnerKey(inst, r.string())] = who_owns;
+      auto& history = table[OwnerKey(inst, r.string())];
+      for (std::size_t k = r.size_prefix(11); k > 0; --k) {
+        OwnEvent e;
+        e.stamp.clock = r.varint();
+        e.stamp.who = r.fixed<std::uint64_t>();
+        const std::uint8_t flags = r.u8();
+        e.take = (flags & 1) != 0;
+        e.lost = (flags & 2) != 0;
+        e.seq = r.varint();
+        history.push_back(e);
+      }
     }
     for (std::size_t n = r.size_prefix(9); n > 0; --n) {
       const auto pid = r.fixed<std::uint64_t>();
       names[pid] = r.string();
+    }
+    const std::uint64_t their_clock = r.varint();
+    std::unordered_map<Id, std::vector<Written>> registers;
+    for (std::size_t n = r.size_prefix(2); n > 0; --n) {
+      auto& ws = registers[r.varint()];
+      for (std::size_t k = r.size_prefix(10); k > 0; --k) {
+        Written x;
+        x.property = r.string();
+        x.stamp.clock = r.varint();
+        x.stamp.who = r.fixed<std::uint64_t>();
+        ws.push_back(std::move(x));
+      }
     }
     if (seqs[id] < seq) {
       // The answering participant has not applied all my bundles yet: installing its state would lose
@@ -400,7 +533,29 @@ struct Participant::Impl {
     discard_recording();
     seqs.erase(id);
     applied = std::move(seqs);
-    owners = std::move(table);
+    // Claims that lost a race this participant had not seen yet (it may resynchronise because of the race):
+    // counted and reported here too, so every participant reports every lost claim once.
+    std::vector<Conflict> newly_lost;
+    for (const auto& [key, history] : table)
+      for (const OwnEvent& e : history) {
+        if (!e.lost) continue;
+        bool known = false;
+        if (auto old = claims.find(key); old != claims.end())
+          for (const OwnEvent& o : old->second) known = known || (o.stamp == e.stamp && o.lost);
+        if (known) continue;
+        Conflict c;
+        c.kind = ConflictKind::ClaimRace;
+        c.writer = e.stamp.who;
+        c.owner = replay(history, e.stamp);
+        c.seq = e.seq;
+        c.instance = key.first;
+        c.property = key.second;
+        newly_lost.push_back(std::move(c));
+      }
+    claims = std::move(table);
+    written = std::move(registers);
+    clock = std::max(clock, their_clock);
+    prefer = 0;
     synced = true;
     self_diverged = false;
     if (ever_synced) ++stats.resyncs;
@@ -408,6 +563,10 @@ struct Participant::Impl {
     log("synchronised from a snapshot of " + who(m.sender) + " (" + std::to_string(state.size()) +
         " instances)");
     synced_signal.emit();
+    for (Conflict& c : newly_lost) {
+      ++stats.claims_lost;
+      report(std::move(c), false);
+    }
     std::deque<Message> pending = std::move(buffer);
     buffer.clear();
     for (const Message& b : pending) sequenced(b);
@@ -427,11 +586,29 @@ struct Participant::Impl {
       buffer.push_back(m);
       return;
     }
+    publish();  // my changes first: the recording must hold only what this participant did
+    const Stamp stamp{m.clock, m.sender};
     Transaction t;
+    // The sets of this bundle that lost to a later stamped write applied here (last writer wins), and the
+    // ones that take the register.
+    struct Lost {
+      Id instance;
+      std::string_view property;
+      Stamp winner;
+    };
+    std::vector<Lost> lost;
+    std::vector<std::pair<Id, std::string_view>> kept;
     if (m.kind == Kind::Bundle) {
       // Decoded before its sequence number counts: a broken message must not make anyone resynchronise.
       try {
-        t = decode_bundle(m.payload);
+        t = decode_bundle(m.payload, [&](Id inst, std::string_view prop) {
+          if (const Stamp* s = written_stamp(inst, prop); s != nullptr && stamp < *s) {
+            lost.push_back({inst, prop, *s});
+            return false;
+          }
+          kept.emplace_back(inst, prop);
+          return true;
+        });
       } catch (const Error& e) {
         ++stats.malformed;
         log("rejected bundle " + std::to_string(m.seq) + " of " + who(m.sender) + ": " + e.what());
@@ -457,18 +634,18 @@ struct Participant::Impl {
         return;
       }
     }
+    clock = std::max(clock, m.clock);
     if (m.kind == Kind::Claim) {
-      apply_claim(m);
       it->second = m.seq;
+      apply_claim(m);
       return;
     }
-    if (auto c = find_conflict(t, m.sender)) {
+    if (auto c = find_conflict(t, m.sender, stamp)) {
       it->second = m.seq;
       c->seq = m.seq;
       report(*c, c->owner == id);  // the owner tells the writer
       return;
     }
-    publish();  // my changes first: the recording must hold only what this participant did
     try {
       state.apply(t);
     } catch (const Error& e) {
@@ -488,10 +665,24 @@ struct Participant::Impl {
       return;
     }
     discard_recording();
+    for (const auto& [inst, prop] : kept) note_write(inst, prop, stamp);
     forget_deleted(t);
     it->second = m.seq;
     ++stats.bundles_applied;
     ++applied_now;
+    for (const Lost& l : lost) {
+      // The later stamped write won here, as it does everywhere. Its writer tells the loser (who may see
+      // nothing amiss: the winner's set simply overwrote its own).
+      ++stats.lost_writes;
+      Conflict c;
+      c.kind = ConflictKind::ConcurrentWrite;
+      c.writer = m.sender;
+      c.owner = l.winner.who;
+      c.seq = m.seq;
+      c.instance = l.instance;
+      c.property = std::string(l.property);
+      report(std::move(c), l.winner.who == id);
+    }
   }
 
   // Nobody answered a resynchronisation (every participant may have seen the same gap): go on with this
@@ -508,24 +699,66 @@ struct Participant::Impl {
   }
 
   void apply_claim(const Message& m) {
+    bool take = false;
+    Id inst = null_id;
+    std::string prop;
     try {
       ByteReader r(m.payload.data(), m.payload.size());
-      const bool take = r.u8() != 0;
-      const Id inst = r.varint();
-      std::string prop = r.string();
+      take = r.u8() != 0;
+      inst = r.varint();
+      prop = r.string();
       names[m.sender] = r.string();
-      OwnerKey key(inst, std::move(prop));
-      if (take) {
-        auto [at, fresh] = owners.try_emplace(key, m.sender);
-        if (!fresh && at->second != m.sender)
-          log("claim of " + who(m.sender) + " on #" + std::to_string(inst) + " ignored: owned by " +
-              who(at->second));
-      } else if (auto at = owners.find(key); at != owners.end() && at->second == m.sender) {
-        owners.erase(at);
-      }
     } catch (const Error& e) {
       ++stats.malformed;
       log("rejected claim " + std::to_string(m.seq) + " of " + who(m.sender) + ": " + e.what());
+      return;
+    }
+    add_claim_event(OwnerKey(inst, std::move(prop)), OwnEvent{Stamp{m.clock, m.sender}, take, m.seq, false});
+  }
+
+  // Puts a claim or release into its key's history in stamp order and settles what changed: takes that
+  // lose now are reported (once) and rolled back; a write applied here that the new order makes a write
+  // to what someone else owned means this state took a bundle the owner rejected: it resynchronises from
+  // the owner.
+  void add_claim_event(const OwnerKey& key, const OwnEvent& event) {
+    std::vector<OwnEvent>& history = claims[key];
+    history.insert(std::upper_bound(history.begin(), history.end(), event,
+                                    [](const OwnEvent& a, const OwnEvent& b) { return a.stamp < b.stamp; }),
+                   event);
+    std::uint64_t owner = 0;
+    for (OwnEvent& e : history) {
+      if (!e.take) {
+        if (owner == e.stamp.who) owner = 0;
+        continue;
+      }
+      if (owner == 0 || owner == e.stamp.who) {
+        owner = e.stamp.who;
+        e.lost = false;
+        continue;
+      }
+      if (e.lost) continue;
+      e.lost = true;
+      ++stats.claims_lost;
+      Conflict c;
+      c.kind = ConflictKind::ClaimRace;
+      c.writer = e.stamp.who;
+      c.owner = owner;
+      c.seq = e.seq;
+      c.instance = key.first;
+      c.property = key.second;
+      report(std::move(c), false);  // every participant sees both claims: nobody needs telling
+    }
+    if (!synced) return;
+    auto it = written.find(key.first);
+    if (it == written.end()) return;
+    for (const Written& w : it->second) {
+      if (!key.second.empty() && w.property != key.second) continue;
+      const std::uint64_t o = owner_at(key.first, w.property, w.stamp);
+      if (o == 0 || o == w.stamp.who) continue;
+      resync("this state holds a write of " + who(w.stamp.who) + " to #" + std::to_string(key.first) + "." +
+                 w.property + " that the claim of " + who(o) + " came before",
+             nullptr, o);
+      return;
     }
   }
 
@@ -538,12 +771,17 @@ struct Participant::Impl {
     c.instance = r.varint();
     c.property = r.string();
     names[m.sender] = r.string();
+    if (const std::uint8_t k = r.u8(); k <= static_cast<std::uint8_t>(ConflictKind::ClaimRace))
+      c.kind = static_cast<ConflictKind>(k);
+    else
+      r.fail("unknown conflict kind " + std::to_string(k));
     if (c.writer == id) {
       report(c, false);
-      // My bundle was rejected by the others but applied here: this state has diverged.
-      if (c.seq != 0 && synced) {
+      // My bundle was rejected by the others but applied here: this state has diverged. (A set that lost
+      // to a concurrent one needs nothing: the winner's set overwrote it here too.)
+      if (c.kind == ConflictKind::Owned && c.seq != 0 && synced) {
         self_diverged = true;
-        resync("my bundle " + std::to_string(c.seq) + " was rejected", nullptr);
+        resync("my bundle " + std::to_string(c.seq) + " was rejected", nullptr, c.owner);
       }
     } else if (c.owner == id) {
       report(c, false);
@@ -598,6 +836,7 @@ struct Participant::Impl {
     Message m;
     m.sender = s.sender;
     m.seq = s.seq;
+    m.clock = s.clock;
     m.target = s.target;
     m.kind = static_cast<Kind>(s.kind);
     m.payload.assign(b + envelope_size, b + n);
@@ -619,8 +858,17 @@ struct Participant::Impl {
       dds_return_loan(reader, samples.data(), got);
       if (got < batch) break;
     }
-    if (!synced && std::chrono::steady_clock::now() - last_request >= opt.request_interval)
-      request_snapshot();
+    if (!synced) {
+      const auto now = std::chrono::steady_clock::now();
+      if (ever_synced && opt.resync_give_up.count() > 0 && now - resync_started >= opt.resync_give_up) {
+        give_up_resync();
+      } else if (now - last_request >= opt.request_interval) {
+        // A resynchronisation asks one participant first (the owner whose state it must take); should it
+        // not answer within ten requests, anyone may.
+        if (prefer != 0 && now - resync_started >= 10 * opt.request_interval) prefer = 0;
+        request_snapshot();
+      }
+    }
     return applied_now;
   }
 
@@ -638,7 +886,9 @@ struct Participant::Impl {
     w.string(prop);
     w.string(opt.name);
     publish();  // the claim comes after the changes made before it
+    ++clock;
     send(Kind::Claim, ++seq, 0, p);
+    add_claim_event(OwnerKey(inst, std::string(prop)), OwnEvent{Stamp{clock, id}, take, seq, false});
   }
 };
 
@@ -699,14 +949,12 @@ void Participant::claim(const SimStateInstance& inst, std::string_view property)
   if (o != 0 && o != impl_->id)
     throw Error("dist: #" + std::to_string(inst.id()) +
                 (property.empty() ? "" : "." + std::string(property)) + " is owned by " + impl_->who(o));
-  impl_->owners[OwnerKey(inst.id(), std::string(property))] = impl_->id;
+  if (impl_->key_owner(inst.id(), property, no_limit) == impl_->id) return;  // mine already
   impl_->send_claim(true, inst.id(), property);
 }
 
 void Participant::release(const SimStateInstance& inst, std::string_view property) {
-  auto it = impl_->owners.find(OwnerKey(inst.id(), std::string(property)));
-  if (it == impl_->owners.end() || it->second != impl_->id) return;
-  impl_->owners.erase(it);
+  if (impl_->key_owner(inst.id(), property, no_limit) != impl_->id) return;
   impl_->send_claim(false, inst.id(), property);
 }
 

@@ -127,7 +127,9 @@ WireBundle encode_bundle(const Transaction& t, const SimState& state) {
   return out;
 }
 
-Transaction decode_bundle(std::span<const std::uint8_t> bytes) {
+Transaction decode_bundle(std::span<const std::uint8_t> bytes) { return decode_bundle(bytes, SetFilter{}); }
+
+Transaction decode_bundle(std::span<const std::uint8_t> bytes, const SetFilter& keep) {
   ByteReader r(bytes.data(), bytes.size());
   try {
     if (bytes.size() < 5 || std::memcmp(bytes.data(), wire_magic, 4) != 0)
@@ -156,6 +158,7 @@ Transaction decode_bundle(std::span<const std::uint8_t> bytes) {
     std::vector<std::uint8_t> out;
     detail::write_tx_header(out);
     const std::size_t op_count = r.size_prefix(3);  // an operation takes at least 3 bytes
+    std::size_t kept = op_count;
     std::vector<detail::TxValue> values;
     for (std::size_t i = 0; i < op_count; ++i) {
       const std::size_t at = r.position();
@@ -183,6 +186,10 @@ Transaction decode_bundle(std::span<const std::uint8_t> bytes) {
         }
         case Transaction::Op::Set: {
           const auto v = value();
+          if (keep && !keep(id, n)) {
+            --kept;
+            break;
+          }
           detail::write_set(out, id, n, v, v);
           break;
         }
@@ -199,7 +206,7 @@ Transaction decode_bundle(std::span<const std::uint8_t> bytes) {
       }
     }
     if (!r.at_end()) r.fail(std::to_string(r.remaining()) + " unexpected bytes after the last operation");
-    return detail::make_transaction(std::move(out), op_count);
+    return detail::make_transaction(std::move(out), kept);
   } catch (const Error& e) {
     throw Error(std::string("wire bundle ") + e.what());
   }

@@ -194,6 +194,32 @@ TEST(DistProcesses, AReaderThatDiesAndARejoinerFollowAWriterProcess) {
   EXPECT_THAT(out, HasSubstr("writer: a reader is done"));
 }
 
+// Packet loss without netem: Cyclone DDS's own test option Internal/Test/XmitLossiness drops the given
+// share of outgoing packets (per mille) in both processes; the reliable protocol must repair every loss,
+// so the reader still sees every value once and in order.
+TEST(DistProcesses, TenPercentPacketLossLosesNothingAndReordersNothing) {
+  const auto file =
+      std::filesystem::temp_directory_path() / ("vsd_dist_lossy_" + std::to_string(::getpid()) + ".xml");
+  std::ofstream(file)
+      << "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/>"
+      << "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
+      << "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>40"
+      << "</MaxAutoParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers></Discovery>"
+      << "<Internal><Test><XmitLossiness>100</XmitLossiness></Test></Internal></Domain></CycloneDDS>";
+  const std::string peer = VSD_DIST_PEER;
+  const std::string d = std::to_string(vsd_dist_test::fresh_domain());
+  const std::string config = " --config file://" + file.string();
+  const auto [rc, out] =
+      run("timeout 120 " + peer + " writer " + d + " 2000" + config + " & W=$!; timeout 100 " + peer +
+          " reader " + d + " 2000" + config + "; R=$?; wait $W; W=$?; [ $R -eq 0 ] && [ $W -eq 0 ]");
+  std::filesystem::remove(file);
+  if (out.find("creating the DDS domain") != std::string::npos)
+    GTEST_SKIP() << "this Cyclone DDS has no Internal/Test/XmitLossiness: " << out;
+  EXPECT_EQ(rc, 0) << out;
+  EXPECT_THAT(out,
+              testing::ContainsRegex("reader: synced at [0-9]+, then [0-9]+ values in order, final 2000"));
+}
+
 // Two network namespaces joined by a veth pair, netem loss, delay and reordering on both ends. Needs root,
 // ip and tc; removes its namespaces whatever happens.
 TEST(DistProcesses, NetworkNamespacesWithLossDelayAndReordering) {

@@ -72,19 +72,26 @@ TEST_F(OwnershipTest, AKnownClaimUndoesTheWholeBundleAtTheWriterAndTellsTheOwner
 }
 
 TEST_F(OwnershipTest, AWriteBeforeTheClaimArrivedIsRejectedEverywhereAndTheWriterResyncs) {
-  robot->claim(*arm, "position");  // sent, but the ui has not read it yet ...
-  ui_arm().set_position(7.0);      // ... and writes
+  robot->claim(*arm, "position");  // sent (stamp 1), but the ui has not read it yet ...
+  ui_arm().set_target(2.0);        // ... and writes: bundle 1 (stamp 1) is unowned, fine everywhere;
   ASSERT_TRUE(ui->publish());
-  ASSERT_TRUE(
-      settle([&] { return !seen_r.empty() && !seen_u.empty() && ui->synced() && ui->stats().resyncs == 1; }));
-  EXPECT_EQ(arm->position(), 1.0);  // rejected at the owner
-  EXPECT_EQ(other_arm().position(), 1.0);
+  ui_arm().set_position(7.0);  // bundle 2 (stamp 2) comes after the claim in the order every replica uses
+  ASSERT_TRUE(ui->publish());
+  ASSERT_TRUE(settle([&] { return !seen_r.empty() && ui->synced() && ui->stats().resyncs == 1; }));
+  ASSERT_TRUE(settle([&] { return !seen_u.empty() && other_arm().position() == 1.0; }));
+  EXPECT_EQ(arm->position(), 1.0);      // rejected at the owner
   EXPECT_EQ(ui_arm().position(), 1.0);  // the writer took the shared state back
-  EXPECT_EQ(seen_r[0].seq, 1u);
-  EXPECT_EQ(seen_u[0].seq, 1u);
+  EXPECT_EQ(arm->target(), 2.0);        // its earlier bundle stands
+  EXPECT_EQ(other_arm().target(), 2.0);
+  EXPECT_EQ(ui_arm().target(), 2.0);
+  EXPECT_EQ(seen_r[0].seq, 2u);
+  EXPECT_EQ(seen_u[0].seq, 2u);
   EXPECT_EQ(seen_u[0].owner, robot->id());
-  EXPECT_TRUE(vsd_dist_test::contains(log_u, "my bundle 1 was rejected; resynchronising from a snapshot"));
-  EXPECT_TRUE(vsd_dist_test::contains(log_c, "owned by 'robot', rejected (bundle 1)"));
+  EXPECT_TRUE(vsd_dist_test::contains(log_u, "resynchronising from a snapshot of 'robot'"));
+  EXPECT_TRUE(vsd_dist_test::contains(log_r, "owned by 'robot', rejected (bundle 2)"));
+  std::string diff;
+  EXPECT_TRUE(r.equals(u, &diff)) << diff;
+  EXPECT_TRUE(r.equals(c, &diff)) << diff;
   // The owner's own writes keep flowing.
   arm->set_position(2.0);
   ASSERT_TRUE(settle([&] { return ui_arm().position() == 2.0 && other_arm().position() == 2.0; }));

@@ -79,11 +79,24 @@ struct ParticipantOptions {
   std::function<void(std::string_view line)> log;
 };
 
-/// @brief A write that touched what another participant owns. Reported to the writer and the owner.
+/// @brief What a Conflict is about.
+enum class ConflictKind : std::uint8_t {
+  /// A write to what another participant owns: the whole bundle was rejected (undone at the writer).
+  Owned = 0,
+  /// Two participants set the same unowned property concurrently: the set with the lower stamp
+  /// (Lamport clock, participant id) lost everywhere; the rest of its bundle stands (docs/dist.md).
+  ConcurrentWrite = 1,
+  /// Two participants claimed the same instance or property concurrently: the claim with the lower stamp
+  /// won everywhere; the other one was rolled back.
+  ClaimRace = 2,
+};
+
+/// @brief A write or claim that lost: reported to the loser and the winner (and logged by receivers).
 struct Conflict {
-  std::uint64_t writer = 0;  ///< participant id of the writer
-  std::uint64_t owner = 0;   ///< participant id of the owner
-  std::uint64_t seq = 0;     ///< the writer's sequence number of the bundle (0: never sent)
+  ConflictKind kind = ConflictKind::Owned;  ///< what happened
+  std::uint64_t writer = 0;  ///< participant id of the loser: the writer, or the claimant whose claim lost
+  std::uint64_t owner = 0;   ///< participant id of the winner: the owner, the winning writer or claimant
+  std::uint64_t seq = 0;     ///< the loser's sequence number of its bundle or claim (0: never sent)
   Id instance = null_id;     ///< the instance touched
   std::string property;      ///< the property touched (empty: the instance itself, a deletion)
   std::string text;          ///< one line for logs: who, what, whose
@@ -100,6 +113,8 @@ struct ParticipantStats {
   std::uint64_t resyncs = 0;           ///< snapshots installed after the first synchronisation
   std::uint64_t snapshots_served = 0;  ///< snapshot requests answered
   std::uint64_t dropped_unsynced = 0;  ///< local bundles dropped because they were made while unsynchronised
+  std::uint64_t lost_writes = 0;  ///< sets of others dropped here: a concurrent write with a later stamp won
+  std::uint64_t claims_lost = 0;  ///< claims (anyone's) that lost a race here, this one's included
 };
 
 /// @brief One SimState's membership in a distributed model (see the file comment).
@@ -142,7 +157,10 @@ class Participant {
 
   // ---- ownership ----
   /// @brief Makes this participant the owner of @p inst (every property, and its deletion). Sent to the
-  /// others in order with the bundles. @throws vsd::Error when another participant owns it already.
+  /// others in order with the bundles. Two claims made at the same time by two participants both succeed
+  /// locally at first; everywhere, the one with the lower stamp (Lamport clock, participant id) wins and
+  /// the other is rolled back and reported (on_conflict, ConflictKind::ClaimRace).
+  /// @throws vsd::Error when another participant owns it already (as far as this one knows).
   void claim(const SimStateInstance& inst);
   /// @brief Makes this participant the owner of one property of @p inst.
   /// @throws vsd::Error when the property does not exist or another participant owns it.

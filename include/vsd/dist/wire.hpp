@@ -12,7 +12,9 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "vsd/core/transaction.hpp"
@@ -39,5 +41,14 @@ struct WireBundle {
 /// @throws vsd::Error "wire bundle byte N: ..." for a wrong header, a bad name index, a count the bytes
 /// cannot hold, truncated or trailing data. The operations themselves are checked by SimState::apply.
 [[nodiscard]] Transaction decode_bundle(std::span<const std::uint8_t> bytes);
+
+/// @brief Decides, for each property set of a wire bundle, whether it is kept (vsd::dist drops the sets
+/// that lost to a concurrent write with a later stamp: docs/dist.md, "Concurrent writes").
+using SetFilter = std::function<bool(Id instance, std::string_view property)>;
+
+/// @brief decode_bundle(), keeping only the sets for which @p keep returns true (all other operations
+/// are kept). @p keep sees every set, in order, even when the bundle turns out malformed later.
+/// @throws vsd::Error as decode_bundle().
+[[nodiscard]] Transaction decode_bundle(std::span<const std::uint8_t> bytes, const SetFilter& keep);
 
 }  // namespace vsd::dist
