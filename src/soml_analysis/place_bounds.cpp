@@ -101,6 +101,12 @@ std::optional<std::vector<std::uint64_t>> place_bounds(const PtNet& net) {
         (r.c[j] > 0 ? pos : neg).push_back(std::move(r));
     }
     if (next.size() + pos.size() * neg.size() > 8 * kMaxRows) return result();
+    // No new row: the rows left are a subset of rows of which none includes another's support, and so
+    // are they. (Most columns of a large net are like this; the pruning below is quadratic.)
+    if (pos.empty() || neg.empty()) {
+      rows = std::move(next);
+      continue;
+    }
     Row out;
     for (const auto& p : pos)
       for (const auto& n : neg) {
