@@ -473,6 +473,28 @@ class Explorer {
 
   // One exploration with `bits` per place; false when a place outgrew them.
   bool attempt(unsigned bits, ExploreResult& r);
+  void phases_b_to_d(std::size_t nchunks, const Layout& L);
+
+  // Whether the hash set holds marking mk (fragment frag of its hash), committed or pending. W: the
+  // marking's words if the loop over them is unrolled, else 0.
+  template <std::uint32_t W>
+  bool contains(const Shard& sh, std::uint64_t frag, const std::uint64_t* mk, std::uint32_t words) const {
+    const std::uint64_t* slots = sh.slots.data();
+    const std::size_t mask = sh.slots.size() - 1;
+    for (std::size_t pos = frag & mask;; pos = (pos + 1) & mask) {
+      const std::uint64_t v = slots[pos];
+      if (v == kEmpty) return false;
+      if (((v >> 32) & 0x7FFFFFFFull) != frag) continue;
+      const std::uint64_t* other;
+      if (v & kPendingBit) {
+        const std::uint64_t ref = sh.pending[v & 0xFFFFFFFFull];
+        other = chunks_[ref >> 32].markings.data() + (ref & 0xFFFFFFFFull) * words;
+      } else {
+        other = record(static_cast<std::uint32_t>(v & 0xFFFFFFFFull));
+      }
+      if (same(other, mk, W != 0 ? W : words)) return true;
+    }
+  }
 
   const PtNet& net_;
   Compiled c_;
@@ -538,9 +560,14 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
   for (; lo < hi; ++level) {
     const std::uint64_t n = hi - lo;
     const std::size_t nchunks = (n + kChunkStates - 1) / kChunkStates;
-    if (chunks_.size() < nchunks) chunks_.resize(nchunks);
-    cur_enabled_.assign(n * tw_, 0);
     const unsigned workers = static_cast<unsigned>(std::min<std::size_t>(threads_, nchunks));
+    // One worker: each successor is looked up (and a new one numbered) as soon as it is made, in the
+    // order phases B and C would have used, so the numbering is the same; no successor buffers, and
+    // phases B to D fall away. Chunk 0 serves as scratch.
+    const bool fused = workers == 1;
+    const std::uint64_t new_lo = states_;
+    if (chunks_.size() < (fused ? 1 : nchunks)) chunks_.resize(fused ? 1 : nchunks);
+    cur_enabled_.assign(n * tw_, 0);
     std::atomic<std::size_t> next_chunk{0};
     std::atomic<bool> stop{false};
     std::size_t base_memory = memory();
@@ -559,7 +586,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
         while (!stop.load(std::memory_order_relaxed)) {
           const std::size_t ci = next_chunk.fetch_add(1);
           if (ci >= nchunks) break;
-          Chunk& ch = chunks_[ci];
+          Chunk& ch = chunks_[fused ? 0 : ci];
           ch.clear();
           const std::uint64_t first = lo + ci * kChunkStates;
           const std::uint64_t last = std::min(hi, first + kChunkStates);
@@ -648,7 +675,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
               while (bitsw != 0) {
                 const std::uint32_t t = wd * 64 + static_cast<std::uint32_t>(std::countr_zero(bitsw));
                 bitsw &= bitsw - 1;
-                std::uint64_t* out = out_markings + k * words;
+                std::uint64_t* out = out_markings + (fused ? k0 : k) * words;
                 if constexpr (W != 0) {
                   if (use_ops) {  // firing adds each word's difference: no carries cross fields here
                     const std::uint64_t* d = pk.diff.data() + std::size_t{t} * W;
@@ -671,19 +698,36 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
                     }
                   }
                 }
-                out_hashes[k] = hash_words(out, words);
-                out_parents[k] = s;
-                out_firings[k] = t;
+                const std::uint64_t h = hash_words(out, words);
+                if (fused) {
+                  Shard& sh = shards_[h >> (64 - kShardBits)];
+                  const std::uint64_t frag = h & 0x7FFFFFFFull;
+                  if (!contains<W>(sh, frag, out, words)) {
+                    if (states_ >= kMaxStates)
+                      vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
+                    insert_slot(sh, h, frag << 32 | add_state(out, s, t));
+                  }
+                } else {
+                  out_hashes[k] = h;
+                  out_parents[k] = s;
+                  out_firings[k] = t;
+                }
                 ++k;
               }
             }
-            ch.markings.set_size(k * words);
-            ch.hashes.set_size(k);
-            ch.parents.set_size(k);
-            ch.firings.set_size(k);
+            if (!fused) {
+              ch.markings.set_size(k * words);
+              ch.hashes.set_size(k);
+              ch.parents.set_size(k);
+              ch.firings.set_size(k);
+            }
             const std::uint64_t count = k - k0;
             st.edges += count;
             if (count == 0 && s < st.first_dead) st.first_dead = s;
+          }
+          if (fused) {  // the new states go straight into the arena and the hash set
+            if (memory() > limit_) stop.store(true);
+            continue;
           }
           ch.fresh.assign(ch.hashes.size(), 0);
           ch.ids.resize(ch.hashes.size());
@@ -713,107 +757,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
       break;
     }
 
-    // ---- phase B: look up / insert into the shards ----------------------------------------------------
-    std::size_t candidates = 0;
-    for (std::size_t ci = 0; ci < nchunks; ++ci) candidates += chunks_[ci].hashes.size();
-    const unsigned bworkers = candidates > 4096 ? std::min<unsigned>(threads_, kShards) : 1u;
-    // Worker w owns the shards s with owner(s) == w: a range of shards each, found by a multiply and a
-    // shift (a division per candidate would cost more than the rest of a probe).
-    auto owner = [bworkers](std::size_t shard) {
-      return static_cast<unsigned>((shard * bworkers) >> kShardBits);
-    };
-    with_words(L.words, [&](auto wc) {
-      constexpr std::uint32_t W = decltype(wc)::value;
-      const std::uint32_t words = W != 0 ? W : L.words;
-      const bool all_mine = bworkers == 1;
-      run_workers(bworkers, [&](unsigned wi) {
-        // Worker wi reads every candidate's hash in order and takes those of its shards.
-        constexpr std::size_t kAhead =
-            8;  // the table probes are cache misses: prefetch a few candidates ahead
-        for (std::size_t ci = 0; ci < nchunks; ++ci) {
-          Chunk& ch = chunks_[ci];
-          const std::size_t count = ch.hashes.size();
-          const std::uint64_t* hashes = ch.hashes.data();
-          const std::uint64_t* markings = ch.markings.data();
-          for (std::size_t i = 0; i < count; ++i) {
-            if (i + kAhead < count) {
-              const std::uint64_t ha = hashes[i + kAhead];
-              const Shard& sa = shards_[ha >> (64 - kShardBits)];
-              if (all_mine || owner(ha >> (64 - kShardBits)) == wi)
-                __builtin_prefetch(sa.slots.data() + ((ha & 0x7FFFFFFFull) & (sa.slots.size() - 1)));
-            }
-            const std::uint64_t h = hashes[i];
-            const std::size_t si = h >> (64 - kShardBits);
-            if (!all_mine && owner(si) != wi) continue;
-            Shard& sh = shards_[si];
-            const std::uint64_t frag = h & 0x7FFFFFFFull;
-            const std::uint64_t* mk = markings + i * words;
-            const std::uint64_t* slots = sh.slots.data();
-            const std::size_t mask = sh.slots.size() - 1;
-            std::size_t pos = frag & mask;
-            bool found = false;
-            for (;; pos = (pos + 1) & mask) {
-              const std::uint64_t v = slots[pos];
-              if (v == kEmpty) break;
-              if (((v >> 32) & 0x7FFFFFFFull) != frag) continue;
-              const std::uint64_t* other;
-              if (v & kPendingBit) {
-                const std::uint64_t ref = sh.pending[v & 0xFFFFFFFFull];
-                other = chunks_[ref >> 32].markings.data() + (ref & 0xFFFFFFFFull) * words;
-              } else {
-                other = record(static_cast<std::uint32_t>(v & 0xFFFFFFFFull));
-              }
-              if (same(other, mk, words)) {
-                found = true;
-                break;
-              }
-            }
-            if (found) continue;
-            ch.fresh[i] = 1;
-            const std::uint64_t pidx = sh.pending.size();
-            sh.pending.push_back((std::uint64_t{ci} << 32) | i);
-            insert_slot(sh, h, kPendingBit | frag << 32 | pidx);
-          }
-        }
-      });
-    });
-
-    // ---- phase C: number the new markings in candidate order ----------------------------------------
-    const std::uint64_t new_lo = states_;
-    bool too_many = false;
-    for (std::size_t ci = 0; ci < nchunks && !too_many; ++ci) {
-      Chunk& ch = chunks_[ci];
-      for (std::size_t i = 0; i < ch.fresh.size(); ++i) {
-        if (!ch.fresh[i]) continue;
-        if (states_ >= kMaxStates) {
-          too_many = true;
-          break;
-        }
-        ch.ids[i] = add_state(ch.markings.data() + i * L.words, ch.parents[i], ch.firings[i]);
-      }
-    }
-    if (too_many) vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
-
-    // ---- phase D: pending entries become state indices ----------------------------------------------
-    run_workers(bworkers, [&](unsigned wi) {
-      for (std::size_t si = 0; si < kShards; ++si) {
-        if (owner(si) != wi) continue;
-        Shard& sh = shards_[si];
-        const std::size_t mask = sh.slots.size() - 1;
-        for (std::size_t k = 0; k < sh.pending.size(); ++k) {
-          const std::uint64_t ref = sh.pending[k];
-          const Chunk& ch = chunks_[ref >> 32];
-          const std::size_t i = ref & 0xFFFFFFFFull;
-          const std::uint64_t h = ch.hashes[i];
-          const std::uint64_t frag = h & 0x7FFFFFFFull;
-          const std::uint64_t want = kPendingBit | frag << 32 | k;
-          std::size_t pos = frag & mask;
-          while (sh.slots[pos] != want) pos = (pos + 1) & mask;
-          sh.slots[pos] = frag << 32 | ch.ids[i];
-        }
-        sh.pending.clear();
-      }
-    });
+    if (!fused) phases_b_to_d(nchunks, L);
 
     // ---- unboundedness: does a new marking strictly cover an ancestor? -------------------------------
     if (check_cover && states_ > new_lo) {
@@ -884,6 +828,90 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     r.dead_marking = unpack(first_dead);
   }
   return true;
+}
+
+// Phases B to D of a level expanded by several workers (see the file comment).
+void Explorer::phases_b_to_d(std::size_t nchunks, const Layout& L) {
+  // ---- phase B: look up / insert into the shards ----------------------------------------------------
+  std::size_t candidates = 0;
+  for (std::size_t ci = 0; ci < nchunks; ++ci) candidates += chunks_[ci].hashes.size();
+  const unsigned bworkers = candidates > 4096 ? std::min<unsigned>(threads_, kShards) : 1u;
+  // Worker w owns the shards s with owner(s) == w: a range of shards each, found by a multiply and a
+  // shift (a division per candidate would cost more than the rest of a probe).
+  auto owner = [bworkers](std::size_t shard) {
+    return static_cast<unsigned>((shard * bworkers) >> kShardBits);
+  };
+  with_words(L.words, [&](auto wc) {
+    constexpr std::uint32_t W = decltype(wc)::value;
+    const std::uint32_t words = W != 0 ? W : L.words;
+    const bool all_mine = bworkers == 1;
+    run_workers(bworkers, [&](unsigned wi) {
+      // Worker wi reads every candidate's hash in order and takes those of its shards.
+      constexpr std::size_t kAhead = 8;  // the table probes are cache misses: prefetch a few candidates ahead
+      for (std::size_t ci = 0; ci < nchunks; ++ci) {
+        Chunk& ch = chunks_[ci];
+        const std::size_t count = ch.hashes.size();
+        const std::uint64_t* hashes = ch.hashes.data();
+        const std::uint64_t* markings = ch.markings.data();
+        for (std::size_t i = 0; i < count; ++i) {
+          if (i + kAhead < count) {
+            const std::uint64_t ha = hashes[i + kAhead];
+            const Shard& sa = shards_[ha >> (64 - kShardBits)];
+            if (all_mine || owner(ha >> (64 - kShardBits)) == wi)
+              __builtin_prefetch(sa.slots.data() + ((ha & 0x7FFFFFFFull) & (sa.slots.size() - 1)));
+          }
+          const std::uint64_t h = hashes[i];
+          const std::size_t si = h >> (64 - kShardBits);
+          if (!all_mine && owner(si) != wi) continue;
+          Shard& sh = shards_[si];
+          const std::uint64_t frag = h & 0x7FFFFFFFull;
+          const std::uint64_t* mk = markings + i * words;
+          const bool found = contains<W>(sh, frag, mk, words);
+          if (found) continue;
+          ch.fresh[i] = 1;
+          const std::uint64_t pidx = sh.pending.size();
+          sh.pending.push_back((std::uint64_t{ci} << 32) | i);
+          insert_slot(sh, h, kPendingBit | frag << 32 | pidx);
+        }
+      }
+    });
+  });
+
+  // ---- phase C: number the new markings in candidate order ----------------------------------------
+  bool too_many = false;
+  for (std::size_t ci = 0; ci < nchunks && !too_many; ++ci) {
+    Chunk& ch = chunks_[ci];
+    for (std::size_t i = 0; i < ch.fresh.size(); ++i) {
+      if (!ch.fresh[i]) continue;
+      if (states_ >= kMaxStates) {
+        too_many = true;
+        break;
+      }
+      ch.ids[i] = add_state(ch.markings.data() + i * L.words, ch.parents[i], ch.firings[i]);
+    }
+  }
+  if (too_many) vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
+
+  // ---- phase D: pending entries become state indices ----------------------------------------------
+  run_workers(bworkers, [&](unsigned wi) {
+    for (std::size_t si = 0; si < kShards; ++si) {
+      if (owner(si) != wi) continue;
+      Shard& sh = shards_[si];
+      const std::size_t mask = sh.slots.size() - 1;
+      for (std::size_t k = 0; k < sh.pending.size(); ++k) {
+        const std::uint64_t ref = sh.pending[k];
+        const Chunk& ch = chunks_[ref >> 32];
+        const std::size_t i = ref & 0xFFFFFFFFull;
+        const std::uint64_t h = ch.hashes[i];
+        const std::uint64_t frag = h & 0x7FFFFFFFull;
+        const std::uint64_t want = kPendingBit | frag << 32 | k;
+        std::size_t pos = frag & mask;
+        while (sh.slots[pos] != want) pos = (pos + 1) & mask;
+        sh.slots[pos] = frag << 32 | ch.ids[i];
+      }
+      sh.pending.clear();
+    }
+  });
 }
 
 }  // namespace
