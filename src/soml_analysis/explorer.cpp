@@ -339,10 +339,10 @@ class Explorer {
         std::uint64_t* down = down_.data() + std::size_t{t} * tw_;
         for (std::uint32_t i = c_.delta_begin[t]; i < c_.delta_begin[t + 1]; ++i) {
           const auto& d = c_.delta[i];
-          for (std::uint32_t u : inputs_of[d.place])
-            (d.delta > 0 ? up : down)[u >> 6] |= std::uint64_t{1} << (u & 63);
-          for (std::uint32_t u : inhibitors_of[d.place])
-            (d.delta > 0 ? down : up)[u >> 6] |= std::uint64_t{1} << (u & 63);
+          std::uint64_t* gains = d.delta > 0 ? up : down;  // input arcs on d.place
+          std::uint64_t* loses = d.delta > 0 ? down : up;  // inhibitor arcs on d.place
+          for (const std::uint32_t r : inputs_of[d.place]) gains[r >> 6] |= std::uint64_t{1} << (r & 63);
+          for (const std::uint32_t r : inhibitors_of[d.place]) loses[r >> 6] |= std::uint64_t{1} << (r & 63);
         }
       }
     }
@@ -562,12 +562,11 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     const std::uint64_t n = hi - lo;
     const std::size_t nchunks = (n + kChunkStates - 1) / kChunkStates;
     const unsigned workers = static_cast<unsigned>(std::min<std::size_t>(threads_, nchunks));
-    // One worker and a small hash set: each successor is looked up (and a new one numbered) as soon as it is made, in the
-    // order phases B and C would have used, so the numbering is the same; no successor buffers, and
-    // phases B to D fall away. Chunk 0 serves as scratch.
-    // Only while the hash set is small enough to stay in cache: on a larger one the lookups are cache
-    // misses, which phase B hides by prefetching a few candidates ahead (the ring of 490 314 states ran
-    // 25 % slower fused).
+    // One worker and a small hash set: each successor is looked up (and a new one numbered) as soon as it is
+    // made, in the order phases B and C would have used, so the numbering is the same; no successor buffers,
+    // and phases B to D fall away. Chunk 0 serves as scratch. Only while the hash set is small enough to stay
+    // in cache: on a larger one the lookups are cache misses, which phase B hides by prefetching a few
+    // candidates ahead (the ring of 490 314 states ran 25 % slower fused).
     std::size_t table_bytes = 0;
     for (const auto& sh : shards_) table_bytes += sh.slots.size() * 8;
     const bool fused = workers == 1 && table_bytes <= kFusedTableBytes;
