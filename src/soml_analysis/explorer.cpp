@@ -26,6 +26,7 @@
 #include <ostream>
 #include <sstream>
 #include <thread>
+#include <type_traits>
 
 #include "compiled_net.hpp"
 #include "place_bounds.hpp"
@@ -43,9 +44,10 @@ constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
 constexpr std::uint64_t kPendingBit = std::uint64_t{1} << 63;
 constexpr unsigned kShardBits = 6;
 constexpr std::size_t kShards = std::size_t{1} << kShardBits;
-constexpr std::size_t kChunkStates = 256;             // frontier states per work item of phase A
-constexpr unsigned kBlockBits = 12;                   // states per arena block = 2^12
-constexpr std::uint64_t kMaxStates = UINT32_MAX - 1;  // indices are 32-bit; kNone is reserved
+constexpr std::size_t kChunkStates = 256;                       // frontier states per work item of phase A
+constexpr unsigned kBlockBits = 12;                             // states per arena block = 2^12
+constexpr std::uint64_t kMaxStates = UINT32_MAX - 1;            // indices are 32-bit; kNone is reserved
+constexpr std::size_t kFusedTableBytes = std::size_t{1} << 20;  // see `fused` in attempt()
 
 std::string format_bytes(std::size_t b) {
   char buf[32];
@@ -108,6 +110,12 @@ struct PackedNet {
   std::vector<WordOp> ops;
   std::vector<WordTest> tests;
   std::vector<std::uint8_t> never;  // one bit per place: needs two or more tokens from a place
+  // Markings of at most kDenseWords words: the same, dense, `words` entries per transition, so that the
+  // explorer's loops over a marking's words are unrolled and branch-free. diff = add - sub (mod 2^64):
+  // firing adds it to each word. need/forbid: the WordTests (all ones in both for a `never` transition,
+  // which no marking passes).
+  static constexpr std::uint32_t kDenseWords = 4;
+  std::vector<std::uint64_t> diff, need, forbid;
 
   PackedNet(const Compiled& c, const PtNet& net, const Layout& L) {
     const std::uint32_t per_word_mask = (1u << L.shift) - 1;
@@ -119,7 +127,8 @@ struct PackedNet {
       for (std::uint32_t i = c.delta_begin[t]; i < c.delta_begin[t + 1]; ++i) {
         const auto& d = c.delta[i];
         const std::uint32_t w = word_of(d.place);
-        auto it = std::find_if(ops.begin() + op_begin[t], ops.end(), [&](const WordOp& o) { return o.word == w; });
+        auto it =
+            std::find_if(ops.begin() + op_begin[t], ops.end(), [&](const WordOp& o) { return o.word == w; });
         if (it == ops.end()) it = ops.insert(ops.end(), WordOp{w, 0, 0});
         const auto magnitude = static_cast<std::uint64_t>(d.delta < 0 ? -d.delta : d.delta);
         (d.delta < 0 ? it->sub : it->add) += magnitude << off_of(d.place);
@@ -144,6 +153,20 @@ struct PackedNet {
     }
     op_begin.push_back(static_cast<std::uint32_t>(ops.size()));
     test_begin.push_back(static_cast<std::uint32_t>(tests.size()));
+    if (L.words > kDenseWords) return;
+    const std::size_t W = L.words;
+    diff.assign(c.transitions * W, 0);
+    need.assign(c.transitions * W, 0);
+    forbid.assign(c.transitions * W, 0);
+    for (std::uint32_t t = 0; t < c.transitions; ++t) {
+      for (std::uint32_t i = op_begin[t]; i < op_begin[t + 1]; ++i)
+        diff[t * W + ops[i].word] = ops[i].add - ops[i].sub;
+      for (std::uint32_t i = test_begin[t]; i < test_begin[t + 1]; ++i) {
+        need[t * W + tests[i].word] = tests[i].need;
+        forbid[t * W + tests[i].word] = tests[i].forbid;
+      }
+      if (never[t]) need[t * W] = forbid[t * W] = ~std::uint64_t{0};
+    }
   }
 
   bool enabled(std::uint32_t t, const std::uint64_t* m) const {
@@ -163,7 +186,7 @@ struct PackedNet {
   }
 };
 
-std::uint64_t hash_words(const std::uint64_t* w, std::uint32_t n) {
+inline std::uint64_t hash_words(const std::uint64_t* w, std::uint32_t n) {
   std::uint64_t h = 0x243F6A8885A308D3ull ^ n;
   for (std::uint32_t i = 0; i < n; ++i) {
     h ^= w[i];
@@ -209,12 +232,65 @@ struct alignas(64) WorkerStats {
   std::vector<std::uint32_t> unpacked2;
 };
 
+// A growable array of a trivial type whose growth does not fill the new elements (std::vector::resize
+// would zero them, only to have them overwritten: a memset per frontier state).
+template <class T>
+class PodBuffer {
+ public:
+  std::size_t size() const { return n_; }
+  std::size_t capacity() const { return cap_; }
+  T* data() { return p_.get(); }
+  const T* data() const { return p_.get(); }
+  T& operator[](std::size_t i) { return p_[i]; }
+  const T& operator[](std::size_t i) const { return p_[i]; }
+  void clear() { n_ = 0; }
+  void reserve(std::size_t c) {
+    if (c <= cap_) return;
+    std::unique_ptr<T[]> q(new T[c]);  // default-initialised: not filled
+    if (n_ != 0) std::memcpy(q.get(), p_.get(), n_ * sizeof(T));
+    p_ = std::move(q);
+    cap_ = c;
+  }
+  // Capacity for at least c elements, doubling: amortised constant growth.
+  void ensure(std::size_t c) {
+    if (c > cap_) reserve(std::max(c, cap_ * 2));
+  }
+  // Only within the capacity; the new elements are not initialised.
+  void set_size(std::size_t n) { n_ = n; }
+
+ private:
+  std::unique_ptr<T[]> p_;
+  std::size_t n_ = 0, cap_ = 0;
+};
+
+// Calls f(std::integral_constant<std::uint32_t, W>) with W = words for the marking widths the explorer
+// has unrolled loops for, W = 0 (the width known at run time only) for the others.
+template <class F>
+void with_words(std::uint32_t words, F&& f) {
+  switch (words) {
+    case 1:
+      f(std::integral_constant<std::uint32_t, 1>{});
+      break;
+    case 2:
+      f(std::integral_constant<std::uint32_t, 2>{});
+      break;
+    case 3:
+      f(std::integral_constant<std::uint32_t, 3>{});
+      break;
+    case 4:
+      f(std::integral_constant<std::uint32_t, 4>{});
+      break;
+    default:
+      f(std::integral_constant<std::uint32_t, 0>{});
+  }
+}
+
 // Successors of one chunk of the frontier.
 struct Chunk {
-  std::vector<std::uint64_t> markings;  // `words` per candidate
-  std::vector<std::uint64_t> hashes;
-  std::vector<std::uint32_t> parents;
-  std::vector<std::uint32_t> firings;
+  PodBuffer<std::uint64_t> markings;  // `words` per candidate
+  PodBuffer<std::uint64_t> hashes;
+  PodBuffer<std::uint32_t> parents;
+  PodBuffer<std::uint32_t> firings;
   std::vector<std::uint8_t> fresh;  // phase B: first occurrence of a new marking
   std::vector<std::uint32_t> ids;   // phase C: its state index
   void clear() {
@@ -244,6 +320,32 @@ class Explorer {
     show_progress_ = opt.progress == ExploreOptions::Progress::always ||
                      (opt.progress == ExploreOptions::Progress::automatic && isatty(STDERR_FILENO) == 1);
     tw_ = std::max<std::uint32_t>(1, (c_.transitions + 63) / 64);
+    // Which transitions a firing of t can enable and which it can disable. An input arc is satisfied
+    // from `weight` tokens up, an inhibitor arc below `weight`: a place that gains tokens can only
+    // satisfy its input arcs and break its inhibitor arcs, one that loses tokens the reverse. So after
+    // firing t, a transition u that was enabled needs a test only if t can disable it (down), one that
+    // was not only if t can enable it (up). Kept as bitsets over the transitions, tw_ words per t, for
+    // nets with up to 64 * kDirWords transitions; larger nets test every transition in aff.
+    if (tw_ <= kDirWords) {
+      up_.assign(std::size_t{c_.transitions} * tw_, 0);
+      down_.assign(std::size_t{c_.transitions} * tw_, 0);
+      std::vector<std::vector<std::uint32_t>> inputs_of(c_.places), inhibitors_of(c_.places);
+      for (std::uint32_t u = 0; u < c_.transitions; ++u) {
+        for (const auto& a : net.transitions()[u].inputs) inputs_of[a.place].push_back(u);
+        for (const auto& a : net.transitions()[u].inhibitors) inhibitors_of[a.place].push_back(u);
+      }
+      for (std::uint32_t t = 0; t < c_.transitions; ++t) {
+        std::uint64_t* up = up_.data() + std::size_t{t} * tw_;
+        std::uint64_t* down = down_.data() + std::size_t{t} * tw_;
+        for (std::uint32_t i = c_.delta_begin[t]; i < c_.delta_begin[t + 1]; ++i) {
+          const auto& d = c_.delta[i];
+          std::uint64_t* gains = d.delta > 0 ? up : down;  // input arcs on d.place
+          std::uint64_t* loses = d.delta > 0 ? down : up;  // inhibitor arcs on d.place
+          for (const std::uint32_t r : inputs_of[d.place]) gains[r >> 6] |= std::uint64_t{1} << (r & 63);
+          for (const std::uint32_t r : inhibitors_of[d.place]) loses[r >> 6] |= std::uint64_t{1} << (r & 63);
+        }
+      }
+    }
   }
 
   ExploreResult run() {
@@ -372,6 +474,28 @@ class Explorer {
 
   // One exploration with `bits` per place; false when a place outgrew them.
   bool attempt(unsigned bits, ExploreResult& r);
+  void phases_b_to_d(std::size_t nchunks, const Layout& L);
+
+  // Whether the hash set holds marking mk (fragment frag of its hash), committed or pending. W: the
+  // marking's words if the loop over them is unrolled, else 0.
+  template <std::uint32_t W>
+  bool contains(const Shard& sh, std::uint64_t frag, const std::uint64_t* mk, std::uint32_t words) const {
+    const std::uint64_t* slots = sh.slots.data();
+    const std::size_t mask = sh.slots.size() - 1;
+    for (std::size_t pos = frag & mask;; pos = (pos + 1) & mask) {
+      const std::uint64_t v = slots[pos];
+      if (v == kEmpty) return false;
+      if (((v >> 32) & 0x7FFFFFFFull) != frag) continue;
+      const std::uint64_t* other;
+      if (v & kPendingBit) {
+        const std::uint64_t ref = sh.pending[v & 0xFFFFFFFFull];
+        other = chunks_[ref >> 32].markings.data() + (ref & 0xFFFFFFFFull) * words;
+      } else {
+        other = record(static_cast<std::uint32_t>(v & 0xFFFFFFFFull));
+      }
+      if (same(other, mk, W != 0 ? W : words)) return true;
+    }
+  }
 
   const PtNet& net_;
   Compiled c_;
@@ -384,6 +508,8 @@ class Explorer {
   bool progress_shown_ = false;
   Clock::time_point start_, last_progress_;
   std::uint32_t tw_ = 1;  // words of an enabled-transition bitset
+  static constexpr std::uint32_t kDirWords = 8;
+  std::vector<std::uint64_t> up_, down_;  // per transition, tw_ words each (when tw_ <= kDirWords)
   Layout layout_{1, 0};
   std::vector<std::unique_ptr<std::uint64_t[]>> blocks_;
   std::vector<Shard> shards_;
@@ -435,9 +561,18 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
   for (; lo < hi; ++level) {
     const std::uint64_t n = hi - lo;
     const std::size_t nchunks = (n + kChunkStates - 1) / kChunkStates;
-    if (chunks_.size() < nchunks) chunks_.resize(nchunks);
-    cur_enabled_.assign(n * tw_, 0);
     const unsigned workers = static_cast<unsigned>(std::min<std::size_t>(threads_, nchunks));
+    // One worker and a small hash set: each successor is looked up (and a new one numbered) as soon as it is
+    // made, in the order phases B and C would have used, so the numbering is the same; no successor buffers,
+    // and phases B to D fall away. Chunk 0 serves as scratch. Only while the hash set is small enough to stay
+    // in cache: on a larger one the lookups are cache misses, which phase B hides by prefetching a few
+    // candidates ahead (the ring of 490 314 states ran 25 % slower fused).
+    std::size_t table_bytes = 0;
+    for (const auto& sh : shards_) table_bytes += sh.slots.size() * 8;
+    const bool fused = workers == 1 && table_bytes <= kFusedTableBytes;
+    const std::uint64_t new_lo = states_;
+    if (chunks_.size() < (fused ? 1 : nchunks)) chunks_.resize(fused ? 1 : nchunks);
+    cur_enabled_.assign(n * tw_, 0);
     std::atomic<std::size_t> next_chunk{0};
     std::atomic<bool> stop{false};
     std::size_t base_memory = memory();
@@ -446,104 +581,165 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     const double successors_per_state = lo == 0 ? 1.0 : static_cast<double>(edges_) / static_cast<double>(lo);
 
     // ---- phase A: expand the frontier -------------------------------------------------------------
-    run_workers(workers, [&](unsigned wi) {
-      WorkerStats& st = ws[wi];
-      std::uint32_t* m = st.unpacked.data();
-      while (!stop.load(std::memory_order_relaxed)) {
-        const std::size_t ci = next_chunk.fetch_add(1);
-        if (ci >= nchunks) break;
-        Chunk& ch = chunks_[ci];
-        ch.clear();
-        const std::uint64_t first = lo + ci * kChunkStates;
-        const std::uint64_t last = std::min(hi, first + kChunkStates);
-        // Size the buffers from the successors per state so far: few reallocations while filling them.
-        const auto expect =
-            static_cast<std::size_t>(static_cast<double>(last - first) * successors_per_state * 1.25) + 16;
-        if (ch.hashes.capacity() < expect) {
-          ch.markings.reserve(expect * L.words);
+    // W: the marking's words when the loops over them are unrolled (1..4), else 0 (L.words at run time).
+    with_words(L.words, [&](auto wc) {
+      constexpr std::uint32_t W = decltype(wc)::value;
+      const std::uint32_t words = W != 0 ? W : L.words;
+      run_workers(workers, [&](unsigned wi) {
+        WorkerStats& st = ws[wi];
+        std::uint32_t* m = st.unpacked.data();
+        while (!stop.load(std::memory_order_relaxed)) {
+          const std::size_t ci = next_chunk.fetch_add(1);
+          if (ci >= nchunks) break;
+          Chunk& ch = chunks_[fused ? 0 : ci];
+          ch.clear();
+          const std::uint64_t first = lo + ci * kChunkStates;
+          const std::uint64_t last = std::min(hi, first + kChunkStates);
+          // Size the buffers from the successors per state so far: few reallocations while filling them.
+          const auto expect =
+              static_cast<std::size_t>(static_cast<double>(last - first) * successors_per_state * 1.25) + 16;
+          ch.markings.reserve(expect * words);
           ch.hashes.reserve(expect);
           ch.parents.reserve(expect);
           ch.firings.reserve(expect);
-        }
-        for (std::uint64_t s64 = first; s64 < last; ++s64) {
-          const auto s = static_cast<std::uint32_t>(s64);
-          const std::uint64_t* rec = record(s);
-          if (unpack_states) {
-            L.unpack(rec, P, m);
-            std::uint64_t sum = 0;
-            for (std::uint32_t p = 0; p < P; ++p) {
-              sum += m[p];
-              st.max_place = std::max(st.max_place, m[p]);
+          for (std::uint64_t s64 = first; s64 < last; ++s64) {
+            const auto s = static_cast<std::uint32_t>(s64);
+            const std::uint64_t* rec = record(s);
+            if (unpack_states) {
+              L.unpack(rec, P, m);
+              std::uint64_t sum = 0;
+              for (std::uint32_t p = 0; p < P; ++p) {
+                sum += m[p];
+                st.max_place = std::max(st.max_place, m[p]);
+              }
+              st.max_sum = std::max(st.max_sum, sum);
+            } else {  // one bit per place: the tokens are the set bits
+              std::uint64_t sum = 0;
+              for (std::uint32_t w = 0; w < words; ++w)
+                sum += static_cast<std::uint64_t>(std::popcount(rec[w]));
+              st.max_sum = std::max(st.max_sum, sum);
+              if (sum != 0) st.max_place = std::max(st.max_place, 1u);
             }
-            st.max_sum = std::max(st.max_sum, sum);
-          } else {  // one bit per place: the tokens are the set bits
-            std::uint64_t sum = 0;
-            for (std::uint32_t w = 0; w < L.words; ++w) sum += static_cast<std::uint64_t>(std::popcount(rec[w]));
-            st.max_sum = std::max(st.max_sum, sum);
-            if (sum != 0) st.max_place = std::max(st.max_place, 1u);
-          }
-          auto enabled = [&](std::uint32_t t) { return use_masks ? pk.enabled(t, rec) : c_.enabled(t, m); };
-          std::uint64_t* en = cur_enabled_.data() + (s64 - lo) * tw_;
-          if (s == 0) {
-            for (std::uint32_t t = 0; t < c_.transitions; ++t)
-              if (enabled(t)) en[t >> 6] |= std::uint64_t{1} << (t & 63);
-          } else {
-            // Incremental enabling: the parent's set, with the transitions reading a changed place retested.
-            const std::uint32_t par = static_cast<std::uint32_t>(rec[L.words] >> 32);
-            const std::uint32_t ft = static_cast<std::uint32_t>(rec[L.words] & 0xFFFFFFFFu);
-            std::memcpy(en, prev_enabled_.data() + (par - prev_lo) * tw_, tw_ * 8);
-            for (std::uint32_t i = c_.aff_begin[ft]; i < c_.aff_begin[ft + 1]; ++i) {
-              const std::uint32_t u = c_.aff[i];
-              const std::uint64_t bit = std::uint64_t{1} << (u & 63);
-              if (enabled(u))
-                en[u >> 6] |= bit;
-              else
-                en[u >> 6] &= ~bit;
-            }
-          }
-          std::uint64_t count = 0;
-          for (std::uint32_t wd = 0; wd < tw_; ++wd)
-            count += static_cast<std::uint64_t>(std::popcount(en[wd]));
-          // Room for all successors at once: no per-successor growth checks in the loop below.
-          std::size_t k = ch.hashes.size();
-          ch.markings.resize((k + count) * L.words);
-          ch.hashes.resize(k + count);
-          ch.parents.resize(k + count);
-          ch.firings.resize(k + count);
-          for (std::uint32_t wd = 0; wd < tw_; ++wd) {
-            std::uint64_t bitsw = en[wd];
-            while (bitsw != 0) {
-              const std::uint32_t t = wd * 64 + static_cast<std::uint32_t>(std::countr_zero(bitsw));
-              bitsw &= bitsw - 1;
-              std::uint64_t* out = ch.markings.data() + k * L.words;
-              for (std::uint32_t w = 0; w < L.words; ++w) out[w] = rec[w];
-              if (use_ops) {
-                pk.fire(t, out);
-              } else {
-                for (std::uint32_t i = c_.delta_begin[t]; i < c_.delta_begin[t + 1]; ++i) {
-                  const auto& d = c_.delta[i];
-                  const std::int64_t v = static_cast<std::int64_t>(m[d.place]) + d.delta;
-                  if (static_cast<std::uint64_t>(v) > L.mask) {
-                    st.overflow = true;
-                    stop.store(true, std::memory_order_relaxed);
-                  }
-                  L.set(out, d.place, static_cast<std::uint64_t>(v) & L.mask);
+            auto enabled = [&](std::uint32_t t) -> bool {
+              if constexpr (W != 0) {
+                if (use_masks) {  // branch-free over the W words
+                  const std::uint64_t* need = pk.need.data() + std::size_t{t} * W;
+                  const std::uint64_t* forbid = pk.forbid.data() + std::size_t{t} * W;
+                  std::uint64_t bad = 0;
+                  for (std::uint32_t w = 0; w < W; ++w)
+                    bad |= ((rec[w] & need[w]) ^ need[w]) | (rec[w] & forbid[w]);
+                  return bad == 0;
                 }
               }
-              ch.hashes[k] = hash_words(out, L.words);
-              ch.parents[k] = s;
-              ch.firings[k] = t;
-              ++k;
+              return use_masks ? pk.enabled(t, rec) : c_.enabled(t, m);
+            };
+            std::uint64_t* en = cur_enabled_.data() + (s64 - lo) * tw_;
+            if (s == 0) {
+              for (std::uint32_t t = 0; t < c_.transitions; ++t)
+                if (enabled(t)) en[t >> 6] |= std::uint64_t{1} << (t & 63);
+            } else {
+              // Incremental enabling: the parent's set, with the transitions reading a changed place
+              // retested.
+              const std::uint32_t par = static_cast<std::uint32_t>(rec[L.words] >> 32);
+              const std::uint32_t ft = static_cast<std::uint32_t>(rec[L.words] & 0xFFFFFFFFu);
+              const std::uint64_t* pen = prev_enabled_.data() + (par - prev_lo) * tw_;
+              for (std::uint32_t wd = 0; wd < tw_; ++wd) en[wd] = pen[wd];
+              if (!up_.empty()) {  // only those that the firing can switch, in the direction it can
+                const std::uint64_t* up = up_.data() + std::size_t{ft} * tw_;
+                const std::uint64_t* down = down_.data() + std::size_t{ft} * tw_;
+                for (std::uint32_t wd = 0; wd < tw_; ++wd) {
+                  std::uint64_t retest = (up[wd] & ~en[wd]) | (down[wd] & en[wd]);
+                  while (retest != 0) {
+                    const unsigned b = static_cast<unsigned>(std::countr_zero(retest));
+                    retest &= retest - 1;
+                    const std::uint64_t e = enabled(wd * 64 + b) ? 1 : 0;
+                    en[wd] = (en[wd] & ~(std::uint64_t{1} << b)) | (e << b);
+                  }
+                }
+              } else {
+                for (std::uint32_t i = c_.aff_begin[ft]; i < c_.aff_begin[ft + 1]; ++i) {
+                  const std::uint32_t u = c_.aff[i];
+                  const std::uint64_t e = enabled(u) ? 1 : 0;
+                  en[u >> 6] = (en[u >> 6] & ~(std::uint64_t{1} << (u & 63))) | (e << (u & 63));
+                }
+              }
             }
+            // Room for every transition's successor: no per-successor growth checks in the loop below.
+            const std::size_t k0 = ch.hashes.size();
+            ch.markings.ensure((k0 + c_.transitions) * words);
+            ch.hashes.ensure(k0 + c_.transitions);
+            ch.parents.ensure(k0 + c_.transitions);
+            ch.firings.ensure(k0 + c_.transitions);
+            std::uint64_t* const out_markings = ch.markings.data();
+            std::uint64_t* const out_hashes = ch.hashes.data();
+            std::uint32_t* const out_parents = ch.parents.data();
+            std::uint32_t* const out_firings = ch.firings.data();
+            std::size_t k = k0;
+            for (std::uint32_t wd = 0; wd < tw_; ++wd) {
+              std::uint64_t bitsw = en[wd];
+              while (bitsw != 0) {
+                const std::uint32_t t = wd * 64 + static_cast<std::uint32_t>(std::countr_zero(bitsw));
+                bitsw &= bitsw - 1;
+                std::uint64_t* out = out_markings + (fused ? k0 : k) * words;
+                if constexpr (W != 0) {
+                  if (use_ops) {  // firing adds each word's difference: no carries cross fields here
+                    const std::uint64_t* d = pk.diff.data() + std::size_t{t} * W;
+                    for (std::uint32_t w = 0; w < W; ++w) out[w] = rec[w] + d[w];
+                  }
+                }
+                if (W == 0 || !use_ops) {
+                  for (std::uint32_t w = 0; w < words; ++w) out[w] = rec[w];
+                  if (use_ops) {
+                    pk.fire(t, out);
+                  } else {
+                    for (std::uint32_t i = c_.delta_begin[t]; i < c_.delta_begin[t + 1]; ++i) {
+                      const auto& d = c_.delta[i];
+                      const std::int64_t v = static_cast<std::int64_t>(m[d.place]) + d.delta;
+                      if (static_cast<std::uint64_t>(v) > L.mask) {
+                        st.overflow = true;
+                        stop.store(true, std::memory_order_relaxed);
+                      }
+                      L.set(out, d.place, static_cast<std::uint64_t>(v) & L.mask);
+                    }
+                  }
+                }
+                const std::uint64_t h = hash_words(out, words);
+                if (fused) {
+                  Shard& sh = shards_[h >> (64 - kShardBits)];
+                  const std::uint64_t frag = h & 0x7FFFFFFFull;
+                  if (!contains<W>(sh, frag, out, words)) {
+                    if (states_ >= kMaxStates)
+                      vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
+                    insert_slot(sh, h, frag << 32 | add_state(out, s, t));
+                  }
+                } else {
+                  out_hashes[k] = h;
+                  out_parents[k] = s;
+                  out_firings[k] = t;
+                }
+                ++k;
+              }
+            }
+            if (!fused) {
+              ch.markings.set_size(k * words);
+              ch.hashes.set_size(k);
+              ch.parents.set_size(k);
+              ch.firings.set_size(k);
+            }
+            const std::uint64_t count = k - k0;
+            st.edges += count;
+            if (count == 0 && s < st.first_dead) st.first_dead = s;
           }
-          st.edges += count;
-          if (count == 0 && s < st.first_dead) st.first_dead = s;
+          if (fused) {  // the new states go straight into the arena and the hash set
+            if (memory() > limit_) stop.store(true);
+            continue;
+          }
+          ch.fresh.assign(ch.hashes.size(), 0);
+          ch.ids.resize(ch.hashes.size());
+          // A level whose successors alone would pass the limit stops here, before it exhausts the machine.
+          if (base_memory + (successor_bytes += ch.bytes()) > limit_) stop.store(true);
         }
-        ch.fresh.assign(ch.hashes.size(), 0);
-        ch.ids.resize(ch.hashes.size());
-        // A level whose successors alone would pass the limit stops here, before it exhausts the machine.
-        if (base_memory + (successor_bytes += ch.bytes()) > limit_) stop.store(true);
-      }
+      });
     });
     for (auto& w : ws) {
       if (w.overflow) return false;
@@ -566,96 +762,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
       break;
     }
 
-    // ---- phase B: look up / insert into the shards ----------------------------------------------------
-    std::size_t candidates = 0;
-    for (std::size_t ci = 0; ci < nchunks; ++ci) candidates += chunks_[ci].hashes.size();
-    const unsigned bworkers = candidates > 4096 ? std::min<unsigned>(threads_, kShards) : 1u;
-    // Worker w owns the shards s with owner(s) == w: a range of shards each, found by a multiply and a
-    // shift (a division per candidate would cost more than the rest of a probe).
-    auto owner = [bworkers](std::size_t shard) { return static_cast<unsigned>((shard * bworkers) >> kShardBits); };
-    run_workers(bworkers, [&](unsigned wi) {
-      // Worker wi reads every candidate's hash in order and takes those of its shards.
-      constexpr std::size_t kAhead = 8;  // the table probes are cache misses: prefetch a few candidates ahead
-      for (std::size_t ci = 0; ci < nchunks; ++ci) {
-        Chunk& ch = chunks_[ci];
-        const std::size_t count = ch.hashes.size();
-        for (std::size_t i = 0; i < count; ++i) {
-          if (i + kAhead < count) {
-            const std::uint64_t ha = ch.hashes[i + kAhead];
-            const Shard& sa = shards_[ha >> (64 - kShardBits)];
-            if (owner(ha >> (64 - kShardBits)) == wi)
-              __builtin_prefetch(sa.slots.data() + ((ha & 0x7FFFFFFFull) & (sa.slots.size() - 1)));
-          }
-          const std::uint64_t h = ch.hashes[i];
-          const std::size_t si = h >> (64 - kShardBits);
-          if (owner(si) != wi) continue;
-          Shard& sh = shards_[si];
-          const std::uint64_t frag = h & 0x7FFFFFFFull;
-          const std::uint64_t* mk = ch.markings.data() + i * L.words;
-          std::size_t mask = sh.slots.size() - 1;
-          std::size_t pos = frag & mask;
-          bool found = false;
-          for (;; pos = (pos + 1) & mask) {
-            const std::uint64_t v = sh.slots[pos];
-            if (v == kEmpty) break;
-            if (((v >> 32) & 0x7FFFFFFFull) != frag) continue;
-            const std::uint64_t* other;
-            if (v & kPendingBit) {
-              const std::uint64_t ref = sh.pending[v & 0xFFFFFFFFull];
-              other = chunks_[ref >> 32].markings.data() + (ref & 0xFFFFFFFFull) * L.words;
-            } else {
-              other = record(static_cast<std::uint32_t>(v & 0xFFFFFFFFull));
-            }
-            if (same(other, mk, L.words)) {
-              found = true;
-              break;
-            }
-          }
-          if (found) continue;
-          ch.fresh[i] = 1;
-          const std::uint64_t pidx = sh.pending.size();
-          sh.pending.push_back((std::uint64_t{ci} << 32) | i);
-          insert_slot(sh, h, kPendingBit | frag << 32 | pidx);
-        }
-      }
-    });
-
-    // ---- phase C: number the new markings in candidate order ----------------------------------------
-    const std::uint64_t new_lo = states_;
-    bool too_many = false;
-    for (std::size_t ci = 0; ci < nchunks && !too_many; ++ci) {
-      Chunk& ch = chunks_[ci];
-      for (std::size_t i = 0; i < ch.fresh.size(); ++i) {
-        if (!ch.fresh[i]) continue;
-        if (states_ >= kMaxStates) {
-          too_many = true;
-          break;
-        }
-        ch.ids[i] = add_state(ch.markings.data() + i * L.words, ch.parents[i], ch.firings[i]);
-      }
-    }
-    if (too_many) vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
-
-    // ---- phase D: pending entries become state indices ----------------------------------------------
-    run_workers(bworkers, [&](unsigned wi) {
-      for (std::size_t si = 0; si < kShards; ++si) {
-        if (owner(si) != wi) continue;
-        Shard& sh = shards_[si];
-        const std::size_t mask = sh.slots.size() - 1;
-        for (std::size_t k = 0; k < sh.pending.size(); ++k) {
-          const std::uint64_t ref = sh.pending[k];
-          const Chunk& ch = chunks_[ref >> 32];
-          const std::size_t i = ref & 0xFFFFFFFFull;
-          const std::uint64_t h = ch.hashes[i];
-          const std::uint64_t frag = h & 0x7FFFFFFFull;
-          const std::uint64_t want = kPendingBit | frag << 32 | k;
-          std::size_t pos = frag & mask;
-          while (sh.slots[pos] != want) pos = (pos + 1) & mask;
-          sh.slots[pos] = frag << 32 | ch.ids[i];
-        }
-        sh.pending.clear();
-      }
-    });
+    if (!fused) phases_b_to_d(nchunks, L);
 
     // ---- unboundedness: does a new marking strictly cover an ancestor? -------------------------------
     if (check_cover && states_ > new_lo) {
@@ -726,6 +833,90 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     r.dead_marking = unpack(first_dead);
   }
   return true;
+}
+
+// Phases B to D of a level expanded by several workers (see the file comment).
+void Explorer::phases_b_to_d(std::size_t nchunks, const Layout& L) {
+  // ---- phase B: look up / insert into the shards ----------------------------------------------------
+  std::size_t candidates = 0;
+  for (std::size_t ci = 0; ci < nchunks; ++ci) candidates += chunks_[ci].hashes.size();
+  const unsigned bworkers = candidates > 4096 ? std::min<unsigned>(threads_, kShards) : 1u;
+  // Worker w owns the shards s with owner(s) == w: a range of shards each, found by a multiply and a
+  // shift (a division per candidate would cost more than the rest of a probe).
+  auto owner = [bworkers](std::size_t shard) {
+    return static_cast<unsigned>((shard * bworkers) >> kShardBits);
+  };
+  with_words(L.words, [&](auto wc) {
+    constexpr std::uint32_t W = decltype(wc)::value;
+    const std::uint32_t words = W != 0 ? W : L.words;
+    const bool all_mine = bworkers == 1;
+    run_workers(bworkers, [&](unsigned wi) {
+      // Worker wi reads every candidate's hash in order and takes those of its shards.
+      constexpr std::size_t kAhead = 8;  // the table probes are cache misses: prefetch a few candidates ahead
+      for (std::size_t ci = 0; ci < nchunks; ++ci) {
+        Chunk& ch = chunks_[ci];
+        const std::size_t count = ch.hashes.size();
+        const std::uint64_t* hashes = ch.hashes.data();
+        const std::uint64_t* markings = ch.markings.data();
+        for (std::size_t i = 0; i < count; ++i) {
+          if (i + kAhead < count) {
+            const std::uint64_t ha = hashes[i + kAhead];
+            const Shard& sa = shards_[ha >> (64 - kShardBits)];
+            if (all_mine || owner(ha >> (64 - kShardBits)) == wi)
+              __builtin_prefetch(sa.slots.data() + ((ha & 0x7FFFFFFFull) & (sa.slots.size() - 1)));
+          }
+          const std::uint64_t h = hashes[i];
+          const std::size_t si = h >> (64 - kShardBits);
+          if (!all_mine && owner(si) != wi) continue;
+          Shard& sh = shards_[si];
+          const std::uint64_t frag = h & 0x7FFFFFFFull;
+          const std::uint64_t* mk = markings + i * words;
+          const bool found = contains<W>(sh, frag, mk, words);
+          if (found) continue;
+          ch.fresh[i] = 1;
+          const std::uint64_t pidx = sh.pending.size();
+          sh.pending.push_back((std::uint64_t{ci} << 32) | i);
+          insert_slot(sh, h, kPendingBit | frag << 32 | pidx);
+        }
+      }
+    });
+  });
+
+  // ---- phase C: number the new markings in candidate order ----------------------------------------
+  bool too_many = false;
+  for (std::size_t ci = 0; ci < nchunks && !too_many; ++ci) {
+    Chunk& ch = chunks_[ci];
+    for (std::size_t i = 0; i < ch.fresh.size(); ++i) {
+      if (!ch.fresh[i]) continue;
+      if (states_ >= kMaxStates) {
+        too_many = true;
+        break;
+      }
+      ch.ids[i] = add_state(ch.markings.data() + i * L.words, ch.parents[i], ch.firings[i]);
+    }
+  }
+  if (too_many) vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
+
+  // ---- phase D: pending entries become state indices ----------------------------------------------
+  run_workers(bworkers, [&](unsigned wi) {
+    for (std::size_t si = 0; si < kShards; ++si) {
+      if (owner(si) != wi) continue;
+      Shard& sh = shards_[si];
+      const std::size_t mask = sh.slots.size() - 1;
+      for (std::size_t k = 0; k < sh.pending.size(); ++k) {
+        const std::uint64_t ref = sh.pending[k];
+        const Chunk& ch = chunks_[ref >> 32];
+        const std::size_t i = ref & 0xFFFFFFFFull;
+        const std::uint64_t h = ch.hashes[i];
+        const std::uint64_t frag = h & 0x7FFFFFFFull;
+        const std::uint64_t want = kPendingBit | frag << 32 | k;
+        std::size_t pos = frag & mask;
+        while (sh.slots[pos] != want) pos = (pos + 1) & mask;
+        sh.slots[pos] = frag << 32 | ch.ids[i];
+      }
+      sh.pending.clear();
+    }
+  });
 }
 
 }  // namespace
