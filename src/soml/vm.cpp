@@ -148,7 +148,8 @@ Val ProgramImpl::exec(std::size_t entry) {
   };
 
   for (;;) {
-    const Ins in = *pc++;
+    Ins in = *pc++;
+  dispatch:
     switch (in.op) {
       case OP_NOP:
         break;
@@ -724,6 +725,16 @@ Val ProgramImpl::exec(std::size_t entry) {
       case OP_FAIL:
         VSD_SAVE();
         fail(strings_[in.b]);
+      case OP_BREAK: {
+        // Only a debugger patches this in (a line start or a breakpoint), so the hook is set. It may
+        // read the frames and registers; then the original instruction runs as if never patched.
+        VSD_SAVE();
+        const auto at = static_cast<std::size_t>(pc - 1 - code);
+        in = fr->fn->original[at];
+        if (debug_ != nullptr) debug_->on_break(*fr->fn, at);
+        VSD_REFRESH();
+        goto dispatch;
+      }
       default:
         VSD_SAVE();
         fail("bad instruction");
