@@ -163,9 +163,18 @@ class Debugger::Impl final : public DebugHooks {
       for (std::size_t i = 0; i < s.size() && !any; ++i)
         any = s[i] != 0 && (stepping || (s[i] == 1 && lines.count(f.lines[i]) != 0));
       if (!any && f.original.empty()) continue;
-      if (f.original.empty()) f.original = f.code;
+      if (f.original.empty()) {
+        f.original = f.code;
+        f.tramp.resize(2 * f.code.size());
+        for (std::size_t i = 0; i < f.code.size(); ++i) {
+          f.tramp[2 * i] = f.code[i];
+          f.tramp[2 * i + 1] = Ins{OP_RESUME, static_cast<std::uint8_t>((i + 1) >> 16), 0, 0,
+                                   static_cast<std::uint16_t>((i + 1) & 0xFFFF)};
+        }
+      }
       for (std::size_t i = 0; i < s.size(); ++i) {
-        const bool want = s[i] != 0 && (stepping || (s[i] == 1 && lines.count(f.lines[i]) != 0));
+        const bool want = s[i] != 0 && f.original[i].op != OP_JMP &&
+                          (stepping || (s[i] == 1 && lines.count(f.lines[i]) != 0));
         f.code[i] = f.original[i];
         if (want) f.code[i].op = OP_BREAK;
       }
@@ -302,9 +311,7 @@ class Debugger::Impl final : public DebugHooks {
                   std::to_string(P_.frames_.size()) + ")");
     return P_.frames_[P_.frames_.size() - 1 - k];
   }
-  static std::size_t pc_of(const Frame& f) {
-    return f.pc > f.fn->code.data() ? static_cast<std::size_t>(f.pc - f.fn->code.data()) - 1 : 0;
-  }
+  static std::size_t pc_of(const Frame& f) { return pc_index(f); }
 
   std::string instance_label(std::uint64_t id) const {
     if (id == 0) return "null";

@@ -99,7 +99,8 @@ enum Op : std::uint8_t {
   OP_NULLCHK,  // error "null" unless a
   OP_RANGE,    // check that a fits the storage type consts[b] (int properties narrower than int64)
   OP_FAIL,     // run-time error strings[b]
-  OP_BREAK     // debugger: patched over a line start; calls the hook, then runs Function::original[pc]
+  OP_BREAK,    // debugger: patched over a line start; calls the hook, then runs Function::tramp[2 pc]
+  OP_RESUME    // the second instruction of a trampoline: pc = target (no budget)
 };
 
 struct Ins {
@@ -133,6 +134,7 @@ struct Function {
   };
   std::vector<Local> locals;
   std::vector<Ins> original;  // the code before a debugger patched OP_BREAK in (empty: never patched)
+  std::vector<Ins> tramp;     // per instruction i: original[i], OP_RESUME to i + 1 (made with original)
 };
 
 // The debugger's hooks (debugger.cpp). Null when none is attached: the VM then meets no OP_BREAK and
@@ -220,6 +222,15 @@ struct Frame {
   std::uint64_t self;
   std::uint64_t mark;
 };
+
+// The index of the instruction a frame last started (its call, or where it stopped), also when the
+// frame runs in its function's debugger trampoline.
+inline std::size_t pc_index(const Frame& f) noexcept {
+  const Function& fn = *f.fn;
+  if (!fn.tramp.empty() && f.pc > fn.tramp.data() && f.pc <= fn.tramp.data() + fn.tramp.size())
+    return static_cast<std::size_t>(f.pc - fn.tramp.data() - 1) / 2;
+  return f.pc > fn.code.data() ? static_cast<std::size_t>(f.pc - fn.code.data()) - 1 : 0;
+}
 
 class ProgramImpl {
  public:
