@@ -5,6 +5,7 @@
 
 #include "vsd/soml/ast.hpp"
 #include "vsd/soml/checker.hpp"
+#include "vsd/soml/debugger.hpp"
 #include "vsd/soml/fwd.hpp"
 #include "vsd/soml/lexer.hpp"
 #include "vsd/soml/module.hpp"

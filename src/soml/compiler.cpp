@@ -51,6 +51,7 @@ class Compiler {
   }
 
   void finish() {
+    close_locals(0);
     F.nregs = max_ + 1;
     F.compiled = true;
     if (max_ > 60000) not_supported(P, SourceLoc{}, "a function with more than 60000 registers");
@@ -963,11 +964,28 @@ class Compiler {
   std::vector<Loop> loops_;
 
   void block(const BlockStmt& b) {
+    const std::size_t open = open_.size();
     for (const StmtPtr& s : b.body) stmt(*s);
+    close_locals(open);
+  }
+
+  // The debugger's table of local names: a local is visible from the end of its initialisation to the
+  // end of its block (or of the loop that declares it).
+  std::vector<std::size_t> open_;  // indices into F.locals still in scope
+  void declare(const std::string& name, int slot, const Type& type) {
+    F.locals.push_back(Function::Local{name, slot, type, static_cast<std::uint32_t>(here()), 0});
+    open_.push_back(F.locals.size() - 1);
+  }
+  void close_locals(std::size_t n) {
+    while (open_.size() > n) {
+      F.locals[open_.back()].to = static_cast<std::uint32_t>(here());
+      open_.pop_back();
+    }
   }
 
   void stmt(const Stmt& s) {
     const int save = top_;
+    const std::size_t open = open_.size();
     at(s.loc);
     switch (s.kind) {
       case StmtKind::Block:
@@ -986,6 +1004,7 @@ class Compiler {
         } else {
           load_int(l.slot, 0);
         }
+        declare(l.name, l.slot, l.type);
         break;
       }
       case StmtKind::If: {
@@ -1051,6 +1070,7 @@ class Compiler {
         const std::size_t jf = emit_jump(OP_JGEI, i, n);
         move(f.var->slot, i, RK::I);
         emit(OP_LGET, f.var->slot, hold, slot);
+        declare(f.var->name, f.var->slot, f.var->type);
         loops_.emplace_back();
         stmt(*f.body);
         const std::size_t cont = here();
@@ -1084,6 +1104,7 @@ class Compiler {
         step_expr(*s.as<ExprStmt>().expr);
         break;
     }
+    if (s.kind != StmtKind::Local) close_locals(open);
     top_ = save;
   }
 
@@ -1128,6 +1149,7 @@ int compile_function(ProgramImpl& p, int index, const FunctionDecl& fd) {
   for (const Param& prm : fd.params) {
     const RK k = reg_kind(prm.type);
     if (k == RK::None) not_supported(p, prm.loc, "a parameter of type '" + prm.type.name() + "'");
+    c.declare(prm.name, static_cast<int>(f.param_kinds.size()), prm.type);
     f.param_kinds.push_back(k);
   }
   f.nparams = static_cast<int>(fd.params.size());
@@ -1156,6 +1178,7 @@ int compile_condition(ProgramImpl& p, const TransitionDecl& t, const std::string
   f.result_type = Type::of(K::Bool);
   Compiler c(p, f, &t, t.when_slots);
   if (t.when_expr) {
+    c.at(t.when_expr->loc);  // the line table (run-time errors, the debugger)
     const int r = c.temp();
     c.expr_to(*t.when_expr, r, f.result_type);
     c.emit(OP_RET, r);
@@ -1183,6 +1206,7 @@ int compile_arrow_condition(ProgramImpl& p, const ArrowDecl& a, const std::strin
   f.result = RK::I;
   f.result_type = Type::of(K::Bool);
   Compiler c(p, f, parent_scope(a), a.condition_slots);
+  c.at(a.condition->loc);
   const int r = c.temp();
   c.expr_to(*a.condition, r, f.result_type);
   c.emit(OP_RET, r);
@@ -1202,6 +1226,7 @@ int compile_init(ProgramImpl& p, const ScopeDecl& s, const std::string& name) {
     if (reg_kind(pd.type) == RK::None)
       not_supported(p, pd.init->loc, "an initial value of type '" + pd.type.name() + "'");
     const int v = c.temp();
+    c.at(pd.init->loc);
     c.expr_to(*pd.init, v, pd.type);
     const int self = c.self_at(0, pd.loc);
     c.at(pd.loc);

@@ -199,8 +199,10 @@ void ProgramImpl::fire(std::uint32_t i) {
   const TransitionInfo& t = net.cls->transitions[static_cast<std::size_t>(ti.t)];
   Transition& tn = *net.transitions[static_cast<std::size_t>(ti.t)];
   const std::uint64_t mark = ti.mark;
+  if (debug_ != nullptr) debug_->on_fire(tn, mark);  // a breakpoint on the transition (debugger.cpp)
   SimStateInstance* m = mark != 0 ? state_.find(mark) : nullptr;
   Place* from = nullptr;
+  std::vector<TokenMove> taken, given;  // black token moves, recorded only for the trace
   std::size_t from_index = 0;
   // Consume.
   std::vector<Place*>& remote_in = remote_scratch_;  // reused: no allocation per firing
@@ -210,7 +212,10 @@ void ProgramImpl::fire(std::uint32_t i) {
     if (a.inhibitor) continue;
     if (a.remote) {
       remote_in[k] = remote_place(a, net.owner);
-      if (remote_in[k] != nullptr) remote_in[k]->set_tokens(remote_in[k]->tokens() - a.weight);
+      if (remote_in[k] != nullptr) {
+        remote_in[k]->set_tokens(remote_in[k]->tokens() - a.weight);
+        if (trace_) taken.push_back(TokenMove{remote_in[k], a.weight});
+      }
       continue;
     }
     Place& p = *net.places[static_cast<std::size_t>(a.place)];
@@ -220,6 +225,7 @@ void ProgramImpl::fire(std::uint32_t i) {
       if (from_index != RefListBase::npos) p.edit_objects().erase(from_index);
     } else if (!a.object) {
       p.set_tokens(p.tokens() - a.weight);
+      if (trace_) taken.push_back(TokenMove{&p, a.weight});
     }
   }
   // Act; on an error, give the consumed tokens back and report.
@@ -258,8 +264,10 @@ void ProgramImpl::fire(std::uint32_t i) {
     if (pp == nullptr) continue;  // a communication arrow whose path meets a null reference
     Place& p = *pp;
     if (!a.object) {
-      if (a.cond < 0 || run(a.cond, net.owner, mark, nullptr, nullptr).i != 0)
+      if (a.cond < 0 || run(a.cond, net.owner, mark, nullptr, nullptr).i != 0) {
         p.set_tokens(p.tokens() + a.weight);
+        if (trace_) given.push_back(TokenMove{&p, a.weight});
+      }
     } else if (to == nullptr && m != nullptr && m->as<Node>() != nullptr) {
       if (a.cond >= 0 && run(a.cond, net.owner, mark, nullptr, nullptr).i == 0) continue;
       p.edit_objects().push_back(*m->as<Node>());
@@ -269,7 +277,7 @@ void ProgramImpl::fire(std::uint32_t i) {
   tn.set_firings(tn.firings() + 1);
   ++firings_;
   mark_dirty(i);
-  if (trace_) trace_(Firing{firings_, &tn, mark, from, to});
+  if (trace_) trace_(Firing{firings_, &tn, mark, from, to, std::move(taken), std::move(given)});
 }
 
 std::uint64_t ProgramImpl::step(std::uint64_t n) {

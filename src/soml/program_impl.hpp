@@ -98,7 +98,9 @@ enum Op : std::uint8_t {
   OP_PRINT,    // print registers a .. a+b-1; kinds from print_kinds[c]
   OP_NULLCHK,  // error "null" unless a
   OP_RANGE,    // check that a fits the storage type consts[b] (int properties narrower than int64)
-  OP_FAIL      // run-time error strings[b]
+  OP_FAIL,     // run-time error strings[b]
+  OP_BREAK,    // debugger: patched over a line start; calls the hook, then runs Function::tramp[2 pc]
+  OP_RESUME    // the second instruction of a trampoline: pc = target (no budget)
 };
 
 struct Ins {
@@ -123,6 +125,27 @@ struct Function {
   RK result = RK::None;
   Type result_type;
   bool compiled = false;
+  // For the debugger: parameters and locals by name, each visible in code [from, to).
+  struct Local {
+    std::string name;
+    int slot = 0;
+    Type type;
+    std::uint32_t from = 0, to = 0;
+  };
+  std::vector<Local> locals;
+  std::vector<Ins> original;  // the code before a debugger patched OP_BREAK in (empty: never patched)
+  std::vector<Ins> tramp;     // per instruction i: original[i], OP_RESUME to i + 1 (made with original)
+};
+
+// The debugger's hooks (debugger.cpp). Null when none is attached: the VM then meets no OP_BREAK and
+// the executor tests one pointer per firing.
+class DebugHooks {
+ public:
+  virtual ~DebugHooks() = default;
+  // An OP_BREAK at instruction @p at of the innermost frame (its pc is saved).
+  virtual void on_break(const Function& f, std::size_t at) = 0;
+  // Transition @p t of @p net is about to fire with mark @p mark.
+  virtual void on_fire(const Transition& t, std::uint64_t mark) = 0;
 };
 
 // How to reach the instance `outer` levels out of a function's scope: a fixed object, or parents.
@@ -199,6 +222,15 @@ struct Frame {
   std::uint64_t self;
   std::uint64_t mark;
 };
+
+// The index of the instruction a frame last started (its call, or where it stopped), also when the
+// frame runs in its function's debugger trampoline.
+inline std::size_t pc_index(const Frame& f) noexcept {
+  const Function& fn = *f.fn;
+  if (!fn.tramp.empty() && f.pc > fn.tramp.data() && f.pc <= fn.tramp.data() + fn.tramp.size())
+    return static_cast<std::size_t>(f.pc - fn.tramp.data() - 1) / 2;
+  return f.pc > fn.code.data() ? static_cast<std::size_t>(f.pc - fn.code.data()) - 1 : 0;
+}
 
 class ProgramImpl {
  public:
@@ -317,6 +349,7 @@ class ProgramImpl {
   std::uint64_t tests_ = 0;
   std::vector<std::string> condition_errors_;
   std::function<void(const Firing&)> trace_;
+  DebugHooks* debug_ = nullptr;
 
   void mark_dirty(std::uint32_t ti) {
     if (!tis_[ti].dirty && !tis_[ti].net->dead) {

@@ -64,8 +64,7 @@ std::string ProgramImpl::stack_text(std::size_t from) const {
   std::string s;
   for (std::size_t i = frames_.size(); i-- > from;) {
     const Frame& f = frames_[i];
-    const std::size_t at =
-        f.pc > f.fn->code.data() ? static_cast<std::size_t>(f.pc - f.fn->code.data()) - 1 : 0;
+    const std::size_t at = pc_index(f);
     const std::uint32_t line = at < f.fn->lines.size() ? f.fn->lines[at] : 0;
     s += "\n  at " + f.fn->name + " (" + checked_->source->name() + ":" + std::to_string(line) + ")";
   }
@@ -724,6 +723,20 @@ Val ProgramImpl::exec(std::size_t entry) {
       case OP_FAIL:
         VSD_SAVE();
         fail(strings_[in.b]);
+      case OP_BREAK: {
+        // Only a debugger patches this in (a line start or a breakpoint). After its hook, the original
+        // instruction runs from the function's trampoline (original, then OP_RESUME back here), so the
+        // hot loop has no extra test and no second dispatch path.
+        VSD_SAVE();
+        const auto at = static_cast<std::size_t>(pc - 1 - code);
+        if (debug_ != nullptr) debug_->on_break(*fr->fn, at);
+        VSD_REFRESH();
+        pc = fr->fn->tramp.data() + 2 * at;
+        break;
+      }
+      case OP_RESUME:
+        pc = VSD_TARGET(in);
+        break;
       default:
         VSD_SAVE();
         fail("bad instruction");

@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "debug.hpp"
 #include "vsd/core/environment.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/soml.hpp"
@@ -21,6 +22,7 @@ namespace an = vsd::soml::analysis;
 constexpr const char* kUsage =
     "Usage: vsd-soml analyze FILE [--json] [--threads N] [--limit-mem SIZE] [--progress | --no-progress]\n"
     "       vsd-soml run FILE [--steps N] [--trace] [--seed S]\n"
+    "       vsd-soml debug FILE [--break FILE:LINE]... [--break-transition NAME]... [--seed S] [--steps N]\n"
     "       vsd-soml convert IN OUT\n"
     "       vsd-soml --help\n"
     "\n"
@@ -31,6 +33,13 @@ constexpr const char* kUsage =
     "  --steps N         fire at most N transitions\n"
     "  --trace           print every firing: step, transition, the token it moved, from where to where\n"
     "  --seed S          the seed of the choice among enabled transitions (default 1)\n"
+    "\n"
+    "debug    Loads FILE like run and reads debugger commands from stdin: break, delete, step, next,\n"
+    "         finish, continue, bt, frame, locals, print, marking, trace, quit (`help` lists them).\n"
+    "         Every firing is printed as with --trace.\n"
+    "  --break LOC             stop when line LOC (FILE:LINE or LINE) runs; repeatable\n"
+    "  --break-transition T    stop before transition T (owner.name or name) fires; repeatable\n"
+    "  --steps N               fire at most N transitions in all (default 1000000)\n"
     "\n"
     "analyze  Explores the state space of the net in FILE and prints a summary: reachable markings\n"
     "         (states), firings (edges: one per reachable marking and transition enabled in it, as the\n"
@@ -118,13 +127,7 @@ int convert(const std::vector<std::string_view>& args) {
   return 0;
 }
 
-std::string node_label(const vsd::Node* n) {
-  if (n == nullptr) return "-";
-  const vsd::Node* owner = n->parent();
-  const bool script_level =
-      owner != nullptr && owner->parent() != nullptr && owner->parent()->parent() == nullptr;
-  return (owner != nullptr && !script_level ? owner->name() + "." : std::string()) + n->name();
-}
+std::string node_label(const vsd::Node* n) { return vsd::soml::net_node_label(n); }
 
 int run(const std::vector<std::string_view>& args) {
   std::string file;
@@ -292,6 +295,7 @@ int main(int argc, char** argv) {
   try {
     if (args[0] == "analyze") return analyze(std::vector<std::string_view>(args.begin() + 1, args.end()));
     if (args[0] == "run") return run(std::vector<std::string_view>(args.begin() + 1, args.end()));
+    if (args[0] == "debug") return debug_command(std::vector<std::string_view>(args.begin() + 1, args.end()));
     if (args[0] == "convert") return convert(std::vector<std::string_view>(args.begin() + 1, args.end()));
     return usage_error("unknown command '" + std::string(args[0]) + "'");
   } catch (const std::invalid_argument& e) {

@@ -42,13 +42,22 @@ struct RunOptions {
   std::ostream* out = nullptr;                    ///< where print() writes (std::cout when null)
 };
 
-/// @brief One firing, as the trace reports it.
+/// @brief Black tokens that one firing took from or put into one place.
+struct TokenMove {
+  const Place* place = nullptr;  ///< the place (a remote one for a communication arrow)
+  std::int64_t count = 0;        ///< how many tokens
+};
+
+/// @brief One firing, as the trace reports it: which token moved from where to where, through which
+/// transition, at which step.
 struct Firing {
   std::uint64_t step = 0;                  ///< number of the firing (1 for the first)
   const Transition* transition = nullptr;  ///< what fired
   vsd::Id mark = 0;                        ///< the token it moved (0: none)
   const Place* from = nullptr;             ///< where the mark came from (object input place)
   const Place* to = nullptr;               ///< where the mark went (null: it left the net)
+  std::vector<TokenMove> taken;            ///< black tokens consumed, in arrow order
+  std::vector<TokenMove> given;            ///< black tokens produced, in arrow order
 };
 
 class ProgramImpl;

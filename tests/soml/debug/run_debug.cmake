@@ -1,0 +1,23 @@
+# Runs `vsd-soml debug NAME.soml <args>` in this directory with NAME.cmd on stdin (args from its first
+# line "# args: ..."; that line is not sent) and compares stdout with NAME.out. Used by vsd_soml_debug_<name>.
+get_filename_component(dir "${CMD}" DIRECTORY)
+get_filename_component(name "${CMD}" NAME_WE)
+file(STRINGS "${CMD}" lines)
+set(args "")
+list(GET lines 0 first)
+if(first MATCHES "^# args: (.*)$")
+  separate_arguments(args UNIX_COMMAND "${CMAKE_MATCH_1}")
+  list(REMOVE_AT lines 0)
+endif()
+list(JOIN lines "\n" input)
+file(WRITE "${WORK}/${name}.in" "${input}\n")
+string(REGEX REPLACE "_[a-z]+$" "" script "${name}")
+execute_process(COMMAND "${TOOL}" debug "${script}.soml" ${args} WORKING_DIRECTORY "${dir}"
+  INPUT_FILE "${WORK}/${name}.in" OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+file(READ "${dir}/${name}.out" expected)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "vsd-soml debug failed (${rc}): ${err}")
+endif()
+if(NOT out STREQUAL expected)
+  message(FATAL_ERROR "output differs from ${dir}/${name}.out:\n--- got ---\n${out}--- expected ---\n${expected}")
+endif()
