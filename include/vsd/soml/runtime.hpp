@@ -49,6 +49,11 @@ struct Firing {
   vsd::Id mark = 0;                        ///< the token it moved (0: none)
   const Place* from = nullptr;             ///< where the mark came from (object input place)
   const Place* to = nullptr;               ///< where the mark went (null: it left the net)
+  /// @brief The net instance (a soml::Invocation) this firing started (an invoking transition), ended
+  /// (the transition whose action ran `finish`), or, for the completion of an invoking transition, the
+  /// one that just finished (then `step` repeats the finishing firing's number); 0 for other firings.
+  vsd::Id invocation = 0;
+  bool completion = false;  ///< the second half of an invoking transition (its `do` and its outputs)
 };
 
 class ProgramImpl;
