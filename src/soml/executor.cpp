@@ -254,7 +254,7 @@ void ProgramImpl::fire(std::uint32_t i) {
     tn.set_firings(tn.firings() + 1);
     ++firings_;
     mark_dirty(i);
-    if (trace_) trace_(Firing{firings_, &tn, mark, from, nullptr, inv->id(), false});
+    if (trace_) trace_(Firing{firings_, &tn, mark, from, nullptr, FiringKind::Invoke, inv->id()});
     return;
   }
   // Act; on an error, give the consumed tokens back and report.
@@ -272,7 +272,7 @@ void ProgramImpl::fire(std::uint32_t i) {
     if (invoker.first != nullptr) {
       const std::uint64_t instance = net.owner;
       ++firings_;
-      if (trace_) trace_(Firing{firings_, &tn, mark, from, nullptr, instance, false});
+      if (trace_) trace_(Firing{firings_, &tn, mark, from, nullptr, FiringKind::Finish, instance});
       complete_outputs(*invoker.first, invoker.second, instance);
       return;
     }
@@ -285,7 +285,7 @@ void ProgramImpl::fire(std::uint32_t i) {
   tn.set_firings(tn.firings() + 1);
   ++firings_;
   mark_dirty(i);
-  if (trace_) trace_(Firing{firings_, &tn, mark, from, to, 0, false});
+  if (trace_) trace_(Firing{firings_, &tn, mark, from, to});
 }
 
 // Produce: black tokens to every black output place, the mark to the first object place that takes it.

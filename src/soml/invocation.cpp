@@ -137,8 +137,8 @@ void ProgramImpl::complete_outputs(NetInst& outer, int index, std::uint64_t inst
   const auto ti = static_cast<std::uint32_t>(outer.first_ti + static_cast<std::uint32_t>(index));
   mark_dirty(ti);
   if (trace_)
-    trace_(Firing{firings_, outer.transitions[static_cast<std::size_t>(index)], mark, nullptr, to, instance,
-                  true});
+    trace_(Firing{firings_, outer.transitions[static_cast<std::size_t>(index)], mark, nullptr, to,
+                  FiringKind::Complete, instance});
 }
 
 }  // namespace vsd::soml

@@ -215,8 +215,9 @@ TEST_F(Nets, AnInvocationIsANetInstanceUnderTheInvokingTransitionUntilItFinishes
   EXPECT_EQ(p.place("done", desk)->objects()[0], job);
   ASSERT_EQ(trace.size(), 3u);  // the finishing firing, then the invoking transition's completion
   EXPECT_EQ(trace[1].invocation, inv_id);
-  EXPECT_FALSE(trace[1].completion);
-  EXPECT_TRUE(trace[2].completion);
+  EXPECT_EQ(trace[0].kind, vsd::soml::FiringKind::Invoke);
+  EXPECT_EQ(trace[1].kind, vsd::soml::FiringKind::Finish);
+  EXPECT_EQ(trace[2].kind, vsd::soml::FiringKind::Complete);
   EXPECT_EQ(trace[2].transition, call);
   EXPECT_EQ(trace[2].to, p.place("done", desk));
   EXPECT_EQ(trace[2].step, 2u);

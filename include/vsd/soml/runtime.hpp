@@ -42,18 +42,24 @@ struct RunOptions {
   std::ostream* out = nullptr;                    ///< where print() writes (std::cout when null)
 };
 
+/// @brief What a firing did besides moving tokens (net invocation, docs/soml.md 4.11).
+enum class FiringKind : std::uint8_t {
+  Plain,     ///< an ordinary firing
+  Invoke,    ///< an invoking transition's first half: it consumed its inputs and started a net instance
+  Finish,    ///< a transition of an invoked net ran `finish`: the instance ends
+  Complete,  ///< an invoking transition's second half, right after the Finish (same step): its action
+             ///< ran with the result and it produced its outputs; `from` is null
+};
+
 /// @brief One firing, as the trace reports it.
 struct Firing {
   std::uint64_t step = 0;                  ///< number of the firing (1 for the first)
   const Transition* transition = nullptr;  ///< what fired
   vsd::Id mark = 0;                        ///< the token it moved (0: none)
   const Place* from = nullptr;             ///< where the mark came from (object input place)
-  const Place* to = nullptr;               ///< where the mark went (null: it left the net)
-  /// @brief The net instance (a soml::Invocation) this firing started (an invoking transition), ended
-  /// (the transition whose action ran `finish`), or, for the completion of an invoking transition, the
-  /// one that just finished (then `step` repeats the finishing firing's number); 0 for other firings.
-  vsd::Id invocation = 0;
-  bool completion = false;  ///< the second half of an invoking transition (its `do` and its outputs)
+  const Place* to = nullptr;               ///< where the mark went (null: it left the net, or waits)
+  FiringKind kind = FiringKind::Plain;     ///< see FiringKind
+  vsd::Id invocation = 0;                  ///< the net instance started, finished or completed (0: Plain)
 };
 
 class ProgramImpl;
