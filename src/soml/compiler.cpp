@@ -1093,7 +1093,8 @@ class Compiler {
         break;
       }
       case StmtKind::Finish:
-        not_supported(P, s.loc, "'finish' (net invocation)");
+        finish_stmt(s.as<ReturnStmt>());
+        break;
       case StmtKind::Break:
         loops_.back().breaks.push_back(emit_jump(OP_JMP));
         break;
@@ -1109,6 +1110,32 @@ class Compiler {
   }
 
   void step_expr(const Expr& e) { (void)expr(e); }
+
+  // `finish v;` (4.11): the result and `finished` become properties of the invoked net's instance (so
+  // the finish is database state, recorded and saved); the executor completes the invocation after
+  // the action. The action ends here.
+  void finish_stmt(const ReturnStmt& r) {
+    int outer = 0;
+    const Decl* d = F.scope;
+    for (; d != nullptr && d->kind != DeclKind::Net; d = d->parent) ++outer;
+    if (d == nullptr) not_supported(P, r.loc, "'finish' outside an invoked net");
+    auto it = P.class_info_.find(&d->as<ClassDecl>());
+    if (it == P.class_info_.end()) not_supported(P, r.loc, "'finish' in this net");
+    const ClassInfo& ci = *it->second;
+    if (r.value && ci.result_slot >= 0) {
+      const int v = temp();
+      expr_to(*r.value, v, d->as<ClassDecl>().result_type);
+      const int inst = self_at(outer, r.loc);
+      at(r.loc);
+      emit(OP_SETP, inst, v, ci.result_slot);
+    }
+    const int inst = self_at(outer, r.loc);
+    const int one = temp();
+    load_int(one, 1);
+    at(r.loc);
+    emit(OP_SETP, inst, one, meta_slot(&Invocation::vsd_prop_finished()));
+    emit(OP_RET0);
+  }
 
   // Jump when the condition is false; `i < n` and `i <= n` on ints fuse into one instruction.
   std::size_t cond_jump(const Expr& c) {
@@ -1252,6 +1279,35 @@ int compile_object_ctor(ProgramImpl& p, const ClassDecl& obj, int ctor, const Fu
   if (base == c.top_) c.temp();
   c.at(obj.base_loc);
   c.emit(OP_CALL, base, ctor, 0);
+  c.emit(OP_RET0);
+  c.finish();
+  return i;
+}
+
+// The arguments of an invoking transition (self: the transition, slot 0: the new net instance): each is
+// evaluated where the transition is (its mark included) and set as the value parameter's property.
+int compile_invoke_args(ProgramImpl& p, const TransitionDecl& t, const std::string& name) {
+  const int i = new_function(p, name);
+  Function& f = *p.functions_[i];
+  f.nparams = 1;
+  f.param_kinds = {RK::R};
+  Compiler c(p, f, &t, 1);
+  const ClassDecl& net = *t.invoked;
+  for (std::size_t k = 0; k < net.params.size() && k < t.invoke_args.size(); ++k) {
+    const PropertyDecl* pd = nullptr;
+    for (const DeclPtr& m : net.members)
+      if (m->kind == DeclKind::Property && m->as<PropertyDecl>().is_param && m->name == net.params[k].name)
+        pd = &m->as<PropertyDecl>();
+    auto slot = pd != nullptr ? p.prop_slot_.find(pd) : p.prop_slot_.end();
+    if (slot == p.prop_slot_.end()) not_supported(p, t.invoke_args[k]->loc, "this net parameter");
+    if (reg_kind(pd->type) == RK::None)
+      not_supported(p, t.invoke_args[k]->loc, "a net parameter of type '" + pd->type.name() + "'");
+    const int v = c.temp();
+    c.expr_to(*t.invoke_args[k], v, pd->type);
+    c.at(t.invoke_args[k]->loc);
+    c.emit(OP_SETP, 0, v, slot->second);
+    c.top_ = 1;
+  }
   c.emit(OP_RET0);
   c.finish();
   return i;

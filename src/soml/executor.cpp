@@ -228,37 +228,81 @@ void ProgramImpl::fire(std::uint32_t i) {
       if (trace_) taken.push_back(TokenMove{&p, a.weight});
     }
   }
+  // On an error, the consumed tokens go back.
+  auto give_back = [&] {
+    for (std::size_t k = 0; k < t.in.size(); ++k) {
+      const ArrowInfo& a = t.in[k];
+      if (a.inhibitor) continue;
+      if (a.remote) {
+        if (remote_in[k] != nullptr && state_.find(remote_in[k]->id()) == remote_in[k])
+          remote_in[k]->set_tokens(remote_in[k]->tokens() + a.weight);
+        continue;
+      }
+      if (net.dead) continue;
+      Place& p = *net.places[static_cast<std::size_t>(a.place)];
+      if (static_cast<int>(k) == t.mark_in) {
+        if (m != nullptr && state_.find(mark) == m && from_index != RefListBase::npos)
+          p.edit_objects().insert(std::min(from_index, p.objects().size()), *m->as<Node>());
+      } else if (!a.object) {
+        p.set_tokens(p.tokens() + a.weight);
+      }
+    }
+  };
+  // An invoking transition: a new net instance takes over; the mark waits in it (4.11).
+  if (t.invoke != nullptr) {
+    SimStateInstance* inv = nullptr;
+    try {
+      inv = &start_invocation(t, tn, mark);
+    } catch (...) {
+      give_back();
+      throw;
+    }
+    tn.set_firings(tn.firings() + 1);
+    ++firings_;
+    mark_dirty(i);
+    if (trace_)
+      trace_(Firing{firings_, &tn, mark, from, nullptr, FiringKind::Invoke, inv->id(), std::move(taken), {}});
+    return;
+  }
   // Act; on an error, give the consumed tokens back and report.
   if (t.action >= 0) {
+    std::pair<NetInst*, int> invoker{nullptr, -1};
     try {
       run(t.action, tn.id(), mark, nullptr, nullptr);
+      // `finish` ran: the invoking transition's action runs with the result now (its error undoes this
+      // firing too), then the instance goes and the invoking transition produces its outputs.
+      if (net.cls->invocable && !net.dead && finished(net)) invoker = complete_action(net);
     } catch (...) {
-      for (std::size_t k = 0; k < t.in.size(); ++k) {
-        const ArrowInfo& a = t.in[k];
-        if (a.inhibitor) continue;
-        if (a.remote) {
-          if (remote_in[k] != nullptr && state_.find(remote_in[k]->id()) == remote_in[k])
-            remote_in[k]->set_tokens(remote_in[k]->tokens() + a.weight);
-          continue;
-        }
-        Place& p = *net.places[static_cast<std::size_t>(a.place)];
-        if (static_cast<int>(k) == t.mark_in) {
-          if (m != nullptr && state_.find(mark) == m && from_index != RefListBase::npos)
-            p.edit_objects().insert(std::min(from_index, p.objects().size()), *m->as<Node>());
-        } else if (!a.object) {
-          p.set_tokens(p.tokens() + a.weight);
-        }
-      }
+      give_back();
       throw;
+    }
+    if (invoker.first != nullptr) {
+      const std::uint64_t instance = net.owner;
+      ++firings_;
+      if (trace_)
+        trace_(
+            Firing{firings_, &tn, mark, from, nullptr, FiringKind::Finish, instance, std::move(taken), {}});
+      complete_outputs(*invoker.first, invoker.second, instance);
+      return;
     }
     if (net.dead) {  // the action deleted its own net: nothing to produce into
       ++firings_;
       return;
     }
   }
-  // Produce: black tokens to every black output place, the mark to the first object place that takes it.
+  Place* to = produce(net, t, mark, trace_ ? &given : nullptr);
+  tn.set_firings(tn.firings() + 1);
+  ++firings_;
+  mark_dirty(i);
+  if (trace_)
+    trace_(Firing{firings_, &tn, mark, from, to, FiringKind::Plain, 0, std::move(taken), std::move(given)});
+}
+
+// Produce: black tokens to every black output place, the mark to the first object place that takes it.
+Place* ProgramImpl::produce(NetInst& net, const TransitionInfo& t, std::uint64_t mark,
+                            std::vector<TokenMove>* given) {
   Place* to = nullptr;
-  m = mark != 0 ? state_.find(mark) : nullptr;
+  SimStateInstance* m = mark != 0 ? state_.find(mark) : nullptr;
   for (const ArrowInfo& a : t.out) {
     Place* pp = a.remote ? remote_place(a, net.owner) : net.places[static_cast<std::size_t>(a.place)];
     if (pp == nullptr) continue;  // a communication arrow whose path meets a null reference
@@ -266,7 +310,7 @@ void ProgramImpl::fire(std::uint32_t i) {
     if (!a.object) {
       if (a.cond < 0 || run(a.cond, net.owner, mark, nullptr, nullptr).i != 0) {
         p.set_tokens(p.tokens() + a.weight);
-        if (trace_) given.push_back(TokenMove{&p, a.weight});
+        if (given != nullptr) given->push_back(TokenMove{&p, a.weight});
       }
     } else if (to == nullptr && m != nullptr && m->as<Node>() != nullptr) {
       if (a.cond >= 0 && run(a.cond, net.owner, mark, nullptr, nullptr).i == 0) continue;
@@ -274,10 +318,7 @@ void ProgramImpl::fire(std::uint32_t i) {
       to = &p;
     }
   }
-  tn.set_firings(tn.firings() + 1);
-  ++firings_;
-  mark_dirty(i);
-  if (trace_) trace_(Firing{firings_, &tn, mark, from, to, std::move(taken), std::move(given)});
+  return to;
 }
 
 std::uint64_t ProgramImpl::step(std::uint64_t n) {

@@ -17,6 +17,7 @@ void Module::register_types(vsd::Registry& registry) {
   registry.add<Place>();
   registry.add<Transition>();
   registry.add<Arrow>();
+  registry.add<Invocation>();
 }
 
 void Module::attach(vsd::Environment& env) {

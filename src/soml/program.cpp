@@ -74,6 +74,29 @@ static const MetaType* storage_type(ProgramImpl& p, Registry& reg, const Type& t
   }
 }
 
+// How the VM stores a property of static type t (see PK).
+static PK prop_kind(const Type& t, const MetaProperty& mp) {
+  switch (t.kind) {
+    case K::Bool:
+      return PK::Bool;
+    case K::Int:
+      return &mp.type() == &meta_type<std::int64_t>() ? PK::I64 : PK::Int;
+    case K::Double:
+      return &mp.type() == &meta_type<double>() ? PK::Double : PK::Other;
+    case K::String:
+      return PK::String;
+    case K::Enum:
+      return PK::Enum;
+    case K::Ref:
+      return PK::Ref;
+    case K::List:
+      return PK::List;
+    default:
+      return PK::Other;
+  }
+  return PK::Other;
+}
+
 void ProgramImpl::load(std::string name, std::string text) {
   Registry& reg = state_.environment().registry();
   checked_ = check_source(name, std::move(text), reg);
@@ -90,17 +113,28 @@ void ProgramImpl::load(std::string name, std::string text) {
 
   // 1. What the runtime cannot run yet is refused with its position, never ignored.
   walk(root, [&](const Decl& d) {
-    if (d.kind == DeclKind::Net)
-      not_supported(*this, d.loc, "net '" + d.name + "' (substitution and invocation)");
+    // A port net is copied into the transitions it substitutes; it has no instance of its own, so its
+    // code cannot reach members of the net itself.
+    for (const Decl* up = d.parent; up != nullptr; up = up->parent)
+      if (up->kind == DeclKind::Net && up->as<ClassDecl>().is_port_net) {
+        if (d.kind == DeclKind::Property || d.kind == DeclKind::Function)
+          not_supported(*this, d.loc,
+                        "a property or function in a port net (a substituted net has no instance)");
+        if (d.kind == DeclKind::Arrow && d.as<ArrowDecl>().arrow == ArrowKind::Communication)
+          not_supported(*this, d.loc, "a communication arrow in a port net");
+        break;
+      }
+    if (d.kind == DeclKind::Net && !d.as<ClassDecl>().is_port_net) {
+      const auto& n = d.as<ClassDecl>();
+      for (const DeclPtr& m : n.members)
+        if (m->name == "finished" || (m->name == "result" && n.result_type.kind != K::Void))
+          not_supported(*this, m->loc,
+                        "a member named '" + m->name + "' in an invocable net (the runtime's property)");
+    }
     if (d.kind == DeclKind::Object && !is_static_instance(d))
       not_supported(*this, d.loc, "an object nested in a class");
     if (d.kind == DeclKind::Class && d.parent != nullptr && d.parent->kind == DeclKind::Class)
       not_supported(*this, d.loc, "a class nested in a class");
-    if (d.kind == DeclKind::Transition) {
-      const auto& t = d.as<TransitionDecl>();
-      if (!t.invoke_name.empty()) not_supported(*this, t.invoke_loc, "net invocation");
-      if (!t.subst_name.empty()) not_supported(*this, t.subst_loc, "net substitution");
-    }
   });
 
   // 2. Script enums become run-time enums.
@@ -116,7 +150,8 @@ void ProgramImpl::load(std::string name, std::string text) {
   // 3. Class-like declarations, bases first.
   std::vector<const ClassDecl*> all;
   walk(root, [&](const Decl& d) {
-    if (d.kind == DeclKind::Class || d.kind == DeclKind::Object || d.kind == DeclKind::Script)
+    if (d.kind == DeclKind::Class || d.kind == DeclKind::Object || d.kind == DeclKind::Script ||
+        (d.kind == DeclKind::Net && !d.as<ClassDecl>().is_port_net))
       all.push_back(&d.as<ClassDecl>());
   });
   std::unordered_map<const ClassDecl*, bool> placed;
@@ -176,12 +211,19 @@ void ProgramImpl::load(std::string name, std::string text) {
       base = ci->base->meta;
     } else if (c->base.meta != nullptr) {
       base = c->base.meta;
+    } else if (c->kind == DeclKind::Net) {
+      base = &Invocation::static_meta();  // one instance per invocation (4.11)
     }
     if (!base->is_a(Node::static_meta()))
       not_supported(*this, c->base_loc, "a class derived from '" + base->name() + "' (not a Node)");
     const std::string cname = c->kind == DeclKind::Script ? "soml::" + stem_ : "soml::" + qualified(*c);
     ClassBuilder b(cname, *base);
     add_members(b, *c);
+    if (c->kind == DeclKind::Net && c->result_type.kind != K::Void) {
+      const MetaType* t = storage_type(*this, reg, c->result_type);
+      if (t == nullptr) not_supported(*this, c->loc, "a net result of type '" + c->result_type.name() + "'");
+      b.property("result", *t);
+    }
     ci->meta = &b.define(reg);
     scope_meta_[c] = ci->meta;
     by_meta_[ci->meta] = ci.get();
@@ -213,35 +255,21 @@ void ProgramImpl::load(std::string name, std::string text) {
     PropSlot s;
     s.prop = mp;
     const auto& pd = d.as<PropertyDecl>();
-    switch (pd.type.kind) {
-      case K::Bool:
-        s.kind = PK::Bool;
-        break;
-      case K::Int:
-        s.kind = &mp->type() == &meta_type<std::int64_t>() ? PK::I64 : PK::Int;
-        break;
-      case K::Double:
-        s.kind = &mp->type() == &meta_type<double>() ? PK::Double : PK::Other;
-        break;
-      case K::String:
-        s.kind = PK::String;
-        break;
-      case K::Enum:
-        s.kind = PK::Enum;
-        break;
-      case K::Ref:
-        s.kind = PK::Ref;
-        break;
-      case K::List:
-        s.kind = PK::List;
-        break;
-      default:
-        s.kind = PK::Other;
-    }
+    s.kind = prop_kind(pd.type, *mp);
     props_.push_back(s);
     prop_slot_[&pd] = static_cast<int>(props_.size() - 1);
     meta_prop_slot_[mp] = prop_slot_[&pd];
   });
+
+  // The `result` property of invocable nets (read when an instance finishes, written by `finish`).
+  for (const ClassDecl* c : class_order_) {
+    if (c->kind != DeclKind::Net || c->result_type.kind == K::Void) continue;
+    ClassInfo& ci = *class_info_.at(c);
+    const MetaProperty* mp = ci.meta->find_property("result");
+    props_.push_back(PropSlot{mp, prop_kind(c->result_type, *mp)});
+    ci.result_slot = static_cast<int>(props_.size() - 1);
+    meta_prop_slot_[mp] = ci.result_slot;
+  }
 
   // 5. Overrides: a function with the name of a base class's function is called virtually.
   for (const ClassDecl* c : class_order_) {
@@ -266,16 +294,66 @@ void ProgramImpl::load(std::string name, std::string text) {
     }
   }
 
-  // 6. Nets of every class: places and transitions, bases' first.
+  // 6. Nets of every class: places and transitions, bases' first. A substitution transition's sub-net
+  // (4.11, hierarchical nets) is copied into the net: the port net's inner places follow, its ports are
+  // the socket places (the same index). Each copy is an Expansion, recorded depth first in member order
+  // so that step 7 adds the sub-net's transitions in the same order.
+  struct Expansion {
+    const TransitionDecl* holder = nullptr;
+    std::unordered_map<const Decl*, int> places;  // the port net's places -> index in the class's net
+    std::vector<int> own;                         // indices of the places this copy added
+  };
+  std::unordered_map<const ClassDecl*, std::vector<Expansion>> expansions;
+  std::function<void(NetClass&, std::vector<Expansion>&, const TransitionDecl&,
+                     const std::unordered_map<const Decl*, int>&, int)>
+      expand_places = [&](NetClass& net, std::vector<Expansion>& exps, const TransitionDecl& t,
+                          const std::unordered_map<const Decl*, int>& outer, int depth) {
+        if (depth >= 16)
+          not_supported(*this, t.subst_loc, "net substitution nested 16 levels deep (recursive?)");
+        const ClassDecl& n = *t.substituted;
+        Expansion e;
+        e.holder = &t;
+        for (std::size_t i = 0; i < n.params.size() && i < t.subst_args.size(); ++i) {
+          const Decl* socket = t.subst_args[i]->type.decl;
+          auto it = socket != nullptr ? outer.find(socket) : outer.end();
+          if (it == outer.end()) not_supported(*this, t.subst_args[i]->loc, "this socket place");
+          for (const DeclPtr& m : n.members)
+            if (m->kind == DeclKind::Place && m->name == n.params[i].name) e.places[m.get()] = it->second;
+        }
+        for (const DeclPtr& m : n.members) {
+          if (m->kind != DeclKind::Place || m->as<PlaceDecl>().is_port) continue;
+          e.places[m.get()] = static_cast<int>(net.places.size());
+          e.own.push_back(static_cast<int>(net.places.size()));
+          net.places.push_back(&m->as<PlaceDecl>());
+          net.place_holder.push_back(-1);  // set when step 7 numbers the holder transition
+        }
+        const std::unordered_map<const Decl*, int> map = e.places;
+        exps.push_back(std::move(e));
+        for (const DeclPtr& m : n.members)
+          if (m->kind == DeclKind::Transition && m->as<TransitionDecl>().substituted != nullptr)
+            expand_places(net, exps, m->as<TransitionDecl>(), map, depth + 1);
+      };
   for (const ClassDecl* c : class_order_) {
     ClassInfo& ci = *class_info_.at(c);
     auto net = std::make_unique<NetClass>();
     if (ci.base != nullptr && ci.base->net) {
       net->places = ci.base->net->places;
+      net->place_holder = ci.base->net->place_holder;
       net->transitions = ci.base->net->transitions;
     }
     for (const DeclPtr& m : c->members)
-      if (m->kind == DeclKind::Place) net->places.push_back(&m->as<PlaceDecl>());
+      if (m->kind == DeclKind::Place) {
+        net->places.push_back(&m->as<PlaceDecl>());
+        net->place_holder.push_back(-1);
+      }
+    std::unordered_map<const Decl*, int> top;
+    for (std::size_t i = 0; i < net->places.size(); ++i) top.emplace(net->places[i], static_cast<int>(i));
+    for (const DeclPtr& m : c->members)
+      if (m->kind == DeclKind::Transition && m->as<TransitionDecl>().substituted != nullptr)
+        expand_places(*net, expansions[c], m->as<TransitionDecl>(), top, 0);
+    net->invocable = c->kind == DeclKind::Net;
+    if (c->kind == DeclKind::Net && c->start != nullptr)
+      ci.start_place = top.count(c->start->place_decl) != 0 ? top.at(c->start->place_decl) : -1;
     if (!net->places.empty()) ci.net = std::move(net);
   }
   auto place_index = [&](const NetClass& n, const Decl* d) {
@@ -353,47 +431,86 @@ void ProgramImpl::load(std::string name, std::string text) {
         c->base.decl->constructor != nullptr)
       ci.object_ctor = compile_object_ctor(*this, *c, function_index_.at(c->base.decl->constructor),
                                            *c->base.decl->constructor);
+    std::size_t next_expansion = 0;
+    // One transition of the class's net, or of a sub-net copied into it (map: the copy's places).
+    std::function<void(const TransitionDecl&, const std::unordered_map<const Decl*, int>*, int,
+                       const std::string&)>
+        make_transition = [&](const TransitionDecl& t, const std::unordered_map<const Decl*, int>* map,
+                              int holder, const std::string& pre) {
+          TransitionInfo ti;
+          ti.decl = &t;
+          ti.index = static_cast<int>(ci.net->transitions.size());
+          ti.holder = holder;
+          if (t.substituted != nullptr) {  // inert: its sub-net's transitions follow, children of its node
+            ti.inert = true;
+            ci.net->transitions.push_back(std::move(ti));
+            Expansion& e = expansions.at(c).at(next_expansion++);
+            const int h = static_cast<int>(ci.net->transitions.size() - 1);
+            for (int p : e.own) ci.net->place_holder[static_cast<std::size_t>(p)] = h;
+            const std::unordered_map<const Decl*, int> sub = e.places;
+            for (const DeclPtr& m : t.substituted->members)
+              if (m->kind == DeclKind::Transition)
+                make_transition(m->as<TransitionDecl>(), &sub, h, pre + t.name + ".");
+            return;
+          }
+          if (t.when_expr || t.when_block)
+            ti.cond = compile_condition(*this, t, pre + t.name + " (condition)");
+          if (t.action) {
+            ti.action = compile_action(*this, t, pre + t.name + " (action)");
+            if (t.invoked != nullptr && t.invoked->result_type.kind != K::Void) {
+              // The action of an invoking transition runs when the net finished: `result` is its slot 0.
+              Function& f = *functions_[static_cast<std::size_t>(ti.action)];
+              f.nparams = 1;
+              f.param_kinds = {reg_kind(t.invoked->result_type)};
+            }
+          }
+          if (t.invoked != nullptr) {
+            ti.invoke = class_info_.at(t.invoked).get();
+            if (!t.invoke_args.empty())
+              ti.invoke_args = compile_invoke_args(*this, t, pre + t.name + " (invocation arguments)");
+          }
+          auto arrow_info = [&](const ArrowDecl& a, const Decl* place) {
+            ArrowInfo ai;
+            ai.decl = &a;
+            if (a.arrow == ArrowKind::Communication) {
+              ai.remote = true;
+              ai.remote_place = &place->as<PlaceDecl>();
+              ai.path = comm_path(a, *c);
+              ai.weight = a.weight;
+              ai.object = !ai.remote_place->token.empty();
+              if (a.condition) not_supported(*this, a.loc, "a condition on a communication arrow");
+              if (ai.object && a.to_decl->kind == DeclKind::Transition)
+                not_supported(*this, a.loc, "a communication arrow taking object tokens");
+              return ai;
+            }
+            if (map != nullptr) {
+              auto it = map->find(place);
+              ai.place = it != map->end() ? it->second : -1;
+            } else {
+              ai.place = place_index(*ci.net, place);
+            }
+            if (ai.place < 0) not_supported(*this, a.loc, "an arrow to a place of another net");
+            ai.weight = a.weight;
+            ai.inhibitor = a.arrow == ArrowKind::Inhibitor;
+            ai.object = !place->as<PlaceDecl>().token.empty();
+            if (a.condition)
+              ai.cond = compile_arrow_condition(
+                  *this, a, pre + "arrow " + a.from_decl->name + " -> " + a.to_decl->name);
+            return ai;
+          };
+          for (const ArrowDecl* a : t.inputs) {
+            ti.in.push_back(arrow_info(*a, a->from_decl));
+            if (ti.in.back().object && !ti.in.back().inhibitor)
+              ti.mark_in = static_cast<int>(ti.in.size() - 1);
+          }
+          for (const ArrowDecl* a : t.outputs) ti.out.push_back(arrow_info(*a, a->to_decl));
+          ci.net->transitions.push_back(std::move(ti));
+        };
     for (const DeclPtr& m : c->members) {
       if (m->kind == DeclKind::Place || m->kind == DeclKind::Transition)
         scope_init_[m.get()] = compile_init(*this, m->as<ScopeDecl>(), prefix + m->name + " (initialisers)");
       if (m->kind != DeclKind::Transition) continue;
-      const auto& t = m->as<TransitionDecl>();
-      TransitionInfo ti;
-      ti.decl = &t;
-      ti.index = static_cast<int>(ci.net->transitions.size());
-      if (t.when_expr || t.when_block)
-        ti.cond = compile_condition(*this, t, prefix + t.name + " (condition)");
-      if (t.action) ti.action = compile_action(*this, t, prefix + t.name + " (action)");
-      auto arrow_info = [&](const ArrowDecl& a, const Decl* place) {
-        ArrowInfo ai;
-        ai.decl = &a;
-        if (a.arrow == ArrowKind::Communication) {
-          ai.remote = true;
-          ai.remote_place = &place->as<PlaceDecl>();
-          ai.path = comm_path(a, *c);
-          ai.weight = a.weight;
-          ai.object = !ai.remote_place->token.empty();
-          if (a.condition) not_supported(*this, a.loc, "a condition on a communication arrow");
-          if (ai.object && a.to_decl->kind == DeclKind::Transition)
-            not_supported(*this, a.loc, "a communication arrow taking object tokens");
-          return ai;
-        }
-        ai.place = place_index(*ci.net, place);
-        if (ai.place < 0) not_supported(*this, a.loc, "an arrow to a place of another net");
-        ai.weight = a.weight;
-        ai.inhibitor = a.arrow == ArrowKind::Inhibitor;
-        ai.object = !place->as<PlaceDecl>().token.empty();
-        if (a.condition)
-          ai.cond = compile_arrow_condition(*this, a,
-                                            prefix + "arrow " + a.from_decl->name + " -> " + a.to_decl->name);
-        return ai;
-      };
-      for (const ArrowDecl* a : t.inputs) {
-        ti.in.push_back(arrow_info(*a, a->from_decl));
-        if (ti.in.back().object && !ti.in.back().inhibitor) ti.mark_in = static_cast<int>(ti.in.size() - 1);
-      }
-      for (const ArrowDecl* a : t.outputs) ti.out.push_back(arrow_info(*a, a->to_decl));
-      ci.net->transitions.push_back(std::move(ti));
+      make_transition(m->as<TransitionDecl>(), nullptr, -1, prefix);
     }
   }
   // Subclasses copied their bases' transitions before these were compiled: copy again.
@@ -402,9 +519,20 @@ void ProgramImpl::load(std::string name, std::string text) {
     if (ci.base == nullptr || !ci.base->net || !ci.net) continue;
     std::vector<TransitionInfo> own = std::move(ci.net->transitions);
     ci.net->transitions = ci.base->net->transitions;
+    const int offset = static_cast<int>(ci.net->transitions.size());
     for (auto& t : own) {
       t.index = static_cast<int>(ci.net->transitions.size());
+      if (t.holder >= 0) t.holder += offset;
       ci.net->transitions.push_back(std::move(t));
+    }
+    // Holders of sub-net places: the base's (numbered after the copy in step 6), the own ones shifted.
+    const std::size_t nbase = ci.base->net->places.size();
+    for (std::size_t i = 0; i < ci.net->place_holder.size(); ++i) {
+      int& h = ci.net->place_holder[i];
+      if (i < nbase)
+        h = ci.base->net->place_holder[i];
+      else if (h >= 0)
+        h += offset;
     }
   }
 
@@ -472,8 +600,8 @@ void ProgramImpl::setup(const ClassInfo& ci, SimStateInstance& inst, const Val* 
   for (const ClassInfo* c : chain)
     if (c->init >= 0) run(c->init, inst.id(), 0, nullptr, nullptr);
   if (ci.net) build_net(ci, inst);
-  // The start place: the most derived class's.
-  for (auto c = chain.rbegin(); c != chain.rend(); ++c) {
+  // The start place: the most derived class's (a net's receives the invocation's black token instead).
+  for (auto c = chain.rbegin(); c != chain.rend() && ci.decl->kind != DeclKind::Net; ++c) {
     const StartDecl* sd = (*c)->decl->start;
     if (sd == nullptr || sd->place_decl == nullptr) continue;
     const ScopeDecl* owner = parent_scope(*sd->place_decl);
@@ -514,50 +642,56 @@ void ProgramImpl::build_net(const ClassInfo& ci, SimStateInstance& inst) {
   net->owner = inst.id();
   net->cls = ci.net.get();
   Node& owner = *inst.as<Node>();
-  for (const PlaceDecl* pd : ci.net->places) {
-    auto& p = static_cast<Place&>(state_.create(*scope_meta_.at(pd)));
+  // Places and transitions of a substituted sub-net are children of the substitution transition's node.
+  auto meta_of = [&](const Decl* d, const MetaInstance& fallback) {
+    auto it = scope_meta_.find(d);
+    return it != scope_meta_.end() ? it->second : &fallback;
+  };
+  for (std::size_t i = 0; i < ci.net->places.size(); ++i) {
+    const PlaceDecl* pd = ci.net->places[i];
+    auto& p = static_cast<Place&>(state_.create(*meta_of(pd, Place::static_meta())));
     p.set_name(pd->name);
     p.set_object_tokens(!pd->token.empty());
     p.set_tokens(pd->initial_tokens);
-    owner.add_child(p);
+    if (ci.net->place_holder[i] < 0) owner.add_child(p);
     net->places.push_back(&p);
     place_watch_[p.id()];
   }
   for (const TransitionInfo& t : ci.net->transitions) {
-    auto& tn = static_cast<Transition&>(state_.create(*scope_meta_.at(t.decl)));
+    auto& tn = static_cast<Transition&>(state_.create(*meta_of(t.decl, Transition::static_meta())));
     tn.set_name(t.decl->name);
-    owner.add_child(tn);
+    (t.holder < 0 ? owner : static_cast<Node&>(*net->transitions[static_cast<std::size_t>(t.holder)]))
+        .add_child(tn);
     net->transitions.push_back(&tn);
   }
-  auto node_of = [&](const Decl* d) -> Node* {
-    for (std::size_t i = 0; i < ci.net->places.size(); ++i)
-      if (ci.net->places[i] == d) return net->places[i];
-    for (std::size_t i = 0; i < ci.net->transitions.size(); ++i)
-      if (ci.net->transitions[i].decl == d) return net->transitions[i];
-    return nullptr;
-  };
-  for (const TransitionInfo& t : ci.net->transitions) {
+  for (std::size_t i = 0; i < ci.net->places.size(); ++i)
+    if (const int h = ci.net->place_holder[i]; h >= 0)
+      net->transitions[static_cast<std::size_t>(h)]->add_child(*net->places[i]);
+  for (std::size_t ti = 0; ti < ci.net->transitions.size(); ++ti) {
+    const TransitionInfo& t = ci.net->transitions[ti];
+    Node* tnode = net->transitions[ti];
     auto add_arrow = [&](const ArrowInfo& a) {
-      Node* from = node_of(a.decl->from_decl);
-      Node* to = node_of(a.decl->to_decl);
+      const bool input = a.decl->to_decl->kind == DeclKind::Transition;
       if (a.remote) {
         // A communication arrow leaves the transition (output) or points at it (input); its place is
         // found when it fires, so its target is set only when it is local.
-        Node* tn = a.decl->to_decl->kind == DeclKind::Transition ? to : from;
         auto& an = state_.create<Arrow>();
         an.set_name(a.decl->from_decl->name + " ~> " + a.decl->to_decl->name);
         an.set_type(ArrowType::Communication);
         an.set_weight(a.weight);
-        if (a.decl->to_decl->kind == DeclKind::Transition) an.set_target(tn);
-        tn->add_child(an);
+        if (input) an.set_target(tnode);
+        tnode->add_child(an);
         return;
       }
+      // By index, not by declaration: a sub-net's port is its socket, and a port net copied twice has
+      // two nodes per place.
+      Node* pnode = net->places[static_cast<std::size_t>(a.place)];
       auto& an = state_.create<Arrow>();
       an.set_name(a.decl->from_decl->name + (a.inhibitor ? " -o " : " -> ") + a.decl->to_decl->name);
       an.set_type(a.inhibitor ? ArrowType::Inhibitor : ArrowType::Normal);
       an.set_weight(a.weight);
-      an.set_target(to);
-      from->add_child(an);
+      an.set_target(input ? tnode : pnode);
+      (input ? pnode : tnode)->add_child(an);
     };
     for (const ArrowInfo& a : t.in) add_arrow(a);
     for (const ArrowInfo& a : t.out) add_arrow(a);
@@ -581,8 +715,8 @@ void ProgramImpl::build_net(const ClassInfo& ci, SimStateInstance& inst) {
     const auto ti = static_cast<std::uint32_t>(tis_.size());
     tis_.push_back(TI{{}, n, static_cast<int>(t)});
     tis_.back().dirty = false;
-    mark_dirty(ti);
     const TransitionInfo& info = ci.net->transitions[t];
+    if (!info.inert) mark_dirty(ti);  // a substitution transition never fires: its sub-net does
     for (const ArrowInfo& a : info.in)
       if (!a.remote) place_watch_[n->places[static_cast<std::size_t>(a.place)]->id()].push_back(ti);
   }
@@ -688,6 +822,8 @@ Place* Program::place(std::string_view name, const Node* owner) const {
   const Node* o = owner != nullptr ? owner : impl_->root_;
   const NetInst* n = impl_->net_of(o->id());
   if (n == nullptr) return nullptr;
+  for (std::size_t i = 0; i < n->places.size(); ++i)  // the net's own places before sub-nets' ones
+    if (n->cls->places[i]->name == name && n->cls->place_holder[i] < 0) return n->places[i];
   for (std::size_t i = 0; i < n->places.size(); ++i)
     if (n->cls->places[i]->name == name) return n->places[i];
   return nullptr;

@@ -187,12 +187,21 @@ struct TransitionInfo {
   std::vector<ArrowInfo> in, out;
   int mark_in = -1;  // index into in of the object input arrow
   int cond = -1, action = -1;
+  // Substitution (4.11): a substitution transition is inert (it never fires; its sub-net's places and
+  // transitions are its children); `holder` is the transition whose sub-net this one belongs to.
+  bool inert = false;
+  int holder = -1;
+  // Invocation: the net it invokes and the function that sets the new instance's value parameters.
+  const struct ClassInfo* invoke = nullptr;
+  int invoke_args = -1;
 };
 
 // The net of a class-like declaration (its own places and transitions, bases' first).
 struct NetClass {
   std::vector<const PlaceDecl*> places;
   std::vector<TransitionInfo> transitions;
+  std::vector<int> place_holder;  // per place: the substitution transition holding it, -1: the owner
+  bool invocable = false;         // the net of an invocable net (its instances can `finish`)
 };
 
 struct NetInst {
@@ -213,6 +222,8 @@ struct ClassInfo {
   int object_ctor = -1;           // object derived with arguments: the constructor call
   std::unique_ptr<NetClass> net;  // null when it has no places or transitions (own or inherited)
   std::unordered_map<const FunctionDecl*, int> vtable;  // root function -> implementation
+  int result_slot = -1;  // invocable net with a result: props_ slot of its `result` property
+  int start_place = -1;  // invocable net: index of its start place
 };
 
 struct Frame {
@@ -260,6 +271,14 @@ class ProgramImpl {
   void setup(const ClassInfo& ci, SimStateInstance& inst, const Val* args, const std::string* sargs,
              int nargs);
   void build_net(const ClassInfo& ci, SimStateInstance& inst);
+  // Invocation (invocation.cpp): the first half of an invoking transition's firing (a new net instance
+  // under the transition, its parameters, its start token) and the second, when the instance finished.
+  SimStateInstance& start_invocation(const TransitionInfo& t, Transition& tn, std::uint64_t mark);
+  bool finished(const NetInst& net) const;
+  // The invoking transition of a finished instance runs its action with the result (may throw; then
+  // nothing changed but `finished` is reset); returns the invoking transition's index in its net.
+  std::pair<NetInst*, int> complete_action(const NetInst& inner);
+  void complete_outputs(NetInst& outer, int t, std::uint64_t instance);
 
   // ---- data ----
   SimState& state_;
@@ -368,6 +387,10 @@ class ProgramImpl {
   // it read as dependencies while a test runs.
   Place* remote_place(const ArrowInfo& a, std::uint64_t owner);
   void fire(std::uint32_t ti);
+  // Produces the output tokens of a firing; returns the place the mark went to (null: it left the net).
+  /// Produces the outputs of @p t; appends the black tokens given to @p given when it is not null.
+  Place* produce(NetInst& net, const TransitionInfo& t, std::uint64_t mark,
+                 std::vector<TokenMove>* given = nullptr);
   void set_enabled(std::uint32_t ti, bool on);
 };
 
@@ -380,6 +403,7 @@ int compile_action(ProgramImpl& p, const TransitionDecl& t, const std::string& n
 int compile_arrow_condition(ProgramImpl& p, const ArrowDecl& a, const std::string& name);
 int compile_init(ProgramImpl& p, const ScopeDecl& s, const std::string& name);
 int compile_object_ctor(ProgramImpl& p, const ClassDecl& obj, int ctor, const FunctionDecl& fd);
+int compile_invoke_args(ProgramImpl& p, const TransitionDecl& t, const std::string& name);
 [[noreturn]] void not_supported(const ProgramImpl& p, SourceLoc loc, const std::string& what);
 std::string where(const ProgramImpl& p, SourceLoc loc);
 

@@ -232,13 +232,14 @@ TEST_F(Runtime, ScriptErrorsAndUnsupportedConstructsAreReportedWithPositions) {
               HasSubstr("test.soml:1:18: error: undefined name 'x'"));
   const std::string e = error_of([&] {
     load(R"(net Relay(place in, place out) {
+  int hops = 0;
   transition pass;
   arrow in -> pass;
   arrow pass -> out;
 }
 )");
   });
-  EXPECT_THAT(e, HasSubstr("test.soml:1:5"));
+  EXPECT_THAT(e, HasSubstr("test.soml:2:7"));
   EXPECT_THAT(e, HasSubstr("not supported"));
 }
 

@@ -199,7 +199,9 @@ int run(const std::vector<std::string_view>& args) {
                   << (mn != nullptr && !mn->name().empty() ? mn->name() : "#" + std::to_string(f.mark)) << " "
                   << node_label(f.from) << " -> " << node_label(f.to);
       }
-      std::cout << "\n";
+      // Net invocation: the first half, the finish and the invoking transition's completion.
+      static constexpr const char* kinds[] = {"", " (invokes)", " (finish)", " (completes)"};
+      std::cout << kinds[static_cast<int>(f.kind)] << "\n";
     });
   std::uint64_t fired = 0;
   try {

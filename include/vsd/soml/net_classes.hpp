@@ -59,6 +59,17 @@ class Transition : public vsd::Node {
   VSD_PROPERTY(std::int64_t, firings, 0)
 };
 
+/// @brief Base of the run-time class of an invocable net ("soml::Invocation"; the net `fetch` becomes
+/// "soml::fetch" derived from it). One instance per invocation, a child of the invoking transition's node
+/// (so nested invocations form the invocation hierarchy in the database tree): `mark` is the token that
+/// waits in the invoking transition, `finished` is set by `finish`, the net's value parameters and its
+/// `result` are properties of the run-time class.
+class Invocation : public vsd::Node {
+  VSD_INSTANCE(Invocation, vsd::Node)
+  VSD_PROPERTY(vsd::SharedRef<vsd::Node>, mark, nullptr)
+  VSD_PROPERTY(bool, finished, false)
+};
+
 /// @brief Arrow types (normal, inhibitor, communication).
 enum class ArrowType : std::uint8_t { Normal, Inhibitor, Communication };
 VSD_ENUM(ArrowType, Normal, Inhibitor, Communication)

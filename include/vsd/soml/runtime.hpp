@@ -48,6 +48,15 @@ struct TokenMove {
   std::int64_t count = 0;        ///< how many tokens
 };
 
+/// @brief What a firing did besides moving tokens (net invocation, docs/soml.md 4.11).
+enum class FiringKind : std::uint8_t {
+  Plain,     ///< an ordinary firing
+  Invoke,    ///< an invoking transition's first half: it consumed its inputs and started a net instance
+  Finish,    ///< a transition of an invoked net ran `finish`: the instance ends
+  Complete,  ///< an invoking transition's second half, right after the Finish (same step): its action
+             ///< ran with the result and it produced its outputs; `from` is null
+};
+
 /// @brief One firing, as the trace reports it: which token moved from where to where, through which
 /// transition, at which step.
 struct Firing {
@@ -55,7 +64,9 @@ struct Firing {
   const Transition* transition = nullptr;  ///< what fired
   vsd::Id mark = 0;                        ///< the token it moved (0: none)
   const Place* from = nullptr;             ///< where the mark came from (object input place)
-  const Place* to = nullptr;               ///< where the mark went (null: it left the net)
+  const Place* to = nullptr;               ///< where the mark went (null: it left the net, or waits)
+  FiringKind kind = FiringKind::Plain;     ///< see FiringKind
+  vsd::Id invocation = 0;                  ///< the net instance started, finished or completed (0: Plain)
   std::vector<TokenMove> taken;            ///< black tokens consumed, in arrow order
   std::vector<TokenMove> given;            ///< black tokens produced, in arrow order
 };
