@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
       joints += (i > 1 ? "," : "") + std::string("iiwa_joint_") + std::to_string(i);
     const std::string config =
         "udp://127.0.0.1:" + std::to_string(robot.port()) + "?joints=" + joints +
-        "&timeout=0.05;fieldbus://?joints=world_iiwa_joint&velocity=1&lower=-2&upper=3";
+        "&timeout=0.5;fieldbus://?joints=world_iiwa_joint&velocity=1&lower=-2&upper=3";
     std::cout << "hardware config: " << config << '\n';
     const Run hw = follow(xml, config);
     std::cout << "udp + fieldbus: max tracking error " << hw.max_error * 1000 << " mm, rms " << hw.rms * 1000

@@ -54,7 +54,8 @@ class JointController : public vsd::Extension {
   VSD_PROPERTY(double, cartesian_gain, 10.0)
   /// Cartesian mode: done within this position (m) and orientation (rad) error.
   VSD_PROPERTY(double, cartesian_tolerance, 1e-4)
-  /// True once the target is reached (Position, Cartesian).
+  /// True once the target is reached (Position, Cartesian). A new target clears it in the next step(),
+  /// not when it is set: a loop "step until done" steps once before testing.
   VSD_PROPERTY(bool, done, true)
   /// Why the controller stopped (empty while fine).
   VSD_PROPERTY(std::string, fault, "")
