@@ -73,7 +73,10 @@ TEST(Scripts, CoverEveryErrorClassAndTheFeatures) {
   const auto names = script_names();
   for (const char* must :
        {"error_syntax.soml", "error_undefined.soml", "error_types.soml", "error_arrows.soml",
-        "error_duplicates.soml", "error_arguments.soml", "features_classes.soml", "features_nets.soml"})
+        "error_duplicates.soml", "error_arguments.soml", "features_classes.soml", "features_nets.soml",
+        // run-time errors with their SOML++ call stacks (run goldens with `// expect-exit: 1`)
+        "run_endless_loop.soml", "run_deep_recursion.soml", "run_division_by_zero.soml",
+        "run_null_reference.soml", "run_index_range.soml"})
     EXPECT_NE(std::find(names.begin(), names.end(), must), names.end()) << must;
 }
 
