@@ -121,10 +121,10 @@ int main(int argc, char** argv) try {
   for (const std::string& e : net.condition_errors()) std::printf("condition error: %s\n", e.c_str());
   const bool bounded = lo >= low_bound && hi <= high_bound;
   std::printf(
-      "check: level %s within [%.0f, %.0f] %% (min %.1f, max %.1f); supervisor issued %lld commands, "
+      "check: level %s [%.0f, %.0f] %% (min %.1f, max %.1f); supervisor issued %lld commands, "
       "%lld alarms\n",
-      bounded ? "stayed" : "LEFT", low_bound, high_bound, lo, hi, static_cast<long long>(commands),
-      static_cast<long long>(alarms));
+      bounded ? "stayed within" : "LEFT its safe bounds", low_bound, high_bound, lo, hi,
+      static_cast<long long>(commands), static_cast<long long>(alarms));
   return bounded && commands > 0 && alarms > 0 ? 0 : 1;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "vsd_soml_supervisor: %s\n", e.what());
