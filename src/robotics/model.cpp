@@ -187,6 +187,24 @@ Model Model::build(std::span<const JointSpec> specs) {
     seg.axis_post = seg.post.rotation.transpose() * seg.axis;
     seg.origin_post = -(seg.post.rotation.transpose() * seg.post.translation);
   }
+  for (std::size_t i = 0; i < m.segments_.size(); ++i) {
+    Segment& seg = m.segments_[i];
+    if (!seg.fast || seg.parent < 0 || static_cast<std::size_t>(seg.parent) + 1 != i) continue;
+    const Segment& par = m.segments_[i - 1];
+    if (!par.fast) continue;
+    seg.chained = true;
+    seg.c_mask = 0;
+    for (int j = 0; j < 3; ++j) {
+      const int from = par.perm[j];
+      for (int h = 0; h < 2; ++h) {
+        seg.c_row[j][h] = seg.b_row[from][h];
+        seg.c_swap[j][h] = seg.b_swap[from][h];
+      }
+      seg.c_col2[j] = seg.b_col2[from];
+      seg.c_translation[j] = seg.pre.translation[from];
+      if (seg.c_translation[j] != 0.0) seg.c_mask |= static_cast<std::uint8_t>(1U << j);
+    }
+  }
   m.body_segment_ = std::move(body_seg);
   return m;
 }
@@ -329,6 +347,9 @@ void Model::forward(const double* q, Data& data) const noexcept {
     values[i] = v;
   }
   detail::sincos_batch(values, sines, cosines, n);
+  // The previous fast segment's product (before its perm): rows of columns 0 and 1, column 2, translation.
+  V2 m01[3] = {};
+  double m2[3] = {}, mt[3] = {};
   for (std::size_t i = 0; i < n; ++i) {
     const Segment& s = segments_[i];
     if (s.fast) {
@@ -338,42 +359,55 @@ void Model::forward(const double* q, Data& data) const noexcept {
       double* r = out[i].rotation.data();  // r[c * 3 + row]
       double* t = out[i].translation.data();
       const V2 cs2 = v2(cosines[i], cosines[i]), sn2 = v2(sines[i], sines[i]);
-      V2 a[3];  // rows of B * Rz(v)'s first two columns; its third column is b_col2
-      for (int j = 0; j < 3; ++j)
-        a[j] = cs2 * v2(s.b_row[j][0], s.b_row[j][1]) + sn2 * v2(s.b_swap[j][0], s.b_swap[j][1]);
+      const auto& row = s.chained ? s.c_row : s.b_row;
+      const auto& swp = s.chained ? s.c_swap : s.b_swap;
+      const double* col2 = s.chained ? s.c_col2 : s.b_col2;
+      const double* lt = s.chained ? s.c_translation : s.pre.translation.data();
+      const unsigned mask = s.chained ? s.c_mask : s.pre_translation_mask;
+      V2 a[3];  // rows of B * Rz(v)'s first two columns; its third column is col2
+      for (int j = 0; j < 3; ++j) a[j] = cs2 * v2(row[j][0], row[j][1]) + sn2 * v2(swp[j][0], swp[j][1]);
       const std::size_t c0 = s.perm[0] * 3U, c1 = s.perm[1] * 3U, c2 = s.perm[2] * 3U;
       if (s.parent < 0) {
         for (int k = 0; k < 3; ++k) {
-          r[c0 + k] = a[k][0];
-          r[c1 + k] = a[k][1];
-          r[c2 + k] = s.b_col2[k];
-          t[k] = s.pre.translation[k];
+          m01[k] = a[k];
+          m2[k] = col2[k];
+          mt[k] = lt[k];
         }
-        continue;
+      } else {
+        double p[9];  // the parent's rotation (column-major), in the chained case in its product's order
+        double tt[3];
+        if (s.chained) {
+          for (int k = 0; k < 3; ++k) {
+            p[k] = m01[k][0];
+            p[3 + k] = m01[k][1];
+            p[6 + k] = m2[k];
+            tt[k] = mt[k];
+          }
+        } else {
+          // Into locals first: r and t could alias the parent's frame as far as the compiler knows.
+          const Frame& pf = out[s.parent];
+          for (int k = 0; k < 9; ++k) p[k] = pf.rotation.data()[k];
+          for (int k = 0; k < 3; ++k) tt[k] = pf.translation[k];
+        }
+        // The mask is fixed per segment: these branches predict perfectly.
+        for (int c = 0; c < 3; ++c)
+          if ((mask >> c) & 1U)
+            for (int k = 0; k < 3; ++k) tt[k] += p[c * 3 + k] * lt[c];
+        for (int k = 0; k < 3; ++k)
+          m01[k] = v2(p[k], p[k]) * a[0] + v2(p[3 + k], p[3 + k]) * a[1] + v2(p[6 + k], p[6 + k]) * a[2];
+        const V2 top = v2(p[0], p[1]) * v2(col2[0], col2[0]) + v2(p[3], p[4]) * v2(col2[1], col2[1]) +
+                       v2(p[6], p[7]) * v2(col2[2], col2[2]);
+        m2[0] = top[0];
+        m2[1] = top[1];
+        m2[2] = p[2] * col2[0] + p[5] * col2[1] + p[8] * col2[2];
+        for (int k = 0; k < 3; ++k) mt[k] = tt[k];
       }
-      // The parent's frame into locals first: r and t could alias it as far as the compiler knows.
-      const Frame& pf = out[s.parent];
-      double p[9];
-      for (int k = 0; k < 9; ++k) p[k] = pf.rotation.data()[k];
-      double tt[3] = {pf.translation[0], pf.translation[1], pf.translation[2]};
-      // The mask is fixed per segment: these branches predict perfectly.
-      for (int c = 0; c < 3; ++c)
-        if ((s.pre_translation_mask >> c) & 1U) {
-          const double l = s.pre.translation[c];
-          for (int k = 0; k < 3; ++k) tt[k] += p[c * 3 + k] * l;
-        }
       for (int k = 0; k < 3; ++k) {
-        const V2 m = v2(p[k], p[k]) * a[0] + v2(p[3 + k], p[3 + k]) * a[1] + v2(p[6 + k], p[6 + k]) * a[2];
-        r[c0 + k] = m[0];
-        r[c1 + k] = m[1];
+        r[c0 + k] = m01[k][0];
+        r[c1 + k] = m01[k][1];
+        r[c2 + k] = m2[k];
+        t[k] = mt[k];
       }
-      const V2 top = v2(p[0], p[1]) * v2(s.b_col2[0], s.b_col2[0]) +
-                     v2(p[3], p[4]) * v2(s.b_col2[1], s.b_col2[1]) +
-                     v2(p[6], p[7]) * v2(s.b_col2[2], s.b_col2[2]);
-      r[c2] = top[0];
-      r[c2 + 1] = top[1];
-      r[c2 + 2] = p[2] * s.b_col2[0] + p[5] * s.b_col2[1] + p[8] * s.b_col2[2];
-      for (int k = 0; k < 3; ++k) t[k] = tt[k];
       continue;
     }
     double* r = out[i].rotation.data();  // r[c * 3 + row]

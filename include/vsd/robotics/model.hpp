@@ -155,6 +155,12 @@ class Model {
     double b_row[3][2] = {};   // (B(j,0), B(j,1)) for row j
     double b_swap[3][2] = {};  // (B(j,1), -B(j,0)): B * Rz's first two columns are c * b_row + s * b_swap
     double b_col2[3] = {};     // B's third column
+    // Chained: the parent is the previous segment, in the fast form too. forward() then keeps the
+    // parent's product in registers in its own column order (before the parent's perm), so B's rows
+    // and pre.p come permuted by the parent's perm: c_* below (row j = the parent's column perm[j]).
+    bool chained = false;
+    std::uint8_t c_mask = 7;
+    double c_row[3][2] = {}, c_swap[3][2] = {}, c_col2[3] = {}, c_translation[3] = {};
   };
   std::vector<Segment> segments_;
   std::vector<DofInfo> layout_;
