@@ -14,6 +14,21 @@ namespace vsd::robotics {
 
 namespace {
 
+// Two doubles in one SSE2 register: GCC and Clang vector extensions (plain operators, no intrinsics);
+// a tiny struct elsewhere, with the same arithmetic (and the same results).
+#if defined(__GNUC__)
+using V2 = double __attribute__((vector_size(16)));
+inline V2 v2(double a, double b) noexcept { return V2{a, b}; }
+#else
+struct V2 {
+  double v[2];
+  double operator[](int i) const noexcept { return v[i]; }
+  friend V2 operator+(V2 a, V2 b) noexcept { return V2{{a.v[0] + b.v[0], a.v[1] + b.v[1]}}; }
+  friend V2 operator*(V2 a, V2 b) noexcept { return V2{{a.v[0] * b.v[0], a.v[1] * b.v[1]}}; }
+};
+inline V2 v2(double a, double b) noexcept { return V2{{a, b}}; }
+#endif
+
 [[noreturn]] void fail(const std::string& msg) { throw vsd::Error(msg); }
 
 bool is_identity(const Frame& f) { return f.rotation.isIdentity(0.0) && f.translation.isZero(0.0); }
@@ -138,8 +153,57 @@ Model Model::build(std::span<const JointSpec> specs) {
   for (Segment& seg : m.segments_) {
     seg.pre_identity = is_identity(seg.pre);
     seg.post_identity = is_identity(seg.post);
+    seg.pre_rotation_identity = seg.pre.rotation.isIdentity(0.0);
+    seg.pre_translation_mask = 0;
+    for (int k = 0; k < 3; ++k)
+      if (seg.pre.translation[k] != 0.0) seg.pre_translation_mask |= static_cast<std::uint8_t>(1U << k);
+    // The fast form: src[i] = the pre.R column that is B's column i (B = pre.R * Q); column i of the
+    // product parent.R * B * Rz(v) is then the frame's column src[i] (times Q^T).
+    int src[3] = {0, 1, 2};
+    seg.fast = seg.post_identity;
+    switch (seg.motion) {
+      case Motion::None:
+      case Motion::RotZ:
+        break;
+      case Motion::RotX:  // Q = [e_y e_z e_x]: B = [p1 p2 p0], product column i goes to (i + 1) % 3
+        src[0] = 1, src[1] = 2, src[2] = 0;
+        break;
+      case Motion::RotY:  // Q = [e_z e_x e_y]: B = [p2 p0 p1], product column i goes to (i + 2) % 3
+        src[0] = 2, src[1] = 0, src[2] = 1;
+        break;
+      default:
+        seg.fast = false;
+        break;
+    }
+    for (int i = 0; i < 3; ++i) seg.perm[i] = static_cast<std::uint8_t>(src[i]);
+    for (int j = 0; j < 3; ++j) {
+      const double b0 = seg.pre.rotation(j, src[0]), b1 = seg.pre.rotation(j, src[1]);
+      seg.b_row[j][0] = b0;
+      seg.b_row[j][1] = b1;
+      seg.b_swap[j][0] = b1;
+      seg.b_swap[j][1] = -b0;
+      seg.b_col2[j] = seg.pre.rotation(j, src[2]);
+    }
     seg.axis_post = seg.post.rotation.transpose() * seg.axis;
     seg.origin_post = -(seg.post.rotation.transpose() * seg.post.translation);
+  }
+  for (std::size_t i = 0; i < m.segments_.size(); ++i) {
+    Segment& seg = m.segments_[i];
+    if (!seg.fast || seg.parent < 0 || static_cast<std::size_t>(seg.parent) + 1 != i) continue;
+    const Segment& par = m.segments_[i - 1];
+    if (!par.fast) continue;
+    seg.chained = true;
+    seg.c_mask = 0;
+    for (int j = 0; j < 3; ++j) {
+      const int from = par.perm[j];
+      for (int h = 0; h < 2; ++h) {
+        seg.c_row[j][h] = seg.b_row[from][h];
+        seg.c_swap[j][h] = seg.b_swap[from][h];
+      }
+      seg.c_col2[j] = seg.b_col2[from];
+      seg.c_translation[j] = seg.pre.translation[from];
+      if (seg.c_translation[j] != 0.0) seg.c_mask |= static_cast<std::uint8_t>(1U << j);
+    }
   }
   m.body_segment_ = std::move(body_seg);
   return m;
@@ -283,8 +347,69 @@ void Model::forward(const double* q, Data& data) const noexcept {
     values[i] = v;
   }
   detail::sincos_batch(values, sines, cosines, n);
+  // The previous fast segment's product (before its perm): rows of columns 0 and 1, column 2, translation.
+  V2 m01[3] = {};
+  double m2[3] = {}, mt[3] = {};
   for (std::size_t i = 0; i < n; ++i) {
     const Segment& s = segments_[i];
+    if (s.fast) {
+      // R = P * B * Rz(v) (P: the parent's rotation, identity at the base), column i to column perm[i];
+      // t = parent t + P * pre.p over the nonzero components of pre.p. The same products and sums in
+      // the same order as the general form below, so the same results; two columns per SSE2 operation.
+      double* r = out[i].rotation.data();  // r[c * 3 + row]
+      double* t = out[i].translation.data();
+      const V2 cs2 = v2(cosines[i], cosines[i]), sn2 = v2(sines[i], sines[i]);
+      const auto& row = s.chained ? s.c_row : s.b_row;
+      const auto& swp = s.chained ? s.c_swap : s.b_swap;
+      const double* col2 = s.chained ? s.c_col2 : s.b_col2;
+      const double* lt = s.chained ? s.c_translation : s.pre.translation.data();
+      const unsigned mask = s.chained ? s.c_mask : s.pre_translation_mask;
+      V2 a[3];  // rows of B * Rz(v)'s first two columns; its third column is col2
+      for (int j = 0; j < 3; ++j) a[j] = cs2 * v2(row[j][0], row[j][1]) + sn2 * v2(swp[j][0], swp[j][1]);
+      const std::size_t c0 = s.perm[0] * 3U, c1 = s.perm[1] * 3U, c2 = s.perm[2] * 3U;
+      if (s.parent < 0) {
+        for (int k = 0; k < 3; ++k) {
+          m01[k] = a[k];
+          m2[k] = col2[k];
+          mt[k] = lt[k];
+        }
+      } else {
+        double p[9];  // the parent's rotation (column-major), in the chained case in its product's order
+        double tt[3];
+        if (s.chained) {
+          for (int k = 0; k < 3; ++k) {
+            p[k] = m01[k][0];
+            p[3 + k] = m01[k][1];
+            p[6 + k] = m2[k];
+            tt[k] = mt[k];
+          }
+        } else {
+          // Into locals first: r and t could alias the parent's frame as far as the compiler knows.
+          const Frame& pf = out[s.parent];
+          for (int k = 0; k < 9; ++k) p[k] = pf.rotation.data()[k];
+          for (int k = 0; k < 3; ++k) tt[k] = pf.translation[k];
+        }
+        // The mask is fixed per segment: these branches predict perfectly.
+        for (int c = 0; c < 3; ++c)
+          if ((mask >> c) & 1U)
+            for (int k = 0; k < 3; ++k) tt[k] += p[c * 3 + k] * lt[c];
+        for (int k = 0; k < 3; ++k)
+          m01[k] = v2(p[k], p[k]) * a[0] + v2(p[3 + k], p[3 + k]) * a[1] + v2(p[6 + k], p[6 + k]) * a[2];
+        const V2 top = v2(p[0], p[1]) * v2(col2[0], col2[0]) + v2(p[3], p[4]) * v2(col2[1], col2[1]) +
+                       v2(p[6], p[7]) * v2(col2[2], col2[2]);
+        m2[0] = top[0];
+        m2[1] = top[1];
+        m2[2] = p[2] * col2[0] + p[5] * col2[1] + p[8] * col2[2];
+        for (int k = 0; k < 3; ++k) mt[k] = tt[k];
+      }
+      for (int k = 0; k < 3; ++k) {
+        r[c0 + k] = m01[k][0];
+        r[c1 + k] = m01[k][1];
+        r[c2 + k] = m2[k];
+        t[k] = mt[k];
+      }
+      continue;
+    }
     double* r = out[i].rotation.data();  // r[c * 3 + row]
     double* t = out[i].translation.data();
     const double v = values[i];
@@ -347,14 +472,24 @@ void Model::forward(const double* q, Data& data) const noexcept {
     if (s.parent < 0) {
       for (int k = 0; k < 9; ++k) r[k] = a[k];
       for (int k = 0; k < 3; ++k) t[k] = lt[k];
-    } else {
-      const double* pr2 = out[s.parent].rotation.data();
-      const double* pt = out[s.parent].translation.data();
-      for (int k = 0; k < 3; ++k) t[k] = pt[k] + pr2[k] * lt[0] + pr2[3 + k] * lt[1] + pr2[6 + k] * lt[2];
-      for (int c = 0; c < 3; ++c)
-        for (int k = 0; k < 3; ++k)
-          r[c * 3 + k] = pr2[k] * a[c * 3] + pr2[3 + k] * a[c * 3 + 1] + pr2[6 + k] * a[c * 3 + 2];
+      continue;
     }
+    const double* pr2 = out[s.parent].rotation.data();
+    const double* pt = out[s.parent].translation.data();
+    if (s.post_identity && s.motion != Motion::Trans) {
+      // lt is pre.p: URDF origins are mostly exact zeros, whose products the general form would add.
+      // The mask is fixed per segment, so these branches predict perfectly.
+      double tt[3] = {pt[0], pt[1], pt[2]};
+      for (int c = 0; c < 3; ++c)
+        if ((s.pre_translation_mask >> c) & 1U)
+          for (int k = 0; k < 3; ++k) tt[k] += pr2[c * 3 + k] * lt[c];
+      for (int k = 0; k < 3; ++k) t[k] = tt[k];
+    } else {
+      for (int k = 0; k < 3; ++k) t[k] = pt[k] + pr2[k] * lt[0] + pr2[3 + k] * lt[1] + pr2[6 + k] * lt[2];
+    }
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 3; ++k)
+        r[c * 3 + k] = pr2[k] * a[c * 3] + pr2[3 + k] * a[c * 3 + 1] + pr2[6 + k] * a[c * 3 + 2];
   }
 }
 

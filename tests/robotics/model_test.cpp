@@ -247,6 +247,51 @@ TEST(Model, TipNotBelowBaseIsAnError) {
   }
 }
 
+// The fast form (a rotation about x, y or z after a general origin; the parent's product kept in
+// registers when it is the previous segment) against the plain composition parent * pre * R(axis, v),
+// on a tree: chained segments, a branch back to an earlier body, fixed and prismatic segments between.
+TEST(Model, CoordinateAxisJointsMatchThePlainComposition) {
+  const Eigen::Vector3d axes[3] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+                                   Eigen::Vector3d::UnitZ()};
+  std::mt19937_64 rng(99);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  std::vector<JointSpec> specs;
+  const int parents[] = {-1, 0, 1, 2, 1, 4, 5, 3, 7, 0};
+  for (int i = 0; i < 10; ++i) {
+    JointSpec s;
+    s.name = s.body = "j" + std::to_string(i);
+    s.parent = parents[i];
+    s.type = i == 6   ? KinematicJointType::Fixed
+             : i == 8 ? KinematicJointType::Prismatic
+                      : KinematicJointType::Rotary;
+    s.placement.pre = Eigen::Translation3d(u(rng), i % 2 == 0 ? 0.0 : u(rng), u(rng)) *
+                      Eigen::AngleAxisd(u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized());
+    s.placement.axis = axes[i % 3];
+    specs.push_back(s);
+  }
+  const Model m = Model::build(specs);
+  Model::Data d = m.make_data();
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<double> q(static_cast<std::size_t>(m.dof()));
+    for (double& v : q) v = 3.0 * u(rng);
+    m.forward(q, d);
+    std::vector<Eigen::Isometry3d> want;
+    int k = 0;
+    for (int i = 0; i < 10; ++i) {
+      const JointSpec& s = specs[static_cast<std::size_t>(i)];
+      Eigen::Isometry3d local = s.placement.pre;
+      if (s.type == KinematicJointType::Rotary)
+        local = local * Eigen::AngleAxisd(q[static_cast<std::size_t>(k++)], s.placement.axis);
+      else if (s.type == KinematicJointType::Prismatic)
+        local = local * Eigen::Translation3d(q[static_cast<std::size_t>(k++)] * s.placement.axis);
+      want.push_back(s.parent < 0 ? local : want[static_cast<std::size_t>(s.parent)] * local);
+      const Frame& got = m.pose(d, i);
+      EXPECT_TRUE(got.rotation.isApprox(want.back().linear(), 1e-12)) << "body " << i;
+      EXPECT_LT((got.translation - want.back().translation()).norm(), 1e-12) << "body " << i;
+    }
+  }
+}
+
 // ---- DH ------------------------------------------------------------------------------------------------
 
 // UR5's published DH table (standard convention).

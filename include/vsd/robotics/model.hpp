@@ -144,6 +144,23 @@ class Model {
     Motion motion = Motion::None;
     bool pre_identity = false;
     bool post_identity = true;
+    bool pre_rotation_identity = false;
+    // Bit k set: pre.translation[k] != 0 (forward() skips the exact zeros of URDF origins).
+    std::uint8_t pre_translation_mask = 7;
+    // Fast form (post identity; a rotation about a coordinate axis, or fixed): B = pre.R * Q with Q the
+    // cyclic permutation taking z to the joint axis, so the motion is a rotation about z:
+    // R = parent.R * B * Rz(v) * Q^T, and Q^T only places column i of the product at column perm[i].
+    bool fast = false;
+    std::uint8_t perm[3] = {0, 1, 2};
+    double b_row[3][2] = {};   // (B(j,0), B(j,1)) for row j
+    double b_swap[3][2] = {};  // (B(j,1), -B(j,0)): B * Rz's first two columns are c * b_row + s * b_swap
+    double b_col2[3] = {};     // B's third column
+    // Chained: the parent is the previous segment, in the fast form too. forward() then keeps the
+    // parent's product in registers in its own column order (before the parent's perm), so B's rows
+    // and pre.p come permuted by the parent's perm: c_* below (row j = the parent's column perm[j]).
+    bool chained = false;
+    std::uint8_t c_mask = 7;
+    double c_row[3][2] = {}, c_swap[3][2] = {}, c_col2[3] = {}, c_translation[3] = {};
   };
   std::vector<Segment> segments_;
   std::vector<DofInfo> layout_;
