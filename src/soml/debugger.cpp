@@ -22,16 +22,6 @@ namespace vsd::soml {
 
 namespace {
 
-std::string fmt_double(double d) {
-  if (std::isnan(d)) return "nan";
-  if (std::isinf(d)) return d > 0 ? "inf" : "-inf";
-  char buf[64];
-  auto r = std::to_chars(buf, buf + sizeof buf, d);
-  std::string s(buf, r.ptr);
-  if (s.find_first_of(".en") == std::string::npos) s += ".0";
-  return s;
-}
-
 std::string quoted(const std::string& s) {
   std::string q = "\"";
   for (const char c : s) {

@@ -407,4 +407,7 @@ int compile_invoke_args(ProgramImpl& p, const TransitionDecl& t, const std::stri
 [[noreturn]] void not_supported(const ProgramImpl& p, SourceLoc loc, const std::string& what);
 std::string where(const ProgramImpl& p, SourceLoc loc);
 
+/// SOML++'s text of a double (vm.cpp): what `string(x)` and `print` show, and the debugger too.
+std::string fmt_double(double d);
+
 }  // namespace vsd::soml

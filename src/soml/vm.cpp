@@ -18,8 +18,7 @@
 
 namespace vsd::soml {
 
-namespace {
-
+// SOML++'s text of a double: shortest round-trip form, always with a '.' or exponent ("2.0").
 std::string fmt_double(double d) {
   if (std::isnan(d)) return "nan";
   if (std::isinf(d)) return d > 0 ? "inf" : "-inf";
@@ -29,6 +28,8 @@ std::string fmt_double(double d) {
   if (s.find_first_of(".en") == std::string::npos) s += ".0";
   return s;
 }
+
+namespace {
 
 inline std::int64_t wrap_add(std::int64_t a, std::int64_t b) {
   return static_cast<std::int64_t>(static_cast<std::uint64_t>(a) + static_cast<std::uint64_t>(b));
