@@ -45,6 +45,18 @@ class PollingBarrier {
       std::this_thread::sleep_for(200us);
     }
   }
+  /// Waits without polling, so nothing another participant sends after the barrier opens can be taken in
+  /// before this thread acts: for actions that all must take before any sees another's (racing claims).
+  /// Safe only where nobody waits for data to arrive.
+  void arrive_and_wait_quietly() {
+    const int gen = generation_.load();
+    if (++arrived_ == n_) {
+      arrived_ = 0;
+      ++generation_;
+      return;
+    }
+    while (generation_.load() == gen) std::this_thread::sleep_for(50us);
+  }
 
  private:
   const int n_;
@@ -112,6 +124,10 @@ TEST(ConcurrentWrites, ThreadsWritingTheSameUnownedPropertiesConvergeAndTheLoser
       return p.stats().bundles_applied == others;
     };
     for (int r = 1; r <= rounds; ++r) {
+      // Nobody writes before everyone is here, and nobody polls until its own writes are out: a writer that
+      // took in another's bundle of this round first would write after it, not concurrently (a plain
+      // overwrite, which nobody is told of, rightly).
+      race.sync.arrive_and_wait_quietly();
       // 0-2 bundles of my own first (on a property nobody else writes this round), so that the clocks, and
       // with them the winners, differ from round to round.
       for (int extra = static_cast<int>(rng() % 3); extra > 0; --extra) {
@@ -211,6 +227,9 @@ TEST(ConcurrentClaims, RacingClaimsEndWithOneOwnerEverywhereAndTheLosersRolledBa
         arm->set_counter(arm->counter() + 1);
         p.publish();
       }
+      // Nobody claims before everyone is here, and nobody polls in between: a claim that arrived first
+      // would make the later local claim a plain error (owned by another) instead of a race.
+      race.sync.arrive_and_wait_quietly();
       const int before = claim_conflicts;
       const bool instance_claim = r % 3 == 0;  // every third round races for the whole instance
       if (p.owner(arm->id(), "target") != 0) race.fail("round " + std::to_string(r) + ": still owned");
