@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "vsd/core/environment.hpp"
 #include "vsd/core/error.hpp"
@@ -90,11 +91,7 @@ class Session {
   int loop() {
     try {
       for (std::string line; read(line);) {
-        std::istringstream in(line);
-        std::string cmd, rest;
-        in >> cmd;
-        std::getline(in, rest);
-        rest = std::string(trim(rest));
+        auto [cmd, rest] = split_command(line);
         if (cmd.empty()) continue;
         if (cmd == "c" || cmd == "continue") {
           run(limit_ - std::min(limit_, program_.firings()), false);
@@ -117,6 +114,14 @@ class Session {
   }
 
  private:
+  // A command line as its first word and the rest, trimmed (both prompts read commands this way).
+  static std::pair<std::string, std::string> split_command(const std::string& line) {
+    std::istringstream in(line);
+    std::string cmd, rest;
+    in >> cmd;
+    std::getline(in, rest);
+    return {cmd, std::string(trim(rest))};
+  }
   static std::string_view trim(std::string_view s) {
     while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front())) != 0) s.remove_prefix(1);
     while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back())) != 0) s.remove_suffix(1);
@@ -221,11 +226,7 @@ class Session {
       std::cout << "\n" << s.line << "\t" << source_line(s.line) << "\n";
     }
     for (std::string line; read(line);) {
-      std::istringstream in(line);
-      std::string cmd, rest;
-      in >> cmd;
-      std::getline(in, rest);
-      rest = std::string(trim(rest));
+      auto [cmd, rest] = split_command(line);
       if (cmd.empty()) continue;
       if (cmd == "c" || cmd == "continue") return soml::Resume::Continue;
       if (cmd == "s" || cmd == "step") return soml::Resume::Step;
