@@ -17,10 +17,12 @@
 //   vsd_workcell IIWA14.URDF [workcell.soml] [OUTDIR]
 //
 // Prints a log of what the supervisor commands and what the plant reports, writes OUTDIR/workcell.csv
-// (robot tip and box positions over time), and ends with check lines; exit code 0 when every box rests
-// on the target area and every job token reached `done`.
+// (robot tool tip and box positions over time; with gnuplot also OUTDIR/workcell.png, the heights), and
+// ends with check lines; exit code 0 when every box rests on its slot of the target area and every job
+// token reached `done`.
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -346,7 +348,7 @@ int main(int argc, char** argv) try {
   // --- Run until every job is done (or a time limit), recording the tip and the boxes.
   const auto csv_path = out / "workcell.csv";
   std::ofstream csv(csv_path);
-  csv << "time,tip_x,tip_y,tip_z";
+  csv << "time,pad_x,pad_y,pad_z";  // the pad's centre: the robot's tool tip
   for (Box* b : boxes) csv << ',' << b->name() << "_x," << b->name() << "_y," << b->name() << "_z";
   csv << '\n';
   vsd::soml::Place* done = net.place("done", supervisor);
@@ -377,6 +379,21 @@ int main(int argc, char** argv) try {
     }
   }
   csv.close();
+  // A plot of the heights over time, when gnuplot is there: the pad going down and up, each box lifted
+  // and put down.
+  if (std::system("command -v gnuplot > /dev/null 2>&1") == 0) {
+    const auto gp_path = out / "workcell.gp";
+    std::ofstream gp(gp_path);
+    gp << "set terminal png size 1000,500 noenhanced\nset output '" << (out / "workcell.png").string() << "'\n"
+       << "set datafile separator ','\nset key autotitle columnhead outside\nset xlabel 'time (s)'\n"
+       << "set ylabel 'height (m)'\nset title 'work cell: gripper pad and boxes (SOML++ supervisor)'\nplot ";
+    for (std::size_t i = 0; i <= boxes.size(); ++i)
+      gp << (i ? ", " : "") << "'" << csv_path.string() << "' using 1:" << 4 + 3 * i << " with lines lw 2";
+    gp << '\n';
+    gp.close();
+    if (std::system(("gnuplot '" + gp_path.string() + "'").c_str()) == 0)
+      std::printf("plot: %s\n", (out / "workcell.png").string().c_str());
+  }
 
   // --- Checks.
   std::printf(
