@@ -193,6 +193,7 @@ int main(int argc, char** argv) try {
   auto& tree = vsd::robotics::build_kinematics(*urdf.scene);
   auto& controller = s.create<vsd::robotics::JointController>();
   urdf.scene->add_extension(controller);
+  // The flange frame with z along the tool (the URDF's iiwa_link_ee has its x axis there instead).
   controller.set_tip("iiwa_link_ee_kuka");
   controller.set_cartesian_gain(8.0);        // 1/s: smooth approach, no overshoot
   controller.set_cartesian_tolerance(5e-4);  // m and rad: "arrived"
@@ -261,7 +262,9 @@ int main(int argc, char** argv) try {
        cell_node);
   vsd::scene::SpatialView view(s);
 
-  // --- The robot's start: the tool pointing down above the middle of the table (IK from a bent arm).
+  // --- The robot's start: the tool pointing down above the middle of the table. The IK seed matters:
+  // the Cartesian controller has no null-space motion, so the arm keeps the posture it starts in, and
+  // one near a joint limit (where the controller clamps) bends the straight-line motions.
   const vsd::robotics::Model& model = tree.model();
   {
     Eigen::Isometry3d home = at(0.52, 0.0, table_top + 0.2 + tool_length);
@@ -338,6 +341,12 @@ int main(int argc, char** argv) try {
   // --- The supervisor.
   vsd::soml::Program& net = soml.load(s, script, read_text(script));
   vsd::Node* supervisor = net.object("cell");
+  if (supervisor == nullptr) throw vsd::Error(script + ": no object 'cell' (the supervisor)");
+  const char* places[] = {"waiting",  "approaching", "descending", "lifting",   "carrying",
+                          "lowering", "settling",    "done",       "robot_free"};
+  for (const char* p : places)
+    if (net.place(p, supervisor) == nullptr)
+      throw vsd::Error(script + ": object 'cell' has no place '" + p + "'");
   supervisor->set("robot", vsd::Value(vsd::SharedRef<vsd::Node>(&robot)));
   for (std::size_t i = 0; i < boxes.size(); ++i)
     supervisor->call("add_job", {vsd::Value(vsd::SharedRef<vsd::Node>(boxes[i])),
@@ -384,7 +393,8 @@ int main(int argc, char** argv) try {
   if (std::system("command -v gnuplot > /dev/null 2>&1") == 0) {
     const auto gp_path = out / "workcell.gp";
     std::ofstream gp(gp_path);
-    gp << "set terminal png size 1000,500 noenhanced\nset output '" << (out / "workcell.png").string() << "'\n"
+    gp << "set terminal png size 1000,500 noenhanced\nset output '" << (out / "workcell.png").string()
+       << "'\n"
        << "set datafile separator ','\nset key autotitle columnhead outside\nset xlabel 'time (s)'\n"
        << "set ylabel 'height (m)'\nset title 'work cell: gripper pad and boxes (SOML++ supervisor)'\nplot ";
     for (std::size_t i = 0; i <= boxes.size(); ++i)
@@ -413,8 +423,7 @@ int main(int argc, char** argv) try {
     on_target += ok ? 1 : 0;
   }
   std::string marking;
-  for (const char* p : {"waiting", "approaching", "descending", "lifting", "carrying", "lowering", "settling",
-                        "done", "robot_free"})
+  for (const char* p : places)
     marking += std::string(marking.empty() ? "" : ", ") + p + " " +
                std::to_string(net.place(p, supervisor)->count());
   std::printf("final marking: %s\n", marking.c_str());
