@@ -1,6 +1,10 @@
 #!/usr/bin/env bash
-# Builds and runs the main vsd demo (examples/vsd_demo). Arguments are passed to the demo.
-#   bash scripts/demo.sh
+# Builds and runs the main vsd demo: the virtual work cell (examples/workcell), in which a SOML++ net
+# supervises a 3D simulation of the iiwa14 moving boxes. When a module it needs was skipped at configure
+# time (a missing Debian package), the core-only tour (examples/demo) runs instead, and says so.
+#   bash scripts/demo.sh            the work cell (writes workcell.csv, and workcell.png with gnuplot,
+#                                   into build/examples/workcell)
+#   bash scripts/demo.sh --tour     the core-only tour (examples/demo); further arguments go to it
 # Environment: BUILD_DIR (default build), VSD_SKIP_DEPS=1 to skip the dependency check.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -9,5 +13,25 @@ BUILD_DIR="${BUILD_DIR:-build}"
 
 bash scripts/install-deps.sh
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release
-cmake --build "$BUILD_DIR" --target vsd_demo --parallel 2
-"$BUILD_DIR/examples/vsd_demo" "$@"
+
+tour() {
+  cmake --build "$BUILD_DIR" --target vsd_demo --parallel 2
+  "$BUILD_DIR/examples/vsd_demo" "$@"
+}
+
+if [[ "${1:-}" == "--tour" ]]; then
+  shift
+  tour "$@"
+  exit
+fi
+# The work cell exists only when vsd::soml, ::robotics, ::physics and ::collision were all configured.
+if cmake --build "$BUILD_DIR" --target help | grep -q '\bvsd_workcell\b'; then
+  cmake --build "$BUILD_DIR" --target vsd_workcell --parallel 2
+  mkdir -p "$BUILD_DIR/examples/workcell"
+  "$BUILD_DIR/examples/vsd_workcell" tests/scene/data/iiwa14.urdf examples/workcell/workcell.soml \
+    "$BUILD_DIR/examples/workcell"
+else
+  echo "demo: the work cell needs vsd::soml, vsd::robotics, vsd::physics and vsd::collision (see the" \
+       "configure messages above); running the core tour instead" >&2
+  tour "$@"
+fi
