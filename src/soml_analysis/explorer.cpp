@@ -415,6 +415,10 @@ class Explorer {
         std::uint64_t* down = down_.data() + std::size_t{t} * tw_;
         for (std::uint32_t i = c_.delta_begin[t]; i < c_.delta_begin[t + 1]; ++i) {
           const auto& d = c_.delta[i];
+          // Named pointers, not `(d.delta > 0 ? up : down)[u >> 6] |= ...`: GCC 12.2 with -fsanitize=shift
+          // (part of the ASan+UBSan build) at -O0 miscompiles a compound assignment through a subscript whose
+          // base is a conditional expression and whose index is a shift; the write lands far outside the
+          // array (SEGV in Pnml.RoundTripKeeps...). A 15-line program does it too; clang and -O1 do not.
           std::uint64_t* gains = d.delta > 0 ? up : down;  // input arcs on d.place
           std::uint64_t* loses = d.delta > 0 ? down : up;  // inhibitor arcs on d.place
           for (const std::uint32_t r : inputs_of[d.place]) gains[r >> 6] |= std::uint64_t{1} << (r & 63);
