@@ -1,6 +1,7 @@
 #include "vsd/soml/analysis/token_game.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <optional>
 
@@ -178,6 +179,34 @@ struct TokenGame::Net {
 
 namespace {
 constexpr std::uint32_t kBlockWords = 8;  // words of the enabled bitset per block count
+
+// kSelectInByte[b][i]: the position of the i-th set bit of byte b (i below the byte's bit count).
+constexpr auto kSelectInByte = [] {
+  std::array<std::array<std::uint8_t, 8>, 256> table{};
+  for (unsigned b = 0; b < 256; ++b) {
+    unsigned i = 0;
+    for (unsigned bit = 0; bit < 8; ++bit)
+      if ((b >> bit) & 1) table[b][i++] = static_cast<std::uint8_t>(bit);
+  }
+  return table;
+}();
+
+// The position of the index-th set bit of w (index < the bit count of w), without branches and without
+// a popcount instruction: byte counts by SWAR, their prefix sums by one multiplication, the byte by a
+// bytewise comparison, the bit in the byte from a table. (A loop clearing `index` low bits mispredicts
+// its exit on every pick.)
+inline unsigned select_bit(std::uint64_t w, unsigned index) {
+  constexpr std::uint64_t kOnes = 0x0101010101010101ull;
+  std::uint64_t c = w - ((w >> 1) & 0x5555555555555555ull);
+  c = (c & 0x3333333333333333ull) + ((c >> 2) & 0x3333333333333333ull);
+  c = (c + (c >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+  const std::uint64_t prefix = c * kOnes;  // byte k: set bits in bytes 0..k (at most 64: no carries)
+  // High bit of byte k set where prefix_k <= index: bytes wholly before the wanted bit.
+  const std::uint64_t before = ((index * kOnes | 0x8080808080808080ull) - prefix) & 0x8080808080808080ull;
+  const auto byte = static_cast<unsigned>(((before >> 7) * kOnes) >> 56);
+  const unsigned skipped = static_cast<unsigned>((prefix << 8) >> (8 * byte)) & 0xFF;  // bits in bytes < byte
+  return 8 * byte + kSelectInByte[(w >> (8 * byte)) & 0xFF][index - skipped];
+}
 }  // namespace
 
 TokenGame::TokenGame(const PtNet& net) : net_(std::make_unique<Net>(net)) { reset(); }
@@ -256,9 +285,7 @@ std::uint32_t TokenGame::nth_enabled(std::uint32_t index) const noexcept {
   while (index >= block_count_[b]) index -= block_count_[b++];
   std::uint32_t w = b * kBlockWords;
   while (index >= word_count_[w]) index -= word_count_[w++];
-  std::uint64_t bits = enabled_bits_[w];
-  for (; index != 0; --index) bits &= bits - 1;
-  return w * 64 + static_cast<std::uint32_t>(std::countr_zero(bits));
+  return w * 64 + select_bit(enabled_bits_[w], index);
 }
 
 template <std::uint32_t S>
