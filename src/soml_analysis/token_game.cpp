@@ -33,7 +33,7 @@ namespace vsd::soml::analysis {
 //
 // Both keep the enabled set as the bitset E with a count per word of E and per block of kBlockWords words,
 // so play() finds the index-th enabled transition by walking counts (no popcount: the default x86-64
-// target has no popcnt instruction) and then the bits of one word.
+// target has no popcnt instruction) and then selecting in one word (select_bit).
 struct TokenGame::Net {
   struct Test {
     std::uint32_t transition;
@@ -64,8 +64,8 @@ struct TokenGame::Net {
   std::vector<std::uint64_t> update_d;     // per update: S slices of the count changes
   std::vector<std::uint64_t> never;        // per word of transitions: lanes never enabled
   std::vector<std::uint64_t> initial_bits;
-  std::vector<std::uint64_t>
-      initial_counts;  // per word of transitions, S slices: counts in the initial marking
+  // Per word of transitions, S slices: the counts in the initial marking.
+  std::vector<std::uint64_t> initial_counts;
 
   explicit Net(const PtNet& net) : c(net), initial(net.initial_marking()) {
     for (const auto& t : net.transitions()) transition_ids.push_back(t.id);

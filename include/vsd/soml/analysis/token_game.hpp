@@ -53,8 +53,8 @@ class TokenGame {
   /// r of xorshift64* (state seeded as seed * 0x9E3779B97F4A7C15 + 1), maps its high 32 bits onto [0, n)
   /// for the n = enabled_count() transitions enabled (index = (r >> 32) * n >> 32, uniform to within
   /// n / 2^32) and fires enabled()[index], the index-th enabled transition in index order. So the same net,
-  /// starting marking, seed and steps give the same firings on every platform and with either marking
-  /// representation (safe() or not).
+  /// starting marking, seed and steps give the same firings on every platform, whichever marking
+  /// representation (safe() or not) the game uses.
   /// @return the number of firings done (== @p steps unless the initial marking is dead: then 0).
   std::uint64_t play(std::uint64_t steps, std::uint64_t seed);
 
