@@ -18,10 +18,13 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <fstream>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <ostream>
 #include <sstream>
@@ -206,19 +209,92 @@ inline bool same(const std::uint64_t* a, const std::uint64_t* b, std::uint32_t w
   return true;
 }
 
-// Work split for phases with a fixed item count: threads take items from a shared counter.
-template <class F>
-void run_workers(unsigned threads, F&& body) {
-  if (threads <= 1) {
-    body(0u);
-    return;
+// The explorer's helper threads, started once per explore() (at the first phase that wants more than one
+// worker) and kept for all its phases and levels: starting and joining threads for every phase of every
+// level cost more than small levels (Dekker-PT-010's) gain from a second thread. Idle helpers block on a
+// condition variable, so a loaded machine loses no cycles to spinning. Worker 0 is the calling thread.
+class WorkerPool {
+ public:
+  WorkerPool() = default;
+  WorkerPool(const WorkerPool&) = delete;
+  WorkerPool& operator=(const WorkerPool&) = delete;
+  ~WorkerPool() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+      ++generation_;
+    }
+    wake_.notify_all();
+    for (auto& t : helpers_) t.join();
   }
-  std::vector<std::thread> pool;
-  pool.reserve(threads - 1);
-  for (unsigned w = 1; w < threads; ++w) pool.emplace_back([&body, w] { body(w); });
-  body(0u);
-  for (auto& t : pool) t.join();
-}
+
+  // Runs body(w) for w in [0, workers), body(0) on this thread, and returns when all have returned (the
+  // pool grows to workers - 1 helpers). Work split: bodies take items from a shared counter of their own.
+  template <class F>
+  void run(unsigned workers, F&& body) {
+    if (workers <= 1) {
+      body(0u);
+      return;
+    }
+    while (helpers_.size() + 1 < workers) {
+      const auto w = static_cast<unsigned>(helpers_.size() + 1);
+      std::uint64_t now = 0;  // a new helper waits for the next job, not the last one
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        now = generation_;
+      }
+      helpers_.emplace_back([this, w, now] { loop(w, now); });
+    }
+    using Body = std::remove_reference_t<F>;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      job_ = static_cast<void*>(&body);
+      call_ = [](void* job, unsigned w) { (*static_cast<Body*>(job))(w); };
+      active_ = workers;
+      pending_ = workers - 1;
+      ++generation_;
+    }
+    wake_.notify_all();
+    std::exception_ptr error;
+    try {
+      body(0u);
+    } catch (...) {
+      error = std::current_exception();  // rethrown once the helpers no longer use `body`
+    }
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      done_.wait(lock, [this] { return pending_ == 0; });
+    }
+    if (error) std::rethrow_exception(error);
+  }
+
+ private:
+  void loop(unsigned w, std::uint64_t seen) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (true) {
+      wake_.wait(lock, [&] { return generation_ != seen; });
+      seen = generation_;
+      if (stop_) return;
+      if (w >= active_) continue;  // a phase with fewer workers than the pool has threads
+      void* const job = job_;
+      void (*const call)(void*, unsigned) = call_;
+      lock.unlock();
+      call(job, w);
+      lock.lock();
+      if (--pending_ == 0) done_.notify_one();
+    }
+  }
+
+  std::vector<std::thread> helpers_;
+  std::mutex mutex_;
+  std::condition_variable wake_, done_;
+  std::uint64_t generation_ = 0;  // one per run(): a helper runs each job once
+  bool stop_ = false;
+  unsigned active_ = 0;   // workers of the current job
+  unsigned pending_ = 0;  // helpers of the current job still running it
+  void* job_ = nullptr;
+  void (*call_)(void*, unsigned) = nullptr;
+};
 
 struct alignas(64) WorkerStats {
   std::uint64_t edges = 0;
@@ -339,6 +415,10 @@ class Explorer {
         std::uint64_t* down = down_.data() + std::size_t{t} * tw_;
         for (std::uint32_t i = c_.delta_begin[t]; i < c_.delta_begin[t + 1]; ++i) {
           const auto& d = c_.delta[i];
+          // Named pointers, not `(d.delta > 0 ? up : down)[u >> 6] |= ...`: GCC 12.2 with -fsanitize=shift
+          // (part of the ASan+UBSan build) at -O0 miscompiles a compound assignment through a subscript whose
+          // base is a conditional expression and whose index is a shift; the write lands far outside the
+          // array (SEGV in Pnml.RoundTripKeeps...). A 15-line program does it too; clang and -O1 do not.
           std::uint64_t* gains = d.delta > 0 ? up : down;  // input arcs on d.place
           std::uint64_t* loses = d.delta > 0 ? down : up;  // inhibitor arcs on d.place
           for (const std::uint32_t r : inputs_of[d.place]) gains[r >> 6] |= std::uint64_t{1} << (r & 63);
@@ -517,6 +597,7 @@ class Explorer {
   std::vector<std::uint64_t> prev_enabled_, cur_enabled_;
   std::uint64_t states_ = 0;
   std::uint64_t edges_ = 0;
+  WorkerPool pool_;  // last: its helpers stop before anything they could touch goes away
 };
 
 bool Explorer::attempt(unsigned bits, ExploreResult& r) {
@@ -561,7 +642,6 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
   for (; lo < hi; ++level) {
     const std::uint64_t n = hi - lo;
     const std::size_t nchunks = (n + kChunkStates - 1) / kChunkStates;
-    const unsigned workers = static_cast<unsigned>(std::min<std::size_t>(threads_, nchunks));
     // One worker and a small hash set: each successor is looked up (and a new one numbered) as soon as it is
     // made, in the order phases B and C would have used, so the numbering is the same; no successor buffers,
     // and phases B to D fall away. Chunk 0 serves as scratch. Only while the hash set is small enough to stay
@@ -569,7 +649,14 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     // candidates ahead (the ring of 490 314 states ran 25 % slower fused).
     std::size_t table_bytes = 0;
     for (const auto& sh : shards_) table_bytes += sh.slots.size() * 8;
-    const bool fused = workers == 1 && table_bytes <= kFusedTableBytes;
+    const bool small_table = table_bytes <= kFusedTableBytes;
+    // While the hash set is small, one worker (fused) also beats several (phased) in wall time: the
+    // phases cost ~5x the CPU per successor (Dekker-PT-010: 2.4 M states/s on one thread, 0.45 M per
+    // core on two). So the threads share only the levels of larger state spaces, unless told otherwise.
+    const unsigned workers = small_table && !opt_.split_small_levels
+                                 ? 1u
+                                 : static_cast<unsigned>(std::min<std::size_t>(threads_, nchunks));
+    const bool fused = workers == 1 && small_table;
     const std::uint64_t new_lo = states_;
     if (chunks_.size() < (fused ? 1 : nchunks)) chunks_.resize(fused ? 1 : nchunks);
     cur_enabled_.assign(n * tw_, 0);
@@ -585,7 +672,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     with_words(L.words, [&](auto wc) {
       constexpr std::uint32_t W = decltype(wc)::value;
       const std::uint32_t words = W != 0 ? W : L.words;
-      run_workers(workers, [&](unsigned wi) {
+      pool_.run(workers, [&](unsigned wi) {
         WorkerStats& st = ws[wi];
         std::uint32_t* m = st.unpacked.data();
         while (!stop.load(std::memory_order_relaxed)) {
@@ -769,7 +856,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
       std::atomic<std::uint64_t> next{new_lo};
       const unsigned cworkers =
           static_cast<unsigned>(std::min<std::uint64_t>(threads_, (states_ - new_lo) / 64 + 1));
-      run_workers(cworkers, [&](unsigned wi) {
+      pool_.run(cworkers, [&](unsigned wi) {
         WorkerStats& st = ws[wi];
         std::uint32_t* m = st.unpacked.data();
         while (true) {
@@ -850,7 +937,7 @@ void Explorer::phases_b_to_d(std::size_t nchunks, const Layout& L) {
     constexpr std::uint32_t W = decltype(wc)::value;
     const std::uint32_t words = W != 0 ? W : L.words;
     const bool all_mine = bworkers == 1;
-    run_workers(bworkers, [&](unsigned wi) {
+    pool_.run(bworkers, [&](unsigned wi) {
       // Worker wi reads every candidate's hash in order and takes those of its shards.
       constexpr std::size_t kAhead = 8;  // the table probes are cache misses: prefetch a few candidates ahead
       for (std::size_t ci = 0; ci < nchunks; ++ci) {
@@ -898,7 +985,7 @@ void Explorer::phases_b_to_d(std::size_t nchunks, const Layout& L) {
   if (too_many) vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
 
   // ---- phase D: pending entries become state indices ----------------------------------------------
-  run_workers(bworkers, [&](unsigned wi) {
+  pool_.run(bworkers, [&](unsigned wi) {
     for (std::size_t si = 0; si < kShards; ++si) {
       if (owner(si) != wi) continue;
       Shard& sh = shards_[si];

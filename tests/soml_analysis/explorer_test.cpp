@@ -43,10 +43,12 @@ std::vector<Expected> expected_rows() {
   return rows;
 }
 
+// Small levels are split among the threads too, so that the multi-threaded path runs on these small nets.
 ExploreOptions quiet(unsigned threads = 1) {
   ExploreOptions o;
   o.threads = threads;
   o.progress = ExploreOptions::Progress::never;
+  o.split_small_levels = true;
   return o;
 }
 
@@ -117,6 +119,25 @@ TEST(Explore, ResultsAreIdenticalForAnyThreadCount) {
     EXPECT_EQ(one.max_tokens_place, two.max_tokens_place);
     EXPECT_EQ(one.max_tokens_marking, two.max_tokens_marking);
     EXPECT_EQ(one.levels, two.levels);
+  }
+}
+
+TEST(Explore, SmallLevelsOnOneThreadByDefaultGiveTheSameResults) {
+  for (const Expected& e : expected_rows()) {
+    SCOPED_TRACE(e.model);
+    const auto net = an::read_pnml_file(std::string(VSD_SOML_TEST_DATA_DIR) + "/" + e.model + ".pnml").net;
+    ExploreOptions o = quiet(2);
+    o.split_small_levels = false;
+    const ExploreResult split = an::explore(net, quiet(2));
+    const ExploreResult fused = an::explore(net, o);
+    EXPECT_EQ(fused.states, e.states);
+    EXPECT_EQ(fused.edges, e.edges);
+    EXPECT_EQ(fused.threads, 2u);
+    EXPECT_EQ(fused.dead_trace, split.dead_trace);
+    EXPECT_EQ(fused.dead_marking, split.dead_marking);
+    EXPECT_EQ(fused.max_tokens_place, split.max_tokens_place);
+    EXPECT_EQ(fused.max_tokens_marking, split.max_tokens_marking);
+    EXPECT_EQ(fused.levels, split.levels);
   }
 }
 
