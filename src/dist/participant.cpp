@@ -527,6 +527,18 @@ struct Participant::Impl {
       // them here. Ask again later.
       return;
     }
+    if (auto bad = invalid_write(table, registers)) {
+      // The answer holds a write its own claims reject (its participant took the bundle before it knew the
+      // claim, and has not noticed yet): ask the owner instead.
+      log("ignored a snapshot of " + who(m.sender) + ": it holds a write of " + who(bad->writer) + " to #" +
+          std::to_string(bad->instance) + "." + bad->property + " that the claim of " + who(bad->owner) +
+          " came before");
+      prefer = bad->owner;
+      nonce = random_id();
+      resync_started = std::chrono::steady_clock::now();
+      request_snapshot();
+      return;
+    }
     const Transaction t = decode_bundle({m.payload.data() + r.position(), r.remaining()});
     clear_state();
     state.apply(t);
@@ -567,9 +579,26 @@ struct Participant::Impl {
       ++stats.claims_lost;
       report(std::move(c), false);
     }
+    // Bundles and claims handled here before the resynchronisation that the answering participant had not
+    // received yet: they will not come again, so they are taken from the history (in their senders' order,
+    // before those that arrived since); should one be missing there, the next message of its sender shows
+    // the gap.
     std::deque<Message> pending = std::move(buffer);
     buffer.clear();
+    std::deque<Message> earlier = std::move(history);
+    history.clear();
+    for (const Message& b : earlier)
+      if (auto a = applied.find(b.sender); a == applied.end() || a->second < b.seq) sequenced(b);
     for (const Message& b : pending) sequenced(b);
+  }
+
+  // Bundles and claims of others handled since the last snapshot was installed (at most history_limit):
+  // a snapshot from a participant that has not received them yet is completed from here.
+  static constexpr std::size_t history_limit = 1024;
+  std::deque<Message> history;
+  void handled(const Message& m) {
+    history.push_back(m);
+    if (history.size() > history_limit) history.pop_front();
   }
 
   std::size_t applied_now = 0;  // bundles applied during the current poll()
@@ -612,8 +641,10 @@ struct Participant::Impl {
       } catch (const Error& e) {
         ++stats.malformed;
         log("rejected bundle " + std::to_string(m.seq) + " of " + who(m.sender) + ": " + e.what());
-        if (auto it = applied.find(m.sender); it != applied.end() && it->second + 1 == m.seq)
+        if (auto it = applied.find(m.sender); it != applied.end() && it->second + 1 == m.seq) {
           it->second = m.seq;  // every participant drops it alike
+          handled(m);
+        }
         return;
       }
     }
@@ -637,11 +668,13 @@ struct Participant::Impl {
     clock = std::max(clock, m.clock);
     if (m.kind == Kind::Claim) {
       it->second = m.seq;
+      handled(m);
       apply_claim(m);
       return;
     }
     if (auto c = find_conflict(t, m.sender, stamp)) {
       it->second = m.seq;
+      handled(m);
       c->seq = m.seq;
       report(*c, c->owner == id);  // the owner tells the writer
       return;
@@ -654,6 +687,7 @@ struct Participant::Impl {
         // It failed on the snapshot too: the shared state cannot take it. Everyone drops it alike.
         ++stats.malformed;
         it->second = m.seq;
+        handled(m);
         log("bundle " + std::to_string(m.seq) + " of " + who(m.sender) +
             " does not apply to the shared state either; dropped");
         return;
@@ -668,6 +702,7 @@ struct Participant::Impl {
     for (const auto& [inst, prop] : kept) note_write(inst, prop, stamp);
     forget_deleted(t);
     it->second = m.seq;
+    handled(m);
     ++stats.bundles_applied;
     ++applied_now;
     for (const Lost& l : lost) {
@@ -749,17 +784,51 @@ struct Participant::Impl {
       report(std::move(c), false);  // every participant sees both claims: nobody needs telling
     }
     if (!synced) return;
-    auto it = written.find(key.first);
-    if (it == written.end()) return;
-    for (const Written& w : it->second) {
-      if (!key.second.empty() && w.property != key.second) continue;
-      const std::uint64_t o = owner_at(key.first, w.property, w.stamp);
-      if (o == 0 || o == w.stamp.who) continue;
-      resync("this state holds a write of " + who(w.stamp.who) + " to #" + std::to_string(key.first) + "." +
-                 w.property + " that the claim of " + who(o) + " came before",
-             nullptr, o);
-      return;
+    if (auto bad = invalid_write(claims, written, key.first, key.second)) {
+      // This state holds a change the others reject: it must not be served to anyone until replaced.
+      self_diverged = true;
+      resync("this state holds a write of " + who(bad->writer) + " to #" + std::to_string(bad->instance) +
+                 "." + bad->property + " that the claim of " + who(bad->owner) + " came before",
+             nullptr, bad->owner);
     }
+  }
+
+  // The first set held in @p registers (of instance @p only, and of property @p prop when not empty; all
+  // instances when @p only is null_id) that @p table makes a write to what someone other than its writer
+  // owned at its stamp: a state holding it took a bundle the owner rejected.
+  std::optional<Conflict> invalid_write(const std::map<OwnerKey, std::vector<OwnEvent>>& table,
+                                        const std::unordered_map<Id, std::vector<Written>>& registers,
+                                        Id only = null_id, std::string_view prop = {}) const {
+    if (table.empty()) return std::nullopt;
+    auto owner_in = [&](Id inst, const std::string& p, const Stamp& limit) {
+      auto key = table.find(OwnerKey(inst, p));
+      std::uint64_t o = key == table.end() ? 0 : replay(key->second, limit);
+      if (o == 0 && !p.empty())
+        if (key = table.find(OwnerKey(inst, std::string())); key != table.end())
+          o = replay(key->second, limit);
+      return o;
+    };
+    auto check = [&](Id inst, const std::vector<Written>& ws) -> std::optional<Conflict> {
+      for (const Written& w : ws) {
+        if (!prop.empty() && w.property != prop) continue;
+        const std::uint64_t o = owner_in(inst, w.property, w.stamp);
+        if (o == 0 || o == w.stamp.who) continue;
+        Conflict c;
+        c.writer = w.stamp.who;
+        c.owner = o;
+        c.instance = inst;
+        c.property = w.property;
+        return c;
+      }
+      return std::nullopt;
+    };
+    if (only != null_id) {
+      auto it = registers.find(only);
+      return it == registers.end() ? std::nullopt : check(only, it->second);
+    }
+    for (const auto& [inst, ws] : registers)
+      if (auto c = check(inst, ws)) return c;
+    return std::nullopt;
   }
 
   void handle_report(const Message& m) {
@@ -888,6 +957,7 @@ struct Participant::Impl {
     publish();  // the claim comes after the changes made before it
     ++clock;
     send(Kind::Claim, ++seq, 0, p);
+    ++stats.claims_sent;
     add_claim_event(OwnerKey(inst, std::string(prop)), OwnEvent{Stamp{clock, id}, take, seq, false});
   }
 };

@@ -104,7 +104,10 @@ struct Conflict {
 
 /// @brief Counters, for tests, tools and monitoring.
 struct ParticipantStats {
-  std::uint64_t bundles_sent = 0;      ///< bundles published
+  std::uint64_t bundles_sent = 0;  ///< bundles published
+  /// claims and releases sent (bundles_sent + claims_sent is the sequence number of the last one sent,
+  /// the number a Conflict's seq names)
+  std::uint64_t claims_sent = 0;
   std::uint64_t bundles_applied = 0;   ///< bundles of others applied
   std::uint64_t duplicates = 0;        ///< bundles and claims dropped as already applied
   std::uint64_t foreign = 0;           ///< samples that are not vsd::dist messages (dropped)
