@@ -154,6 +154,9 @@ struct Participant::Impl {
   std::unordered_map<std::uint64_t, std::uint64_t> applied;  // sender -> last seq handled
   std::unordered_map<Id, std::vector<Written>> written;      // instance -> its registers' stamps
   std::map<OwnerKey, std::vector<OwnEvent>> claims;          // every claim and release, per key
+  // Instances deleted, with the stamp of the deletion: a change to one of them made concurrently with the
+  // deletion is dropped by every replica (the deletion wins), whatever the arrival order.
+  std::unordered_map<Id, Stamp> deleted;
   std::uint64_t prefer = 0;  // the participant a resynchronisation asks first (0: anyone)
   std::unordered_map<std::uint64_t, std::string> names;
   std::deque<Message> buffer;  // bundles and claims received while unsynchronised
@@ -306,11 +309,11 @@ struct Participant::Impl {
     }
     return std::nullopt;
   }
-  void forget_deleted(const Transaction& t) {
-    if (claims.empty() && written.empty()) return;
+  void forget_deleted(const Transaction& t, const Stamp& stamp) {
     detail::TxParser parser(t);
     for (detail::TxOp op; parser.next(op);)
       if (op.op == Transaction::Op::Delete) {
+        deleted.emplace(op.id, stamp);
         written.erase(op.id);
         std::erase_if(claims, [&](const auto& e) { return e.first.first == op.id; });
       }
@@ -325,6 +328,9 @@ struct Participant::Impl {
         return "concurrent claims of " + what + ": the claim of " + who(c.writer) + " (claim " +
                std::to_string(c.seq) + ") lost to the earlier stamped one of " + who(c.owner) +
                "; rolled back";
+      case ConflictKind::Deleted:
+        return "write by " + who(c.writer) + " to " + what + " (bundle " + std::to_string(c.seq) +
+               ") dropped: " + who(c.owner) + " deleted #" + std::to_string(c.instance) + " concurrently";
       case ConflictKind::Owned:
         break;
     }
@@ -352,6 +358,48 @@ struct Participant::Impl {
   }
 
   // ---- sending ----
+  // Replaces the reference-list edits (insert, erase) of @p t by one set per edited list, of its value as
+  // @p t leaves it, after the other operations. Index-based edits of one list made concurrently by two
+  // participants do not commute; whole values do under last-writer-wins (docs/dist.md). The sets carry the
+  // new value as old value too: the wire form drops old values anyway.
+  void lists_as_sets(Transaction& t) const {
+    const std::vector<std::uint8_t>& bytes = t.bytes();
+    std::vector<std::pair<Id, std::string_view>> lists;
+    std::vector<std::pair<std::size_t, std::size_t>> keep;  // byte ranges of the other operations
+    detail::TxParser parser(t);
+    std::size_t start = 0;
+    bool other = false;
+    auto close = [&](std::size_t end) {
+      if (other && end > start) keep.emplace_back(start, end);
+    };
+    for (detail::TxOp op; parser.next(op);) {
+      close(op.offset);
+      start = op.offset;
+      other = op.op != Transaction::Op::Insert && op.op != Transaction::Op::Erase;
+      if (!other && std::find(lists.begin(), lists.end(), std::pair(op.id, op.name)) == lists.end())
+        lists.emplace_back(op.id, op.name);
+    }
+    if (lists.empty()) return;
+    close(bytes.size());
+    std::vector<std::uint8_t> out;
+    detail::write_tx_header(out);
+    std::size_t ops = 0;
+    for (const auto& [b, e] : keep) {
+      out.insert(out.end(), bytes.begin() + static_cast<std::ptrdiff_t>(b),
+                 bytes.begin() + static_cast<std::ptrdiff_t>(e));
+      ++ops;
+    }
+    for (const auto& [holder, prop] : lists) {
+      const SimStateInstance* x = state.find(holder);
+      if (x == nullptr) continue;  // deleted by the bundle itself
+      const MetaProperty* p = x->meta().find_property(prop);
+      if (p == nullptr) continue;
+      detail::write_set(out, *x, *p, p->address(*x), p->address(*x));
+      ++ops;
+    }
+    t = detail::make_transaction(std::move(out), ops);
+  }
+
   bool publish() {
     if (!state.recording()) return false;
     Transaction t = state.take_recording();
@@ -368,9 +416,11 @@ struct Participant::Impl {
       report(*c, true);
       return false;
     }
+    // List edits travel as the edited list's new value: a list is one register, like any property.
+    lists_as_sets(t);
     WireBundle wb = encode_bundle(t, state);
     if (wb.ops == 0) {
-      forget_deleted(t);
+      forget_deleted(t, Stamp{clock, id});
       return false;
     }
     std::vector<std::uint8_t> p;
@@ -384,7 +434,7 @@ struct Participant::Impl {
     detail::TxParser parser(t);
     for (detail::TxOp op; parser.next(op);)
       if (op.op == Transaction::Op::Set) note_write(op.id, op.name, stamp);
-    forget_deleted(t);
+    forget_deleted(t, stamp);
     ++stats.bundles_sent;
     return true;
   }
@@ -447,6 +497,12 @@ struct Participant::Impl {
         w.varint(x.stamp.clock);
         w.fixed(x.stamp.who);
       }
+    }
+    w.varint(deleted.size());
+    for (const auto& [inst, stamp] : deleted) {
+      w.varint(inst);
+      w.varint(stamp.clock);
+      w.fixed(stamp.who);
     }
     p.insert(p.end(), wb.bytes.begin(), wb.bytes.end());
     send(Kind::Snapshot, 0, m.sender, p);
@@ -522,6 +578,13 @@ struct Participant::Impl {
         ws.push_back(std::move(x));
       }
     }
+    std::unordered_map<Id, Stamp> tombstones;
+    for (std::size_t n = r.size_prefix(10); n > 0; --n) {
+      const Id inst = r.varint();
+      Stamp& st = tombstones[inst];
+      st.clock = r.varint();
+      st.who = r.fixed<std::uint64_t>();
+    }
     if (seqs[id] < seq) {
       // The answering participant has not applied all my bundles yet: installing its state would lose
       // them here. Ask again later.
@@ -566,6 +629,7 @@ struct Participant::Impl {
       }
     claims = std::move(table);
     written = std::move(registers);
+    deleted = std::move(tombstones);
     clock = std::max(clock, their_clock);
     prefer = 0;
     synced = true;
@@ -626,11 +690,21 @@ struct Participant::Impl {
       Stamp winner;
     };
     std::vector<Lost> lost;
+    std::vector<Lost> gone;  // changes to instances deleted concurrently (winner: the deletion's stamp)
     std::vector<std::pair<Id, std::string_view>> kept;
     if (m.kind == Kind::Bundle) {
       // Decoded before its sequence number counts: a broken message must not make anyone resynchronise.
       try {
-        t = decode_bundle(m.payload, [&](Id inst, std::string_view prop) {
+        t = decode_bundle(m.payload, [&](Transaction::Op op, Id inst, std::string_view prop) {
+          if (auto d = deleted.find(inst); d != deleted.end()) {
+            // The deletion wins, whatever the stamps: every replica ends without the instance. A second
+            // deletion of it is no conflict.
+            if (op != Transaction::Op::Delete &&
+                std::none_of(gone.begin(), gone.end(), [&](const Lost& g) { return g.instance == inst; }))
+              gone.push_back({inst, prop, d->second});
+            return false;
+          }
+          if (op != Transaction::Op::Set) return true;
           if (const Stamp* s = written_stamp(inst, prop); s != nullptr && stamp < *s) {
             lost.push_back({inst, prop, *s});
             return false;
@@ -700,7 +774,7 @@ struct Participant::Impl {
     }
     discard_recording();
     for (const auto& [inst, prop] : kept) note_write(inst, prop, stamp);
-    forget_deleted(t);
+    forget_deleted(t, stamp);
     it->second = m.seq;
     handled(m);
     ++stats.bundles_applied;
@@ -717,6 +791,18 @@ struct Participant::Impl {
       c.instance = l.instance;
       c.property = std::string(l.property);
       report(std::move(c), l.winner.who == id);
+    }
+    for (const Lost& g : gone) {
+      // The deleter tells the writer, as the winner of a concurrent set does.
+      ++stats.lost_writes;
+      Conflict c;
+      c.kind = ConflictKind::Deleted;
+      c.writer = m.sender;
+      c.owner = g.winner.who;
+      c.seq = m.seq;
+      c.instance = g.instance;
+      c.property = std::string(g.property);
+      report(std::move(c), g.winner.who == id);
     }
   }
 
@@ -840,7 +926,7 @@ struct Participant::Impl {
     c.instance = r.varint();
     c.property = r.string();
     names[m.sender] = r.string();
-    if (const std::uint8_t k = r.u8(); k <= static_cast<std::uint8_t>(ConflictKind::ClaimRace))
+    if (const std::uint8_t k = r.u8(); k <= static_cast<std::uint8_t>(ConflictKind::Deleted))
       c.kind = static_cast<ConflictKind>(k);
     else
       r.fail("unknown conflict kind " + std::to_string(k));

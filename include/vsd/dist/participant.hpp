@@ -89,6 +89,9 @@ enum class ConflictKind : std::uint8_t {
   /// Two participants claimed the same instance or property concurrently: the claim with the lower stamp
   /// won everywhere; the other one was rolled back.
   ClaimRace = 2,
+  /// A change to an instance (a set or a list edit) was made while another participant deleted it: the
+  /// deletion won everywhere, the change was dropped; the deleter tells the writer (docs/dist.md).
+  Deleted = 3,
 };
 
 /// @brief A write or claim that lost: reported to the loser and the winner (and logged by receivers).
