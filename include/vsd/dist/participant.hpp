@@ -98,11 +98,12 @@ enum class ConflictKind : std::uint8_t {
 struct Conflict {
   ConflictKind kind = ConflictKind::Owned;  ///< what happened
   std::uint64_t writer = 0;  ///< participant id of the loser: the writer, or the claimant whose claim lost
-  std::uint64_t owner = 0;   ///< participant id of the winner: the owner, the winning writer or claimant
-  std::uint64_t seq = 0;     ///< the loser's sequence number of its bundle or claim (0: never sent)
-  Id instance = null_id;     ///< the instance touched
-  std::string property;      ///< the property touched (empty: the instance itself, a deletion)
-  std::string text;          ///< one line for logs: who, what, whose
+  std::uint64_t owner =
+      0;  ///< participant id of the winner: the owner, the winning writer or claimant, the deleter
+  std::uint64_t seq = 0;  ///< the loser's sequence number of its bundle or claim (0: never sent)
+  Id instance = null_id;  ///< the instance touched
+  std::string property;   ///< the property touched (empty: the instance itself, a deletion)
+  std::string text;       ///< one line for logs: who, what, whose
 };
 
 /// @brief Counters, for tests, tools and monitoring.
@@ -119,7 +120,8 @@ struct ParticipantStats {
   std::uint64_t resyncs = 0;           ///< snapshots installed after the first synchronisation
   std::uint64_t snapshots_served = 0;  ///< snapshot requests answered
   std::uint64_t dropped_unsynced = 0;  ///< local bundles dropped because they were made while unsynchronised
-  std::uint64_t lost_writes = 0;  ///< sets of others dropped here: a concurrent write with a later stamp won
+  std::uint64_t lost_writes = 0;  ///< sets and list edits of others dropped here: a concurrent write with a
+                                  ///< later stamp or a concurrent deletion won
   std::uint64_t claims_lost = 0;  ///< claims (anyone's) that lost a race here, this one's included
 };
 
