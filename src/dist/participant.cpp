@@ -309,14 +309,12 @@ struct Participant::Impl {
     }
     return std::nullopt;
   }
-  void forget_deleted(const Transaction& t, const Stamp& stamp) {
-    detail::TxParser parser(t);
-    for (detail::TxOp op; parser.next(op);)
-      if (op.op == Transaction::Op::Delete) {
-        deleted.emplace(op.id, stamp);
-        written.erase(op.id);
-        std::erase_if(claims, [&](const auto& e) { return e.first.first == op.id; });
-      }
+  void forget_deleted(const std::vector<Id>& ids, const Stamp& stamp) {
+    for (const Id gone : ids) {
+      deleted.emplace(gone, stamp);
+      written.erase(gone);
+      if (!claims.empty()) std::erase_if(claims, [&](const auto& e) { return e.first.first == gone; });
+    }
   }
   std::string describe(const Conflict& c) const {
     std::string what = "#" + std::to_string(c.instance) + (c.property.empty() ? "" : "." + c.property);
@@ -416,11 +414,14 @@ struct Participant::Impl {
       report(*c, true);
       return false;
     }
-    // List edits travel as the edited list's new value: a list is one register, like any property.
-    lists_as_sets(t);
     WireBundle wb = encode_bundle(t, state);
+    if (wb.list_edits) {
+      // List edits travel as the edited list's new value: a list is one register, like any property.
+      lists_as_sets(t);
+      wb = encode_bundle(t, state);
+    }
     if (wb.ops == 0) {
-      forget_deleted(t, Stamp{clock, id});
+      forget_deleted(wb.deleted, Stamp{clock, id});
       return false;
     }
     std::vector<std::uint8_t> p;
@@ -431,10 +432,8 @@ struct Participant::Impl {
     send(Kind::Bundle, ++seq, 0, p);
     // My sets now hold the bundle's stamp here, as they will at every receiver that applies them.
     const Stamp stamp{clock, id};
-    detail::TxParser parser(t);
-    for (detail::TxOp op; parser.next(op);)
-      if (op.op == Transaction::Op::Set) note_write(op.id, op.name, stamp);
-    forget_deleted(t, stamp);
+    for (const auto& [inst, prop] : wb.sets) note_write(inst, prop, stamp);
+    forget_deleted(wb.deleted, stamp);
     ++stats.bundles_sent;
     return true;
   }
@@ -692,6 +691,7 @@ struct Participant::Impl {
     std::vector<Lost> lost;
     std::vector<Lost> gone;  // changes to instances deleted concurrently (winner: the deletion's stamp)
     std::vector<std::pair<Id, std::string_view>> kept;
+    std::vector<Id> deletes;
     if (m.kind == Kind::Bundle) {
       // Decoded before its sequence number counts: a broken message must not make anyone resynchronise.
       try {
@@ -704,6 +704,7 @@ struct Participant::Impl {
               gone.push_back({inst, prop, d->second});
             return false;
           }
+          if (op == Transaction::Op::Delete) deletes.push_back(inst);
           if (op != Transaction::Op::Set) return true;
           if (const Stamp* s = written_stamp(inst, prop); s != nullptr && stamp < *s) {
             lost.push_back({inst, prop, *s});
@@ -774,7 +775,7 @@ struct Participant::Impl {
     }
     discard_recording();
     for (const auto& [inst, prop] : kept) note_write(inst, prop, stamp);
-    forget_deleted(t, stamp);
+    forget_deleted(deletes, stamp);
     it->second = m.seq;
     handled(m);
     ++stats.bundles_applied;

@@ -89,6 +89,7 @@ WireBundle encode_bundle(const Transaction& t, const SimState& state) {
         w.u8(static_cast<std::uint8_t>(op.op));
         w.varint(op.id);
         w.varint(names.index(op.name));
+        out.deleted.push_back(op.id);
         break;
       case Transaction::Op::Set:
         if (!distributed(class_of(op.id), op.name)) {
@@ -100,6 +101,7 @@ WireBundle encode_bundle(const Transaction& t, const SimState& state) {
         w.varint(names.index(op.name));
         w.varint(op.new_value.size());
         w.raw(op.new_value.data(), op.new_value.size());
+        out.sets.emplace_back(op.id, op.name);
         break;
       case Transaction::Op::Insert:
       case Transaction::Op::Erase:
@@ -112,6 +114,7 @@ WireBundle encode_bundle(const Transaction& t, const SimState& state) {
         w.varint(names.index(op.name));
         w.varint(op.index);
         w.varint(op.target);
+        out.list_edits = true;
         break;
     }
     ++out.ops;

@@ -15,6 +15,7 @@
 #include <functional>
 #include <span>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "vsd/core/transaction.hpp"
@@ -30,6 +31,10 @@ struct WireBundle {
   std::vector<std::uint8_t> bytes;  ///< "VSDW", version, name table, operations
   std::size_t ops = 0;              ///< operations kept (0: nothing to send)
   std::size_t dropped = 0;          ///< operations dropped (non-Distributed properties)
+  /// (instance, property) of every set kept, in order; the views point into the encoded Transaction
+  std::vector<std::pair<Id, std::string_view>> sets;
+  std::vector<Id> deleted;  ///< the instances the bundle deletes
+  bool list_edits = false;  ///< true when a reference-list edit (insert, erase) was kept
 };
 
 /// @brief Encodes @p t, recorded by @p state, in wire form, keeping only Distributed properties.
