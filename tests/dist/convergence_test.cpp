@@ -317,6 +317,8 @@ TEST(ConcurrentClaims, WritesUnderALosingClaimAreRejectedAndAllReplicasConverge)
       race.arm_id = arm.id();
     }
     auto o = options("u" + std::to_string(k), race.domain, k == 0);
+    // VSD_DIST_TEST_VERBOSE=1: every participant's log and every failure on stderr as they happen (the
+    // order of events is what tells a race apart).
     if (std::getenv("VSD_DIST_TEST_VERBOSE") != nullptr)
       o.log = [k](std::string_view l) {
         std::fprintf(stderr, "u%d: %.*s\n", k, static_cast<int>(l.size()), l.data());
