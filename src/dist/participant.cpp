@@ -154,6 +154,9 @@ struct Participant::Impl {
   std::unordered_map<std::uint64_t, std::uint64_t> applied;  // sender -> last seq handled
   std::unordered_map<Id, std::vector<Written>> written;      // instance -> its registers' stamps
   std::map<OwnerKey, std::vector<OwnEvent>> claims;          // every claim and release, per key
+  // Instances deleted, with the stamp of the deletion: a change to one of them made concurrently with the
+  // deletion is dropped by every replica (the deletion wins), whatever the arrival order.
+  std::unordered_map<Id, Stamp> deleted;
   std::uint64_t prefer = 0;  // the participant a resynchronisation asks first (0: anyone)
   std::unordered_map<std::uint64_t, std::string> names;
   std::deque<Message> buffer;  // bundles and claims received while unsynchronised
@@ -306,14 +309,12 @@ struct Participant::Impl {
     }
     return std::nullopt;
   }
-  void forget_deleted(const Transaction& t) {
-    if (claims.empty() && written.empty()) return;
-    detail::TxParser parser(t);
-    for (detail::TxOp op; parser.next(op);)
-      if (op.op == Transaction::Op::Delete) {
-        written.erase(op.id);
-        std::erase_if(claims, [&](const auto& e) { return e.first.first == op.id; });
-      }
+  void forget_deleted(const std::vector<Id>& ids, const Stamp& stamp) {
+    for (const Id gone : ids) {
+      deleted.emplace(gone, stamp);
+      written.erase(gone);
+      if (!claims.empty()) std::erase_if(claims, [&](const auto& e) { return e.first.first == gone; });
+    }
   }
   std::string describe(const Conflict& c) const {
     std::string what = "#" + std::to_string(c.instance) + (c.property.empty() ? "" : "." + c.property);
@@ -325,6 +326,9 @@ struct Participant::Impl {
         return "concurrent claims of " + what + ": the claim of " + who(c.writer) + " (claim " +
                std::to_string(c.seq) + ") lost to the earlier stamped one of " + who(c.owner) +
                "; rolled back";
+      case ConflictKind::Deleted:
+        return "write by " + who(c.writer) + " to " + what + " (bundle " + std::to_string(c.seq) +
+               ") dropped: " + who(c.owner) + " deleted #" + std::to_string(c.instance) + " concurrently";
       case ConflictKind::Owned:
         break;
     }
@@ -352,6 +356,48 @@ struct Participant::Impl {
   }
 
   // ---- sending ----
+  // Replaces the reference-list edits (insert, erase) of @p t by one set per edited list, of its value as
+  // @p t leaves it, after the other operations. Index-based edits of one list made concurrently by two
+  // participants do not commute; whole values do under last-writer-wins (docs/dist.md). The sets carry the
+  // new value as old value too: the wire form drops old values anyway.
+  void lists_as_sets(Transaction& t) const {
+    const std::vector<std::uint8_t>& bytes = t.bytes();
+    std::vector<std::pair<Id, std::string_view>> lists;
+    std::vector<std::pair<std::size_t, std::size_t>> keep;  // byte ranges of the other operations
+    detail::TxParser parser(t);
+    std::size_t start = 0;
+    bool other = false;
+    auto close = [&](std::size_t end) {
+      if (other && end > start) keep.emplace_back(start, end);
+    };
+    for (detail::TxOp op; parser.next(op);) {
+      close(op.offset);
+      start = op.offset;
+      other = op.op != Transaction::Op::Insert && op.op != Transaction::Op::Erase;
+      if (!other && std::find(lists.begin(), lists.end(), std::pair(op.id, op.name)) == lists.end())
+        lists.emplace_back(op.id, op.name);
+    }
+    if (lists.empty()) return;
+    close(bytes.size());
+    std::vector<std::uint8_t> out;
+    detail::write_tx_header(out);
+    std::size_t ops = 0;
+    for (const auto& [b, e] : keep) {
+      out.insert(out.end(), bytes.begin() + static_cast<std::ptrdiff_t>(b),
+                 bytes.begin() + static_cast<std::ptrdiff_t>(e));
+      ++ops;
+    }
+    for (const auto& [holder, prop] : lists) {
+      const SimStateInstance* x = state.find(holder);
+      if (x == nullptr) continue;  // deleted by the bundle itself
+      const MetaProperty* p = x->meta().find_property(prop);
+      if (p == nullptr) continue;
+      detail::write_set(out, *x, *p, p->address(*x), p->address(*x));
+      ++ops;
+    }
+    t = detail::make_transaction(std::move(out), ops);
+  }
+
   bool publish() {
     if (!state.recording()) return false;
     Transaction t = state.take_recording();
@@ -369,8 +415,13 @@ struct Participant::Impl {
       return false;
     }
     WireBundle wb = encode_bundle(t, state);
+    if (wb.list_edits) {
+      // List edits travel as the edited list's new value: a list is one register, like any property.
+      lists_as_sets(t);
+      wb = encode_bundle(t, state);
+    }
     if (wb.ops == 0) {
-      forget_deleted(t);
+      forget_deleted(wb.deleted, Stamp{clock, id});
       return false;
     }
     std::vector<std::uint8_t> p;
@@ -381,10 +432,8 @@ struct Participant::Impl {
     send(Kind::Bundle, ++seq, 0, p);
     // My sets now hold the bundle's stamp here, as they will at every receiver that applies them.
     const Stamp stamp{clock, id};
-    detail::TxParser parser(t);
-    for (detail::TxOp op; parser.next(op);)
-      if (op.op == Transaction::Op::Set) note_write(op.id, op.name, stamp);
-    forget_deleted(t);
+    for (const auto& [inst, prop] : wb.sets) note_write(inst, prop, stamp);
+    forget_deleted(wb.deleted, stamp);
     ++stats.bundles_sent;
     return true;
   }
@@ -447,6 +496,12 @@ struct Participant::Impl {
         w.varint(x.stamp.clock);
         w.fixed(x.stamp.who);
       }
+    }
+    w.varint(deleted.size());
+    for (const auto& [inst, stamp] : deleted) {
+      w.varint(inst);
+      w.varint(stamp.clock);
+      w.fixed(stamp.who);
     }
     p.insert(p.end(), wb.bytes.begin(), wb.bytes.end());
     send(Kind::Snapshot, 0, m.sender, p);
@@ -522,9 +577,28 @@ struct Participant::Impl {
         ws.push_back(std::move(x));
       }
     }
+    std::unordered_map<Id, Stamp> tombstones;
+    for (std::size_t n = r.size_prefix(10); n > 0; --n) {
+      const Id inst = r.varint();
+      Stamp& st = tombstones[inst];
+      st.clock = r.varint();
+      st.who = r.fixed<std::uint64_t>();
+    }
     if (seqs[id] < seq) {
       // The answering participant has not applied all my bundles yet: installing its state would lose
       // them here. Ask again later.
+      return;
+    }
+    if (auto bad = invalid_write(table, registers)) {
+      // The answer holds a write its own claims reject (its participant took the bundle before it knew the
+      // claim, and has not noticed yet): ask the owner instead.
+      log("ignored a snapshot of " + who(m.sender) + ": it holds a write of " + who(bad->writer) + " to #" +
+          std::to_string(bad->instance) + "." + bad->property + " that the claim of " + who(bad->owner) +
+          " came before");
+      prefer = bad->owner;
+      nonce = random_id();
+      resync_started = std::chrono::steady_clock::now();
+      request_snapshot();
       return;
     }
     const Transaction t = decode_bundle({m.payload.data() + r.position(), r.remaining()});
@@ -554,6 +628,7 @@ struct Participant::Impl {
       }
     claims = std::move(table);
     written = std::move(registers);
+    deleted = std::move(tombstones);
     clock = std::max(clock, their_clock);
     prefer = 0;
     synced = true;
@@ -567,9 +642,26 @@ struct Participant::Impl {
       ++stats.claims_lost;
       report(std::move(c), false);
     }
+    // Bundles and claims handled here before the resynchronisation that the answering participant had not
+    // received yet: they will not come again, so they are taken from the history (in their senders' order,
+    // before those that arrived since); should one be missing there, the next message of its sender shows
+    // the gap.
     std::deque<Message> pending = std::move(buffer);
     buffer.clear();
+    std::deque<Message> earlier = std::move(history);
+    history.clear();
+    for (const Message& b : earlier)
+      if (auto a = applied.find(b.sender); a == applied.end() || a->second < b.seq) sequenced(b);
     for (const Message& b : pending) sequenced(b);
+  }
+
+  // Bundles and claims of others handled since the last snapshot was installed (at most history_limit):
+  // a snapshot from a participant that has not received them yet is completed from here.
+  static constexpr std::size_t history_limit = 1024;
+  std::deque<Message> history;
+  void handled(const Message& m) {
+    history.push_back(m);
+    if (history.size() > history_limit) history.pop_front();
   }
 
   std::size_t applied_now = 0;  // bundles applied during the current poll()
@@ -597,11 +689,23 @@ struct Participant::Impl {
       Stamp winner;
     };
     std::vector<Lost> lost;
+    std::vector<Lost> gone;  // changes to instances deleted concurrently (winner: the deletion's stamp)
     std::vector<std::pair<Id, std::string_view>> kept;
+    std::vector<Id> deletes;
     if (m.kind == Kind::Bundle) {
       // Decoded before its sequence number counts: a broken message must not make anyone resynchronise.
       try {
-        t = decode_bundle(m.payload, [&](Id inst, std::string_view prop) {
+        t = decode_bundle(m.payload, [&](Transaction::Op op, Id inst, std::string_view prop) {
+          if (auto d = deleted.find(inst); d != deleted.end()) {
+            // The deletion wins, whatever the stamps: every replica ends without the instance. A second
+            // deletion of it is no conflict.
+            if (op != Transaction::Op::Delete &&
+                std::none_of(gone.begin(), gone.end(), [&](const Lost& g) { return g.instance == inst; }))
+              gone.push_back({inst, prop, d->second});
+            return false;
+          }
+          if (op == Transaction::Op::Delete) deletes.push_back(inst);
+          if (op != Transaction::Op::Set) return true;
           if (const Stamp* s = written_stamp(inst, prop); s != nullptr && stamp < *s) {
             lost.push_back({inst, prop, *s});
             return false;
@@ -612,8 +716,10 @@ struct Participant::Impl {
       } catch (const Error& e) {
         ++stats.malformed;
         log("rejected bundle " + std::to_string(m.seq) + " of " + who(m.sender) + ": " + e.what());
-        if (auto it = applied.find(m.sender); it != applied.end() && it->second + 1 == m.seq)
+        if (auto it = applied.find(m.sender); it != applied.end() && it->second + 1 == m.seq) {
           it->second = m.seq;  // every participant drops it alike
+          handled(m);
+        }
         return;
       }
     }
@@ -637,11 +743,13 @@ struct Participant::Impl {
     clock = std::max(clock, m.clock);
     if (m.kind == Kind::Claim) {
       it->second = m.seq;
+      handled(m);
       apply_claim(m);
       return;
     }
     if (auto c = find_conflict(t, m.sender, stamp)) {
       it->second = m.seq;
+      handled(m);
       c->seq = m.seq;
       report(*c, c->owner == id);  // the owner tells the writer
       return;
@@ -654,6 +762,7 @@ struct Participant::Impl {
         // It failed on the snapshot too: the shared state cannot take it. Everyone drops it alike.
         ++stats.malformed;
         it->second = m.seq;
+        handled(m);
         log("bundle " + std::to_string(m.seq) + " of " + who(m.sender) +
             " does not apply to the shared state either; dropped");
         return;
@@ -666,8 +775,9 @@ struct Participant::Impl {
     }
     discard_recording();
     for (const auto& [inst, prop] : kept) note_write(inst, prop, stamp);
-    forget_deleted(t);
+    forget_deleted(deletes, stamp);
     it->second = m.seq;
+    handled(m);
     ++stats.bundles_applied;
     ++applied_now;
     for (const Lost& l : lost) {
@@ -682,6 +792,18 @@ struct Participant::Impl {
       c.instance = l.instance;
       c.property = std::string(l.property);
       report(std::move(c), l.winner.who == id);
+    }
+    for (const Lost& g : gone) {
+      // The deleter tells the writer, as the winner of a concurrent set does.
+      ++stats.lost_writes;
+      Conflict c;
+      c.kind = ConflictKind::Deleted;
+      c.writer = m.sender;
+      c.owner = g.winner.who;
+      c.seq = m.seq;
+      c.instance = g.instance;
+      c.property = std::string(g.property);
+      report(std::move(c), g.winner.who == id);
     }
   }
 
@@ -749,17 +871,51 @@ struct Participant::Impl {
       report(std::move(c), false);  // every participant sees both claims: nobody needs telling
     }
     if (!synced) return;
-    auto it = written.find(key.first);
-    if (it == written.end()) return;
-    for (const Written& w : it->second) {
-      if (!key.second.empty() && w.property != key.second) continue;
-      const std::uint64_t o = owner_at(key.first, w.property, w.stamp);
-      if (o == 0 || o == w.stamp.who) continue;
-      resync("this state holds a write of " + who(w.stamp.who) + " to #" + std::to_string(key.first) + "." +
-                 w.property + " that the claim of " + who(o) + " came before",
-             nullptr, o);
-      return;
+    if (auto bad = invalid_write(claims, written, key.first, key.second)) {
+      // This state holds a change the others reject: it must not be served to anyone until replaced.
+      self_diverged = true;
+      resync("this state holds a write of " + who(bad->writer) + " to #" + std::to_string(bad->instance) +
+                 "." + bad->property + " that the claim of " + who(bad->owner) + " came before",
+             nullptr, bad->owner);
     }
+  }
+
+  // The first set held in @p registers (of instance @p only, and of property @p prop when not empty; all
+  // instances when @p only is null_id) that @p table makes a write to what someone other than its writer
+  // owned at its stamp: a state holding it took a bundle the owner rejected.
+  std::optional<Conflict> invalid_write(const std::map<OwnerKey, std::vector<OwnEvent>>& table,
+                                        const std::unordered_map<Id, std::vector<Written>>& registers,
+                                        Id only = null_id, std::string_view prop = {}) const {
+    if (table.empty()) return std::nullopt;
+    auto owner_in = [&](Id inst, const std::string& p, const Stamp& limit) {
+      auto key = table.find(OwnerKey(inst, p));
+      std::uint64_t o = key == table.end() ? 0 : replay(key->second, limit);
+      if (o == 0 && !p.empty())
+        if (key = table.find(OwnerKey(inst, std::string())); key != table.end())
+          o = replay(key->second, limit);
+      return o;
+    };
+    auto check = [&](Id inst, const std::vector<Written>& ws) -> std::optional<Conflict> {
+      for (const Written& w : ws) {
+        if (!prop.empty() && w.property != prop) continue;
+        const std::uint64_t o = owner_in(inst, w.property, w.stamp);
+        if (o == 0 || o == w.stamp.who) continue;
+        Conflict c;
+        c.writer = w.stamp.who;
+        c.owner = o;
+        c.instance = inst;
+        c.property = w.property;
+        return c;
+      }
+      return std::nullopt;
+    };
+    if (only != null_id) {
+      auto it = registers.find(only);
+      return it == registers.end() ? std::nullopt : check(only, it->second);
+    }
+    for (const auto& [inst, ws] : registers)
+      if (auto c = check(inst, ws)) return c;
+    return std::nullopt;
   }
 
   void handle_report(const Message& m) {
@@ -771,7 +927,7 @@ struct Participant::Impl {
     c.instance = r.varint();
     c.property = r.string();
     names[m.sender] = r.string();
-    if (const std::uint8_t k = r.u8(); k <= static_cast<std::uint8_t>(ConflictKind::ClaimRace))
+    if (const std::uint8_t k = r.u8(); k <= static_cast<std::uint8_t>(ConflictKind::Deleted))
       c.kind = static_cast<ConflictKind>(k);
     else
       r.fail("unknown conflict kind " + std::to_string(k));
@@ -888,6 +1044,7 @@ struct Participant::Impl {
     publish();  // the claim comes after the changes made before it
     ++clock;
     send(Kind::Claim, ++seq, 0, p);
+    ++stats.claims_sent;
     add_claim_event(OwnerKey(inst, std::string(prop)), OwnEvent{Stamp{clock, id}, take, seq, false});
   }
 };

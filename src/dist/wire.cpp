@@ -89,6 +89,7 @@ WireBundle encode_bundle(const Transaction& t, const SimState& state) {
         w.u8(static_cast<std::uint8_t>(op.op));
         w.varint(op.id);
         w.varint(names.index(op.name));
+        out.deleted.push_back(op.id);
         break;
       case Transaction::Op::Set:
         if (!distributed(class_of(op.id), op.name)) {
@@ -100,6 +101,7 @@ WireBundle encode_bundle(const Transaction& t, const SimState& state) {
         w.varint(names.index(op.name));
         w.varint(op.new_value.size());
         w.raw(op.new_value.data(), op.new_value.size());
+        out.sets.emplace_back(op.id, op.name);
         break;
       case Transaction::Op::Insert:
       case Transaction::Op::Erase:
@@ -112,6 +114,7 @@ WireBundle encode_bundle(const Transaction& t, const SimState& state) {
         w.varint(names.index(op.name));
         w.varint(op.index);
         w.varint(op.target);
+        out.list_edits = true;
         break;
     }
     ++out.ops;
@@ -127,9 +130,9 @@ WireBundle encode_bundle(const Transaction& t, const SimState& state) {
   return out;
 }
 
-Transaction decode_bundle(std::span<const std::uint8_t> bytes) { return decode_bundle(bytes, SetFilter{}); }
+Transaction decode_bundle(std::span<const std::uint8_t> bytes) { return decode_bundle(bytes, OpFilter{}); }
 
-Transaction decode_bundle(std::span<const std::uint8_t> bytes, const SetFilter& keep) {
+Transaction decode_bundle(std::span<const std::uint8_t> bytes, const OpFilter& keep) {
   ByteReader r(bytes.data(), bytes.size());
   try {
     if (bytes.size() < 5 || std::memcmp(bytes.data(), wire_magic, 4) != 0)
@@ -177,6 +180,10 @@ Transaction decode_bundle(std::span<const std::uint8_t> bytes, const SetFilter& 
           break;
         }
         case Transaction::Op::Delete: {
+          if (keep && !keep(Transaction::Op::Delete, id, {})) {
+            --kept;
+            break;
+          }
           ByteWriter w(out);  // the VSDT layout of a deletion (transaction.hpp), without last values
           w.u8(static_cast<std::uint8_t>(Transaction::Op::Delete));
           w.varint(id);
@@ -186,7 +193,7 @@ Transaction decode_bundle(std::span<const std::uint8_t> bytes, const SetFilter& 
         }
         case Transaction::Op::Set: {
           const auto v = value();
-          if (keep && !keep(id, n)) {
+          if (keep && !keep(Transaction::Op::Set, id, n)) {
             --kept;
             break;
           }
@@ -197,6 +204,10 @@ Transaction decode_bundle(std::span<const std::uint8_t> bytes, const SetFilter& 
         case Transaction::Op::Erase: {
           const std::uint64_t index = r.varint();
           const Id target = r.varint();
+          if (keep && !keep(static_cast<Transaction::Op>(code), id, n)) {
+            --kept;
+            break;
+          }
           detail::write_list(out, static_cast<Transaction::Op>(code), id, n, static_cast<std::size_t>(index),
                              target);
           break;

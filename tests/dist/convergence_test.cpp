@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdio>
+#include <cstdlib>
 #include <mutex>
 #include <random>
 #include <set>
@@ -78,6 +80,7 @@ struct Race {
   void fail(const std::string& what) {
     std::lock_guard lock(mutex);
     failures.push_back(what);
+    if (std::getenv("VSD_DIST_TEST_VERBOSE") != nullptr) std::fprintf(stderr, "FAIL %s\n", what.c_str());
   }
 };
 
@@ -290,6 +293,136 @@ TEST(ConcurrentClaims, RacingClaimsEndWithOneOwnerEverywhereAndTheLosersRolledBa
   for (std::size_t k = 0; k < n_participants; ++k) {
     total_won += won[k];
     EXPECT_EQ(told[k], lost[k]) << "c" << k << " was not told of every lost claim";
+  }
+  EXPECT_EQ(total_won, rounds);
+}
+
+// Every participant claims the arm's target (or the whole arm) at once and writes it right away, before it
+// could know of the others' claims: the writes made under the claims that lose are writes to what the
+// winner owns. Every replica must end with the winner's value, the losers' writes rejected and reported.
+TEST(ConcurrentClaims, WritesUnderALosingClaimAreRejectedAndAllReplicasConverge) {
+  constexpr int rounds = 60;
+  Race race;
+  std::array<std::atomic<std::uint64_t>, n_participants> write_seq{};  // this round's claimed write
+  std::array<int, n_participants> won{}, told{};
+  std::atomic<int> agreed{0};
+
+  auto run = [&](int k) {
+    const auto me = static_cast<std::size_t>(k);
+    vsd::Environment env{static_cast<std::uint16_t>(50 + k)};
+    vsd::SimState& s = env.main_state();
+    if (k == 0) {
+      auto& arm = s.create<DArm>();
+      s.database().add_child(arm);
+      race.arm_id = arm.id();
+    }
+    auto o = options("u" + std::to_string(k), race.domain, k == 0);
+    // VSD_DIST_TEST_VERBOSE=1: every participant's log and every failure on stderr as they happen (the
+    // order of events is what tells a race apart).
+    if (std::getenv("VSD_DIST_TEST_VERBOSE") != nullptr)
+      o.log = [k](std::string_view l) {
+        std::fprintf(stderr, "u%d: %.*s\n", k, static_cast<int>(l.size()), l.data());
+      };
+    vsd::dist::Participant p(s, o);
+    race.ids[me] = p.id();
+    std::set<std::uint64_t> my_rejected;                           // my bundles rejected as Owned
+    std::set<std::pair<std::uint64_t, std::uint64_t>> i_rejected;  // (writer, seq) rejected as the owner
+    auto c = p.on_conflict().connect([&](const vsd::dist::Conflict& x) {
+      if (x.kind != vsd::dist::ConflictKind::Owned) return;
+      if (x.writer == p.id()) my_rejected.insert(x.seq);
+      if (x.owner == p.id()) i_rejected.insert({x.writer, x.seq});
+    });
+    if (!p.wait_synced(20s)) race.fail("u" + std::to_string(k) + ": no snapshot");
+    race.sync.arrive_and_wait(p);
+    std::mt19937 rng(static_cast<unsigned>(k) * 15485863U + 5U);
+    const std::string who = "u" + std::to_string(k);
+    for (int r = 1; r <= rounds; ++r) {
+      const std::string at = who + " round " + std::to_string(r) + ": ";
+      DArm* arm = s.find<DArm>(race.arm_id.load());  // a resync replaces the instances
+      if (arm == nullptr) {
+        race.fail(at + "no arm");
+        return;
+      }
+      // Varying clocks, so that the winner varies.
+      for (int extra = static_cast<int>(rng() % 3); extra > 0; --extra) {
+        arm->set_counter(arm->counter() + 1);
+        p.publish();
+      }
+      race.sync.arrive_and_wait_quietly();  // nobody sees another's claim before making its own
+      const bool instance_claim = r % 3 == 0;
+      if (instance_claim)
+        p.claim(*arm);
+      else
+        p.claim(*arm, "target");
+      const double mine = r * 10.0 + k;
+      arm->set_target(mine);
+      arm->set_joints({mine, -mine});  // with target: the bundle must stay whole or go whole
+      if (!p.publish()) race.fail(at + "the claimed write was not published");
+      write_seq[me] = p.stats().bundles_sent + p.stats().claims_sent;
+      race.sync.arrive_and_wait(p);
+      // The claims settle alike everywhere ...
+      if (!poll_until(p, [&] {
+            return p.synced() && p.stats().claims_lost >= (n_participants - 1) * static_cast<unsigned>(r);
+          }))
+        race.fail(at + "claims did not settle");
+      const std::uint64_t owner = p.owner(race.arm_id.load(), "target");
+      std::size_t winner = n_participants;
+      for (std::size_t j = 0; j < n_participants; ++j)
+        if (race.ids[j] == owner) winner = j;
+      if (winner == n_participants) {
+        race.fail(at + "nobody owns the target");
+        return;
+      }
+      const double winning = r * 10.0 + static_cast<double>(winner);
+      // ... the winner rejects every loser's write, every loser is told, and everyone holds the winner's
+      // value.
+      const bool done = poll_until(p, [&] {
+        if (winner == me) {
+          for (std::size_t j = 0; j < n_participants; ++j)
+            if (j != me && i_rejected.count({race.ids[j], write_seq[j].load()}) == 0) return false;
+        } else if (my_rejected.count(write_seq[me].load()) == 0) {
+          return false;
+        }
+        const DArm* a = s.find<DArm>(race.arm_id.load());
+        return p.synced() && a != nullptr && a->target() == winning;
+      });
+      if (!done) race.fail(at + "did not settle on the winner's value " + std::to_string(winning));
+      if (winner == me)
+        ++won[me];
+      else if (my_rejected.count(write_seq[me].load()) != 0)
+        ++told[me];
+      race.results[me].owner = owner;
+      race.sync.arrive_and_wait(p);
+      if (owner != race.results[0].owner) race.fail(at + "owners differ");
+      race.results[me].bytes = vsd::io::save_bytes(s);
+      race.sync.arrive_and_wait(p);
+      if (race.results[me].bytes != race.results[0].bytes)
+        race.fail(at + "replica differs");
+      else if (k == 0)
+        ++agreed;
+      arm = s.find<DArm>(race.arm_id.load());
+      if (arm != nullptr && arm->joints() != std::vector<double>{winning, -winning})
+        race.fail(at + "a bundle was half applied");
+      if (owner == p.id() && arm != nullptr) {
+        if (instance_claim)
+          p.release(*arm);
+        else
+          p.release(*arm, "target");
+      }
+      if (!poll_until(p, [&] { return p.synced() && p.owner(race.arm_id.load(), "target") == 0; }))
+        race.fail(at + "release not seen");
+      race.sync.arrive_and_wait(p);
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int k = 0; k < n_participants; ++k) threads.emplace_back(run, k);
+  for (auto& t : threads) t.join();
+  for (const auto& f : race.failures) ADD_FAILURE() << f;
+  EXPECT_EQ(agreed.load(), rounds);
+  int total_won = 0;
+  for (std::size_t k = 0; k < n_participants; ++k) {
+    total_won += won[k];
+    EXPECT_EQ(told[k] + won[k], rounds) << "u" << k << " was not told of every rejected write";
   }
   EXPECT_EQ(total_won, rounds);
 }

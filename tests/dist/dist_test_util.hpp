@@ -24,6 +24,7 @@ class DArm : public vsd::Node {
   VSD_PROPERTY(std::vector<double>, joints, {})
   VSD_PROPERTY(std::string, note, "", vsd::Editable | vsd::Savable)  // not Distributed: stays local
   VSD_PROPERTY(vsd::SharedRef<vsd::Node>, watched, nullptr)
+  VSD_PROPERTY(vsd::SharedRefList<vsd::Node>, tools, {})  // a list two participants may edit at once
 };
 
 /// A DDS domain id for this test: tests of one run (and runs of ctest -j) must not hear each other.

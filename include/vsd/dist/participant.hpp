@@ -89,22 +89,29 @@ enum class ConflictKind : std::uint8_t {
   /// Two participants claimed the same instance or property concurrently: the claim with the lower stamp
   /// won everywhere; the other one was rolled back.
   ClaimRace = 2,
+  /// A change to an instance (a set or a list edit) was made while another participant deleted it: the
+  /// deletion won everywhere, the change was dropped; the deleter tells the writer (docs/dist.md).
+  Deleted = 3,
 };
 
 /// @brief A write or claim that lost: reported to the loser and the winner (and logged by receivers).
 struct Conflict {
   ConflictKind kind = ConflictKind::Owned;  ///< what happened
   std::uint64_t writer = 0;  ///< participant id of the loser: the writer, or the claimant whose claim lost
-  std::uint64_t owner = 0;   ///< participant id of the winner: the owner, the winning writer or claimant
-  std::uint64_t seq = 0;     ///< the loser's sequence number of its bundle or claim (0: never sent)
-  Id instance = null_id;     ///< the instance touched
-  std::string property;      ///< the property touched (empty: the instance itself, a deletion)
-  std::string text;          ///< one line for logs: who, what, whose
+  std::uint64_t owner =
+      0;  ///< participant id of the winner: the owner, the winning writer or claimant, the deleter
+  std::uint64_t seq = 0;  ///< the loser's sequence number of its bundle or claim (0: never sent)
+  Id instance = null_id;  ///< the instance touched
+  std::string property;   ///< the property touched (empty: the instance itself, a deletion)
+  std::string text;       ///< one line for logs: who, what, whose
 };
 
 /// @brief Counters, for tests, tools and monitoring.
 struct ParticipantStats {
-  std::uint64_t bundles_sent = 0;      ///< bundles published
+  std::uint64_t bundles_sent = 0;  ///< bundles published
+  /// claims and releases sent (bundles_sent + claims_sent is the sequence number of the last one sent,
+  /// the number a Conflict's seq names)
+  std::uint64_t claims_sent = 0;
   std::uint64_t bundles_applied = 0;   ///< bundles of others applied
   std::uint64_t duplicates = 0;        ///< bundles and claims dropped as already applied
   std::uint64_t foreign = 0;           ///< samples that are not vsd::dist messages (dropped)
@@ -113,7 +120,8 @@ struct ParticipantStats {
   std::uint64_t resyncs = 0;           ///< snapshots installed after the first synchronisation
   std::uint64_t snapshots_served = 0;  ///< snapshot requests answered
   std::uint64_t dropped_unsynced = 0;  ///< local bundles dropped because they were made while unsynchronised
-  std::uint64_t lost_writes = 0;  ///< sets of others dropped here: a concurrent write with a later stamp won
+  std::uint64_t lost_writes = 0;  ///< sets and list edits of others dropped here: a concurrent write with a
+                                  ///< later stamp or a concurrent deletion won
   std::uint64_t claims_lost = 0;  ///< claims (anyone's) that lost a race here, this one's included
 };
 

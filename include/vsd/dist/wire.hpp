@@ -15,6 +15,7 @@
 #include <functional>
 #include <span>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "vsd/core/transaction.hpp"
@@ -30,6 +31,10 @@ struct WireBundle {
   std::vector<std::uint8_t> bytes;  ///< "VSDW", version, name table, operations
   std::size_t ops = 0;              ///< operations kept (0: nothing to send)
   std::size_t dropped = 0;          ///< operations dropped (non-Distributed properties)
+  /// (instance, property) of every set kept, in order; the views point into the encoded Transaction
+  std::vector<std::pair<Id, std::string_view>> sets;
+  std::vector<Id> deleted;  ///< the instances the bundle deletes
+  bool list_edits = false;  ///< true when a reference-list edit (insert, erase) was kept
 };
 
 /// @brief Encodes @p t, recorded by @p state, in wire form, keeping only Distributed properties.
@@ -42,13 +47,14 @@ struct WireBundle {
 /// cannot hold, truncated or trailing data. The operations themselves are checked by SimState::apply.
 [[nodiscard]] Transaction decode_bundle(std::span<const std::uint8_t> bytes);
 
-/// @brief Decides, for each property set of a wire bundle, whether it is kept (vsd::dist drops the sets
-/// that lost to a concurrent write with a later stamp: docs/dist.md, "Concurrent writes").
-using SetFilter = std::function<bool(Id instance, std::string_view property)>;
+/// @brief Decides, for each deletion, property set and list edit of a wire bundle, whether it is kept
+/// (vsd::dist drops sets that lost to a concurrent write with a later stamp, and changes to instances
+/// deleted concurrently: docs/dist.md, "Concurrent writes"). @p property is empty for a deletion.
+using OpFilter = std::function<bool(Transaction::Op op, Id instance, std::string_view property)>;
 
-/// @brief decode_bundle(), keeping only the sets for which @p keep returns true (all other operations
-/// are kept). @p keep sees every set, in order, even when the bundle turns out malformed later.
-/// @throws vsd::Error as decode_bundle().
-[[nodiscard]] Transaction decode_bundle(std::span<const std::uint8_t> bytes, const SetFilter& keep);
+/// @brief decode_bundle(), keeping only the deletions, sets and list edits for which @p keep returns true
+/// (creations are always kept). @p keep sees every such operation, in order, even when the bundle turns
+/// out malformed later. @throws vsd::Error as decode_bundle().
+[[nodiscard]] Transaction decode_bundle(std::span<const std::uint8_t> bytes, const OpFilter& keep);
 
 }  // namespace vsd::dist
