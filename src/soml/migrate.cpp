@@ -88,7 +88,7 @@ class Migration {
   void make_statics(const ClassDecl& c, Node* parent);
   void init(const Pair& p);
   void map_nets(const Pair& p);
-  void copy_properties(SimStateInstance& from, SimStateInstance& to, bool node_children);
+  void copy_properties(SimStateInstance& from, SimStateInstance& to);
   void copy_marking(Place& from, Place& to, const std::string& where);
   void adopt_children(const Pair& p);
   bool doomed(const SimStateInstance* x) const;
@@ -222,8 +222,7 @@ void Migration::report_properties(const MetaInstance& from, const MetaInstance& 
 
 // The values of @p from's properties in @p to: by name, converted where the type changed, references
 // to migrated instances redirected. `children` is not copied (adopt_children), nor is the marking kind.
-void Migration::copy_properties(SimStateInstance& from, SimStateInstance& to, bool node_children) {
-  (void)node_children;
+void Migration::copy_properties(SimStateInstance& from, SimStateInstance& to) {
   const std::string who = from.is_a<Node>() ? from.as<Node>()->name() : "#" + std::to_string(from.id());
   for (const MetaProperty* p : to.meta().properties()) {
     if (p == &Node::vsd_prop_children() || p->name() == "object_tokens") continue;
@@ -254,7 +253,7 @@ void Migration::copy_properties(SimStateInstance& from, SimStateInstance& to, bo
 }
 
 void Migration::copy_marking(Place& from, Place& to, const std::string& where) {
-  copy_properties(from, to, false);
+  copy_properties(from, to);
   if (from.object_tokens() == to.object_tokens()) return;
   if (from.object_tokens()) {
     // Object tokens became black ones: their number stays.
@@ -317,7 +316,7 @@ void Migration::run() {
   for (const Pair& p : pairs_) map_nets(p);
   for (const Pair& p : pairs_) {
     report_properties(p.from->meta(), p.to->meta(), label(*p.ci->decl, nw_.stem_));
-    copy_properties(*p.from, *p.to, true);
+    copy_properties(*p.from, *p.to);
     const NetInst* on = old_.net_of(p.from->id());
     if (on != nullptr) {
       const std::string owner = p.from->as<Node>()->name();
@@ -325,7 +324,7 @@ void Migration::run() {
         if (auto it = map_.find(on->places[i]->id()); it != map_.end())
           copy_marking(*on->places[i], static_cast<Place&>(*it->second), owner + "." + on->places[i]->name());
       for (Transition* t : on->transitions)
-        if (auto it = map_.find(t->id()); it != map_.end()) copy_properties(*t, *it->second, false);
+        if (auto it = map_.find(t->id()); it != map_.end()) copy_properties(*t, *it->second);
     }
   }
   for (const Pair& p : pairs_) adopt_children(p);

@@ -72,7 +72,7 @@ place done;
 place extra = 1;
 place<Job> waiting;
 transition t1 { do { count += 1; } }
-transition t2 { do { count += 100; } }
+transition t2 { do { count += twice(50); } }
 arrow ready -> t1;
 arrow t1 -> done;
 arrow extra -> t2;
@@ -160,7 +160,7 @@ TEST_F(Migrate, MarkingsAreKeptAndNewTransitionsAndFunctionsRun) {
   EXPECT_DOUBLE_EQ(p.object("j1")->get<double>("weight"), 2.5);
   // The new transition t2 fires, and t1 once more.
   EXPECT_EQ(p.run_until_quiet(), 2u);
-  EXPECT_EQ(int_of(p.root(), "count"), 6 + 1 + 100);
+  EXPECT_EQ(int_of(p.root(), "count"), 6 + 1 + 150) << "t2 calls the new twice()";
   EXPECT_EQ(p.firings(), 3u) << "the firing count goes on";
   // The changed body is used, from C++ and from code.
   EXPECT_EQ(p.root().call("twice", {vsd::Value(std::int64_t{5})}).as<std::int64_t>(), 15);
@@ -174,6 +174,7 @@ TEST_F(Migrate, ReferencesFromCppNodesFollowTheMigratedObjects) {
   h.set_target(b);
   h.edit_watched().push_back(*p.object("cell"));
   h.edit_watched().push_back(p.root());
+  h.add_child(*b);  // the C++ node owns the Box the code made
   // A C++ node the script object holds as a child moves with it.
   auto& child = state.create<vsd::Node>();
   child.set_name("attached");
@@ -187,6 +188,8 @@ TEST_F(Migrate, ReferencesFromCppNodesFollowTheMigratedObjects) {
   ASSERT_EQ(h.watched().size(), 2u);
   EXPECT_EQ(h.watched()[0], p.object("cell"));
   EXPECT_EQ(h.watched()[1], &p.root());
+  ASSERT_EQ(h.children().size(), 1u);
+  EXPECT_EQ(h.children()[0], h.target().get()) << "the composite holder holds the new Box";
   EXPECT_EQ(child.parent(), &p.root());
   EXPECT_EQ(p.root().parent(), &state.database());
   // The old script object and its source are gone: one of each is left.
@@ -318,7 +321,7 @@ TEST_F(Migrate, TheModuleRunsTheNewVersionInTheSchedulerStep) {
   EXPECT_EQ(int_of(p.root(), "count"), 7);
   p.reload("test.soml", v2);
   env.step();  // t2 is enabled in the new version: the module's task runs it
-  EXPECT_EQ(int_of(p.root(), "count"), 107);
+  EXPECT_EQ(int_of(p.root(), "count"), 157);
 }
 
 }  // namespace
