@@ -362,29 +362,36 @@ void Migration::run() {
   std::stable_partition(redirects.begin(), redirects.end(), [](const Redirect& r) {
     return r.prop->type().kind() != TypeKind::Ref && r.prop->type().kind() != TypeKind::RefList;
   });
-  for (const Redirect& r : redirects) {
-    if (r.prop->type().is_ref_list()) {
-      const auto* list = static_cast<const RefListBase*>(r.prop->address(*r.holder));
-      // The Database holds the new script object already (a node has one place in its parent).
-      const bool has_new = list->contains(r.to);
-      for (std::size_t i = 0; i < list->size();) {
-        if (list->at(i) != r.from) {
-          ++i;
-          continue;
-        }
-        if (!has_new) r.holder->list_insert(*r.prop, i++, *r.to);
-        r.holder->list_erase(*r.prop, i);
-      }
-    } else {
-      r.holder->set(r.prop->name(),
-                    Value::from_text(r.prop->type(), r.prop->get_value(*r.holder).to_text(), &remap_));
-    }
-  }
+  // Ids, not pointers: a composite redirect deletes the old instance it releases, with its subtree.
   std::vector<Id> gone{old_.root_->id()};
   for (const Pair& p : pairs_) gone.push_back(p.from->id());
   for (const auto& [key, id] : old_statics_) gone.push_back(id);
   for (const auto& [id, net] : old_.node_net_) gone.push_back(id);
   if (old_.source_node_ != nullptr) gone.push_back(old_.source_node_->id());
+  std::vector<std::pair<Id, Id>> ids;  // holder, old instance
+  for (const Redirect& r : redirects) ids.emplace_back(r.holder->id(), r.from->id());
+  for (std::size_t k = 0; k < redirects.size(); ++k) {
+    const Redirect& r = redirects[k];
+    SimStateInstance* holder = state_.find(ids[k].first);
+    if (holder == nullptr) continue;
+    const Id from = ids[k].second;
+    if (r.prop->type().is_ref_list()) {
+      const auto* list = static_cast<const RefListBase*>(r.prop->address(*holder));
+      // The Database holds the new script object already (a node has one place in its parent).
+      const bool has_new = list->contains(r.to);
+      for (std::size_t i = 0; i < list->size();) {
+        if (list->at(i)->id() != from) {
+          ++i;
+          continue;
+        }
+        if (!has_new) holder->list_insert(*r.prop, i++, *r.to);
+        holder->list_erase(*r.prop, i);
+      }
+    } else {
+      holder->set(r.prop->name(),
+                  Value::from_text(r.prop->type(), r.prop->get_value(*holder).to_text(), &remap_));
+    }
+  }
   for (Id id : gone)
     if (SimStateInstance* x = state_.find(id); x != nullptr) state_.destroy(*x);
 }
