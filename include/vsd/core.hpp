@@ -23,6 +23,7 @@
 #include "vsd/core/node.hpp"
 #include "vsd/core/reference.hpp"
 #include "vsd/core/registry.hpp"
+#include "vsd/core/savepoint.hpp"
 #include "vsd/core/scheduler.hpp"
 #include "vsd/core/sim_state.hpp"
 #include "vsd/core/transaction.hpp"

@@ -46,6 +46,21 @@ std::vector<SimStateInstance*> SimStateInstance::composite_holders() const {
   return out;
 }
 
+std::vector<std::pair<SimStateInstance*, const MetaProperty*>> SimStateInstance::referrers() const {
+  std::vector<std::pair<SimStateInstance*, const MetaProperty*>> out;
+  for (const detail::RefLink* head : {composite_head_, shared_head_}) {
+    std::vector<std::pair<SimStateInstance*, const MetaProperty*>> part;
+    for (const detail::RefLink* l = head; l != nullptr; l = l->next)
+      if (l->holder != nullptr && l->prop != nullptr &&
+          std::find(part.begin(), part.end(), std::make_pair(l->holder, l->prop)) == part.end())
+        part.emplace_back(l->holder, l->prop);
+    std::reverse(part.begin(), part.end());  // the lists are newest first
+    for (auto& r : part)
+      if (std::find(out.begin(), out.end(), r) == out.end()) out.push_back(r);
+  }
+  return out;
+}
+
 SimStateInstance* SimStateInstance::composite_holder(const MetaProperty& p) const noexcept {
   SimStateInstance* found = nullptr;
   for (const detail::RefLink* l = composite_head_; l != nullptr; l = l->next)

@@ -316,6 +316,26 @@ void Registry::undefine(const MetaInstance& cls) {
   runtime_classes_.erase(it);  // ~MetaInstance unlinks it from its base
 }
 
+void Registry::rename(const MetaInstance& cls, std::string name) {
+  std::unique_lock lock(mutex_);
+  if (!cls.is_runtime()) detail::throw_error("built-in class '" + cls.name() + "' cannot be renamed");
+  if (!owns_locked(cls)) detail::throw_error("class '" + cls.name() + "' is not defined in this registry");
+  if (name == cls.name()) return;
+  if (classes_.count(name) != 0) detail::throw_error("class name '" + name + "' is already registered");
+  check_class_name(name);
+  for (const auto& t : runtime_types_)
+    if (t->target() == &cls)
+      detail::throw_error("class '" + cls.name() + "' cannot be renamed: type '" + t->name() + "' names it");
+  short_names_.reserve(short_names_.size() + 1);
+  classes_.reserve(classes_.size() + 1);
+  auto& m = const_cast<MetaInstance&>(cls);  // the Registry owns it (checked above)
+  unindex_locked(cls);
+  classes_.erase(cls.name());
+  m.name_ = std::move(name);
+  classes_.emplace(cls.name(), &cls);
+  index_locked(cls);
+}
+
 }  // namespace vsd
 
 namespace vsd {

@@ -98,6 +98,11 @@ static PK prop_kind(const Type& t, const MetaProperty& mp) {
 }
 
 void ProgramImpl::load(std::string name, std::string text) {
+  define(std::move(name), std::move(text));
+  populate();
+}
+
+void ProgramImpl::define(std::string name, std::string text) {
   Registry& reg = state_.environment().registry();
   checked_ = check_source(name, std::move(text), reg);
   if (!checked_->ok()) throw Error(checked_->diagnostics.format());
@@ -141,6 +146,19 @@ void ProgramImpl::load(std::string name, std::string text) {
   walk(root, [&](const Decl& d) {
     if (d.kind != DeclKind::Enum) return;
     const auto& e = d.as<EnumDecl>();
+    // A reload (migrate.cpp) keeps the running version's enum when its values are the same.
+    if (previous_ != nullptr)
+      for (const auto& [old_decl, old_type] : previous_->enums_) {
+        if (old_type->name() != "soml::" + qualified(e)) continue;
+        bool same = old_type->enum_values().size() == e.values.size();
+        for (std::size_t i = 0; same && i < e.values.size(); ++i)
+          same = old_type->enum_values()[i].name == e.values[i] &&
+                 old_type->enum_values()[i].value == static_cast<std::int64_t>(i);
+        if (!same) not_supported(*this, e.loc, "changing the values of enum '" + e.name + "' at run time");
+        enums_[&e] = old_type;
+        reused_enums_.push_back(old_type);
+        return;
+      }
     EnumBuilder b("soml::" + qualified(e));
     b.underlying(meta_type<std::int64_t>());
     for (std::size_t i = 0; i < e.values.size(); ++i) b.value(e.values[i], static_cast<std::int64_t>(i));
@@ -535,11 +553,26 @@ void ProgramImpl::load(std::string name, std::string text) {
         h += offset;
     }
   }
+}
 
-  // 8. The database content: source components, the script object and its objects.
+void ProgramImpl::connect_listeners() {
   listener_ = state_.on_property_changed().connect(
       [this](SimStateInstance& inst, const MetaProperty& p) { on_change(inst, p); });
   deleted_listener_ = state_.on_deleted().connect([this](SimStateInstance& inst) { on_deleted(inst); });
+}
+
+std::vector<const MetaInstance*> ProgramImpl::runtime_classes() const {
+  std::vector<const MetaInstance*> out;
+  for (const auto& [decl, m] : scope_meta_)
+    if (m->is_runtime() && std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
+  // Subclasses first (the order Registry::undefine needs), then by name for a stable order.
+  std::sort(out.begin(), out.end(), [](const MetaInstance* a, const MetaInstance* b) {
+    return a->depth() != b->depth() ? a->depth() > b->depth() : a->name() < b->name();
+  });
+  return out;
+}
+
+void ProgramImpl::make_source() {
   source_node_ = &state_.create<SourceFile>();
   source_node_->set_name(stem_ + " (source)");
   source_node_->set_file(checked_->source->name());
@@ -556,7 +589,14 @@ void ProgramImpl::load(std::string name, std::string text) {
     if (d.has_members())
       for (const DeclPtr& m : d.as<ScopeDecl>().members) component(*m, sc);
   };
-  component(root, *source_node_);
+  component(*checked_->script.root, *source_node_);
+}
+
+void ProgramImpl::populate() {
+  const ClassDecl& root = *checked_->script.root;
+  // 8. The database content: source components, the script object and its objects.
+  connect_listeners();
+  make_source();
 
   // Static instances first (their ids are constants of the code), then their values, nets and constructors.
   std::vector<std::pair<const ClassDecl*, SimStateInstance*>> statics;

@@ -249,6 +249,17 @@ class ProgramImpl {
   ~ProgramImpl();
 
   void load(std::string name, std::string text);
+  // load() in two halves: check, define the run-time classes and enums, compile (define); then make the
+  // database content (populate). A reload (migrate.cpp) defines, then migrates instead of populating.
+  void define(std::string name, std::string text);
+  void populate();
+  void connect_listeners();
+  void make_source();  // the SourceFile node and its SourceComponents
+  // The run-time classes this program defined (script classes, places and transitions with members of
+  // their own), subclasses first.
+  [[nodiscard]] std::vector<const MetaInstance*> runtime_classes() const;
+  const ProgramImpl* previous_ = nullptr;      // the running version, while a reload defines this one
+  std::vector<const MetaType*> reused_enums_;  // enums of previous_ this version kept
 
   // ---- VM ----
   // Runs function @p f on @p self with arguments in args (count f.nparams); returns the result.
@@ -393,6 +404,10 @@ class ProgramImpl {
                  std::vector<TokenMove>* given = nullptr);
   void set_enabled(std::uint32_t ti, bool on);
 };
+
+// Program::reload (migrate.cpp): moves the state from the running version @p old to @p nw (made, not
+// loaded), all or nothing.
+MigrationReport migrate(ProgramImpl& old, ProgramImpl& nw, std::string name, std::string text);
 
 // Loader helpers shared by the compiler.
 RK reg_kind(const Type& t) noexcept;

@@ -17,6 +17,8 @@
 #include <span>
 #include <string_view>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "vsd/core/config.hpp"
 #include "vsd/core/meta_instance.hpp"
@@ -96,6 +98,9 @@ class SimStateInstance : public Instance {
   [[nodiscard]] bool is_floating() const noexcept { return (life_ & floating_bit) != 0; }
   /// @brief Instances holding composite references to this one (a Node's parent among them).
   [[nodiscard]] std::vector<SimStateInstance*> composite_holders() const;
+  /// @brief Every (instance, property) whose value refers to this one, composite and shared references
+  /// alike (references held outside properties are not listed), oldest first, each pair once.
+  [[nodiscard]] std::vector<std::pair<SimStateInstance*, const MetaProperty*>> referrers() const;
   /// @brief The first instance holding this one compositely through property @p p, or nullptr.
   [[nodiscard]] SimStateInstance* composite_holder(const MetaProperty& p) const noexcept;
 

@@ -80,6 +80,12 @@ class Registry {
   /// @brief Removes a run-time class that has no live instances and no subclasses.
   /// @throws vsd::Error otherwise, or for built-in classes.
   void undefine(const MetaInstance& cls);
+  /// @brief Gives run-time class @p cls the full name @p name (a script that redefines its classes at
+  /// run time retires the old versions under other names; vsd::soml). Instances keep their class; changes
+  /// recorded from now on carry the new name.
+  /// @throws vsd::Error for built-in classes, classes of another registry, a name that is taken or not a
+  /// class name, and classes that reference types ("shared<X>") were made for (their names would lie).
+  void rename(const MetaInstance& cls, std::string name);
 
   /// @brief Takes ownership of a run-time value type built by EnumBuilder or StructBuilder (or
   /// detail::make_runtime_vector). @throws vsd::Error when another type has its name.

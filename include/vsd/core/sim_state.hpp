@@ -124,6 +124,7 @@ class SimState : public Instance {
 
  private:
   friend class SimStateInstance;
+  friend class Savepoint;
   friend class Node;
   friend class Database;
   friend struct detail::RefAccess;

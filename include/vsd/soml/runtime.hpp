@@ -21,6 +21,7 @@
  */
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
@@ -71,6 +72,20 @@ struct Firing {
   std::vector<TokenMove> given;            ///< black tokens produced, in arrow order
 };
 
+/// @brief What Program::reload did (shaped like vsd::io::LoadReport: what changed, and the warnings of
+/// schema evolution: values dropped or not converted, tokens in removed places).
+struct MigrationReport {
+  std::size_t migrated = 0;  ///< live instances moved to the new version of their class
+  std::size_t created = 0;   ///< objects the new version declares that the running one had not
+  std::size_t deleted = 0;   ///< objects the new version no longer declares (deleted with their nets)
+  /// Per migrated or new property of a class: "Demo.count: kept", "Demo.limit: new", "Demo.old: removed",
+  /// "Demo.size: converted from int to double" (one line per class and property, in declaration order).
+  std::vector<std::string> properties;
+  /// Schema differences handled with a loss: removed properties' values, values that did not convert,
+  /// tokens in removed places, retired classes that could not be undefined.
+  std::vector<std::string> warnings;
+};
+
 class ProgramImpl;
 
 /// @brief A SOML++ script loaded into one SimState.
@@ -84,6 +99,17 @@ class Program {
   ~Program();
   Program(const Program&) = delete;
   Program& operator=(const Program&) = delete;
+
+  /// @brief Replaces the running script by a changed version of it (docs/soml.md, "Changing a running
+  /// program"): its classes are redefined, live objects migrate to the new classes (properties kept by
+  /// name, converted where the type changed, new ones initialised, removed ones reported), markings stay
+  /// where the places still exist, transitions, arrows and functions are the new ones. Migrated objects
+  /// are new instances (new ids); every reference to them held in a database property is redirected,
+  /// pointers to the old instances are invalid afterwards.
+  /// @return what changed.
+  /// @throws vsd::Error with every diagnostic (file:line:col) of the new text, or what cannot be
+  /// migrated; then the state, this Program and its classes are exactly as before.
+  MigrationReport reload(std::string name, std::string text);
 
   /// @brief The script object's node (a child of the Database).
   [[nodiscard]] vsd::Node& root() const noexcept;
