@@ -128,10 +128,11 @@ std::string joined(const std::vector<std::string>& v, std::size_t from = 0) {
 
 // Scripts that run without errors: object tokens (philosophers, supervisor), communication arrows,
 // invocations that are mid-flight at many of the split points, substitution, place and transition
-// properties, inheritance and `new`.
+// properties, `new`, script enums (run-time enums the file defines), weights and inhibitor arrows.
 const char* const continuing[] = {
     "run_philosophers.soml", "run_communication.soml",    "invoke_fetch.soml",   "subst_relay.soml",
-    "run_supervisor.soml",   "run_place_properties.soml", "run_nodes_meta.soml", "run_arrow_conditions.soml"};
+    "run_supervisor.soml",   "run_place_properties.soml", "run_nodes_meta.soml", "run_arrow_conditions.soml",
+    "run_enums.soml",        "run_weights_inhibitor.soml"};
 constexpr std::uint64_t most = 40;  // firings per script at most (the philosophers never stop)
 
 TEST(Attach, AReplicaThatAppliedTheRecordedBundlesContinuesIdentically) {
@@ -177,8 +178,8 @@ TEST(Attach, ARunSavedMidExecutionByVsdIoContinuesIdenticallyAfterLoading) {
     const std::string ref_out = ref.out.str();
     const std::string ref_state = dump(ref.env.main_state());
     const bool quiet = ref.p->step(1) == 0;  // the philosophers never stop
-    for (std::uint64_t n = 0; n <= total; ++n) {
-      // Every split point, in both formats in turn.
+    for (std::uint64_t n = 0; n <= total; n += total > 20 ? 3 : 1) {
+      // Every split point (every third of a long run), in both formats in turn.
       const auto format = n % 2 == 0 ? vsd::io::Format::Text : vsd::io::Format::Binary;
       SCOPED_TRACE("split after " + std::to_string(n) + " of " + std::to_string(total) +
                    (n % 2 == 0 ? " (text)" : " (binary)"));
