@@ -213,7 +213,6 @@ void ProgramImpl::attach_content() {
     throw Error(file + ": script object '" + stem_ +
                 "' has no executor state (a soml::Executor child named "
                 "'(executor)'): the state was not made by a running program");
-  exec_id_ = exec_->id();
   rng_ = exec_->rng();
   firings_ = exec_->firings();
   std::unordered_map<Id, std::uint32_t> ti_of;
@@ -244,11 +243,7 @@ void ProgramImpl::attach_content() {
 }
 
 void ProgramImpl::sync_state() {
-  if (exec_ == nullptr) return;
-  if (state_.find(exec_id_) != exec_) {  // someone deleted it: the run is no longer saved
-    exec_ = nullptr;
-    return;
-  }
+  if (exec_ == nullptr) return;  // on_deleted forgets it when it is deleted
   if (exec_->rng() != rng_) exec_->set_rng(rng_);
   if (exec_->firings() != firings_) exec_->set_firings(firings_);
   auto node = [&](std::uint32_t i) -> Node* {

@@ -26,6 +26,7 @@ void ProgramImpl::on_change(SimStateInstance& inst, const MetaProperty& p) {
 // A net whose owner, place or transition is deleted stops: its transitions leave the enabled set and
 // are never tested again (their nodes, which the executor holds by pointer, are going away).
 void ProgramImpl::on_deleted(SimStateInstance& inst) {
+  if (&inst == exec_) exec_ = nullptr;  // someone deleted the executor's state: the run is no longer saved
   auto it = node_net_.find(inst.id());
   if (it == node_net_.end()) return;
   NetInst* n = it->second;

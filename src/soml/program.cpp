@@ -586,7 +586,6 @@ void ProgramImpl::load(std::string name, std::string text) {
   // What decides the continuation of the run, as database state (attach.cpp).
   exec_ = &state_.create<Executor>();
   exec_->set_name("(executor)");
-  exec_id_ = exec_->id();
   root_->add_child(*exec_);
   sync_state();
 }

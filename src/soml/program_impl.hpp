@@ -281,8 +281,7 @@ class ProgramImpl {
 
   // ---- attaching to content already in the state (attach.cpp) ----
   bool attaching_ = false;
-  Executor* exec_ = nullptr;
-  Id exec_id_ = 0;  // the executor's database state (a child of the script object)
+  Executor* exec_ = nullptr;  // the executor's database state (a child of the script object)
   // A class the state has already (a file defined it): checked against the script's, then used.
   const MetaInstance& adopt_class(ClassBuilder& b, const std::string& name, const MetaInstance& base,
                                   const ScopeDecl& decl);
