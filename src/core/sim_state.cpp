@@ -370,6 +370,58 @@ Transaction SimState::take_recording() {
   return t;
 }
 
+SimState::Savepoint SimState::savepoint() {
+  Savepoint sp{recorded_.size(), recorded_ops_, recording_};
+  if (!recording_) {
+    // Not start_recording(): it would visit every instance when the state watch is on already (a
+    // state-wide listener turned it on), and a savepoint is taken per net firing.
+    if (recorded_.empty()) detail::write_tx_header(recorded_);
+    recording_ = true;
+    if (!state_watch_) enable_state_watch();
+  }
+  return sp;
+}
+
+void SimState::release(const Savepoint& sp) noexcept {
+  if (sp.was_recording) return;
+  recording_ = false;
+  recorded_.resize(sp.bytes);  // keeps the capacity for the next savepoint
+  recorded_ops_ = sp.ops;
+}
+
+void SimState::roll_back(const Savepoint& sp) {
+  if (!recording_ || recorded_.size() < sp.bytes || recorded_ops_ < sp.ops) {
+    release(sp);
+    throw Error("savepoint: the recording of SimState '" + name() +
+                "' was taken or stopped while the savepoint was open; nothing was undone");
+  }
+  // The changes since sp as a bundle of their own (a header, then their operations), inverted.
+  const std::size_t from = std::max(sp.bytes, detail::tx_header_size);
+  std::vector<std::uint8_t> bytes;
+  detail::write_tx_header(bytes);
+  if (recorded_.size() > from)
+    bytes.insert(bytes.end(), recorded_.begin() + static_cast<std::ptrdiff_t>(from), recorded_.end());
+  const Transaction undo = detail::make_transaction(std::move(bytes), recorded_ops_ - sp.ops).inverted();
+  // The undo itself is not recorded: the changes it reverses are dropped from the recording instead.
+  recording_ = false;
+  auto resume = [&] {
+    recording_ = true;
+    // An instance changed while nothing recorded or listened drops its watch bit (emit_property's fast
+    // path): set them again, or the changes after the savepoint would go unrecorded.
+    if (sp.was_recording) enable_state_watch();
+    release(sp);
+  };
+  try {
+    apply(undo);
+  } catch (...) {  // nothing was undone (apply is all or nothing): the recording keeps the changes
+    resume();
+    throw;
+  }
+  recorded_.resize(std::max(sp.bytes, from));
+  recorded_ops_ = sp.ops;
+  resume();
+}
+
 Transaction SimState::stop_recording() {
   recording_ = false;
   Transaction t = take_recording();

@@ -19,7 +19,7 @@ namespace detail {
 
 namespace {
 constexpr std::uint8_t magic[4] = {'V', 'S', 'D', 'T'};
-constexpr std::size_t header_size = 5;
+constexpr std::size_t header_size = tx_header_size;
 
 // Writes a value framed by a 4-byte length, so that readers can skip or check it without its type.
 void write_framed(std::vector<std::uint8_t>& out, const MetaType& type, const void* value) {

@@ -4,6 +4,7 @@
 // signal. Among the enabled transitions one is chosen with a seeded generator, so runs are
 // reproducible. Every firing changes markings through the setters of the place nodes.
 #include <algorithm>
+#include <utility>
 
 #include "program_impl.hpp"
 #include "vsd/core/error.hpp"
@@ -25,6 +26,7 @@ void ProgramImpl::on_change(SimStateInstance& inst, const MetaProperty& p) {
 // A net whose owner, place or transition is deleted stops: its transitions leave the enabled set and
 // are never tested again (their nodes, which the executor holds by pointer, are going away).
 void ProgramImpl::on_deleted(SimStateInstance& inst) {
+  if (&inst == exec_) exec_ = nullptr;  // someone deleted the executor's state: the run is no longer saved
   auto it = node_net_.find(inst.id());
   if (it == node_net_.end()) return;
   NetInst* n = it->second;
@@ -40,6 +42,7 @@ void ProgramImpl::on_deleted(SimStateInstance& inst) {
   }
   for (Transition* t : n->transitions) node_net_.erase(t->id());
   node_net_.erase(n->owner);
+  if (guarding_) killed_.push_back(n);
 }
 
 void ProgramImpl::put_token(Place& p, SimStateInstance* obj, std::int64_t n) {
@@ -198,89 +201,124 @@ void ProgramImpl::fire(std::uint32_t i) {
   NetInst& net = *ti.net;
   const TransitionInfo& t = net.cls->transitions[static_cast<std::size_t>(ti.t)];
   Transition& tn = *net.transitions[static_cast<std::size_t>(ti.t)];
+  if (debug_ != nullptr) debug_->on_fire(tn, ti.mark);  // a breakpoint on the transition (debugger.cpp)
+  // A firing that runs SOML++ code (an action, an invocation's arguments, initialisers and constructors,
+  // output arrow conditions) can fail half-way: it runs under a savepoint of the SimState, and an error
+  // undoes every change it made — properties, markings, created and deleted instances — so a firing is
+  // all or nothing. One without code cannot fail and runs without the recording that costs.
+  if (!t.guarded) {
+    fire_body(i);
+  } else {
+    const SimState::Savepoint sp = state_.savepoint();
+    const std::uint64_t firings = firings_;
+    const std::size_t killed = killed_.size();
+    struct Guard {
+      ProgramImpl& p;
+      std::size_t killed;
+      ~Guard() {
+        p.guarding_ = false;
+        p.killed_.resize(std::min(killed, p.killed_.size()));
+      }
+    } guard{*this, killed};
+    guarding_ = true;
+    try {
+      fire_body(i);
+    } catch (const Error& e) {
+      pending_.clear();
+      finished_instance_ = 0;
+      firings_ = firings;
+      guarding_ = false;
+      roll_back(sp, killed, e.what());
+      throw;
+    } catch (...) {
+      pending_.clear();
+      finished_instance_ = 0;
+      firings_ = firings;
+      guarding_ = false;
+      roll_back(sp, killed, "an exception");
+      throw;
+    }
+    state_.release(sp);
+  }
+  // The trace once the firing stands; then a finished invocation goes (its transition, which a Finish
+  // entry of the trace names, lived until now).
+  const Id gone = std::exchange(finished_instance_, 0);
+  struct Cleanup {
+    ProgramImpl& p;
+    Id gone;
+    ~Cleanup() {
+      p.pending_.clear();
+      if (SimStateInstance* o = gone != 0 ? p.state_.find(gone) : nullptr; o != nullptr) p.state_.destroy(*o);
+    }
+  } cleanup{*this, gone};
+  if (trace_)
+    for (const Firing& f : pending_) trace_(f);
+}
+
+void ProgramImpl::roll_back(const SimState::Savepoint& sp, std::size_t killed, const std::string& why) {
+  try {
+    state_.roll_back(sp);
+  } catch (const Error& e) {
+    throw Error(why + "\nand undoing the failed firing failed too: " + e.what());
+  }
+  // Nets whose nodes the firing deleted are back (re-created with their ids): the executor takes them up
+  // again. Nets the firing created are gone again with their nodes.
+  for (std::size_t k = killed; k < killed_.size(); ++k) revive(killed_[k]);
+  killed_.resize(killed);
+}
+
+void ProgramImpl::fire_body(std::uint32_t i) {
+  TI& ti = tis_[i];
+  NetInst& net = *ti.net;
+  const TransitionInfo& t = net.cls->transitions[static_cast<std::size_t>(ti.t)];
+  Transition& tn = *net.transitions[static_cast<std::size_t>(ti.t)];
   const std::uint64_t mark = ti.mark;
-  if (debug_ != nullptr) debug_->on_fire(tn, mark);  // a breakpoint on the transition (debugger.cpp)
   SimStateInstance* m = mark != 0 ? state_.find(mark) : nullptr;
   Place* from = nullptr;
   std::vector<TokenMove> taken, given;  // black token moves, recorded only for the trace
-  std::size_t from_index = 0;
   // Consume.
-  std::vector<Place*>& remote_in = remote_scratch_;  // reused: no allocation per firing
-  remote_in.assign(t.in.size(), nullptr);
   for (std::size_t k = 0; k < t.in.size(); ++k) {
     const ArrowInfo& a = t.in[k];
     if (a.inhibitor) continue;
     if (a.remote) {
-      remote_in[k] = remote_place(a, net.owner);
-      if (remote_in[k] != nullptr) {
-        remote_in[k]->set_tokens(remote_in[k]->tokens() - a.weight);
-        if (trace_) taken.push_back(TokenMove{remote_in[k], a.weight});
+      if (Place* rp = remote_place(a, net.owner); rp != nullptr) {
+        rp->set_tokens(rp->tokens() - a.weight);
+        if (trace_) taken.push_back(TokenMove{rp, a.weight});
       }
       continue;
     }
     Place& p = *net.places[static_cast<std::size_t>(a.place)];
     if (static_cast<int>(k) == t.mark_in) {
       from = &p;
-      from_index = p.objects().index_of(m);
-      if (from_index != RefListBase::npos) p.edit_objects().erase(from_index);
+      const std::size_t at = p.objects().index_of(m);
+      if (at != RefListBase::npos) p.edit_objects().erase(at);
     } else if (!a.object) {
       p.set_tokens(p.tokens() - a.weight);
       if (trace_) taken.push_back(TokenMove{&p, a.weight});
     }
   }
-  // On an error, the consumed tokens go back.
-  auto give_back = [&] {
-    for (std::size_t k = 0; k < t.in.size(); ++k) {
-      const ArrowInfo& a = t.in[k];
-      if (a.inhibitor) continue;
-      if (a.remote) {
-        if (remote_in[k] != nullptr && state_.find(remote_in[k]->id()) == remote_in[k])
-          remote_in[k]->set_tokens(remote_in[k]->tokens() + a.weight);
-        continue;
-      }
-      if (net.dead) continue;
-      Place& p = *net.places[static_cast<std::size_t>(a.place)];
-      if (static_cast<int>(k) == t.mark_in) {
-        if (m != nullptr && state_.find(mark) == m && from_index != RefListBase::npos)
-          p.edit_objects().insert(std::min(from_index, p.objects().size()), *m->as<Node>());
-      } else if (!a.object) {
-        p.set_tokens(p.tokens() + a.weight);
-      }
-    }
-  };
   // An invoking transition: a new net instance takes over; the mark waits in it (4.11).
   if (t.invoke != nullptr) {
-    SimStateInstance* inv = nullptr;
-    try {
-      inv = &start_invocation(t, tn, mark);
-    } catch (...) {
-      give_back();
-      throw;
-    }
+    SimStateInstance& inv = start_invocation(t, tn, mark);
     tn.set_firings(tn.firings() + 1);
     ++firings_;
     mark_dirty(i);
     if (trace_)
-      trace_(Firing{firings_, &tn, mark, from, nullptr, FiringKind::Invoke, inv->id(), std::move(taken), {}});
+      pending_.push_back(
+          Firing{firings_, &tn, mark, from, nullptr, FiringKind::Invoke, inv.id(), std::move(taken), {}});
     return;
   }
-  // Act; on an error, give the consumed tokens back and report.
+  // Act.
   if (t.action >= 0) {
-    std::pair<NetInst*, int> invoker{nullptr, -1};
-    try {
-      run(t.action, tn.id(), mark, nullptr, nullptr);
-      // `finish` ran: the invoking transition's action runs with the result now (its error undoes this
-      // firing too), then the instance goes and the invoking transition produces its outputs.
-      if (net.cls->invocable && !net.dead && finished(net)) invoker = complete_action(net);
-    } catch (...) {
-      give_back();
-      throw;
-    }
-    if (invoker.first != nullptr) {
+    run(t.action, tn.id(), mark, nullptr, nullptr);
+    // `finish` ran: the invoking transition's action runs with the result now (its error undoes this
+    // firing too), then the instance goes and the invoking transition produces its outputs.
+    if (net.cls->invocable && !net.dead && finished(net)) {
+      const std::pair<NetInst*, int> invoker = complete_action(net);
       const std::uint64_t instance = net.owner;
       ++firings_;
       if (trace_)
-        trace_(
+        pending_.push_back(
             Firing{firings_, &tn, mark, from, nullptr, FiringKind::Finish, instance, std::move(taken), {}});
       complete_outputs(*invoker.first, invoker.second, instance);
       return;
@@ -295,7 +333,8 @@ void ProgramImpl::fire(std::uint32_t i) {
   ++firings_;
   mark_dirty(i);
   if (trace_)
-    trace_(Firing{firings_, &tn, mark, from, to, FiringKind::Plain, 0, std::move(taken), std::move(given)});
+    pending_.push_back(
+        Firing{firings_, &tn, mark, from, to, FiringKind::Plain, 0, std::move(taken), std::move(given)});
 }
 
 // Produce: black tokens to every black output place, the mark to the first object place that takes it.
@@ -322,6 +361,18 @@ Place* ProgramImpl::produce(NetInst& net, const TransitionInfo& t, std::uint64_t
 }
 
 std::uint64_t ProgramImpl::step(std::uint64_t n) {
+  std::uint64_t fired = 0;
+  try {
+    fired = step_loop(n);
+  } catch (...) {
+    sync_state();
+    throw;
+  }
+  sync_state();
+  return fired;
+}
+
+std::uint64_t ProgramImpl::step_loop(std::uint64_t n) {
   std::uint64_t fired = 0;
   while (fired < n) {
     if (!refresh()) break;

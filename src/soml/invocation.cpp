@@ -58,27 +58,22 @@ Val load_value(const PropSlot& s, const SimStateInstance& o, std::string& str) {
 
 SimStateInstance& ProgramImpl::start_invocation(const TransitionInfo& t, Transition& tn, std::uint64_t mark) {
   const ClassInfo& ci = *t.invoke;
+  // A failure here (arguments, initialisers, constructors) is undone with the whole firing (fire()).
   SimStateInstance& inst = create_node(ci, &tn, ci.decl->name);
   const Id id = inst.id();
-  try {
-    auto& inv = static_cast<Invocation&>(inst);
-    SimStateInstance* m = mark != 0 ? state_.find(mark) : nullptr;
-    if (m != nullptr && m->as<Node>() != nullptr) inv.set_mark(SharedRef<Node>(m->as<Node>()));
-    if (t.invoke_args >= 0) {
-      Val self{};
-      self.id = id;
-      run(t.invoke_args, tn.id(), mark, &self, nullptr);
-    }
-    setup(ci, inst, nullptr, nullptr, 0);
-    NetInst* n = net_of(id);
-    if (n == nullptr || ci.start_place < 0)
-      fail("net " + ci.decl->name + " has no start place to receive the invocation's token");
-    put_token(*n->places[static_cast<std::size_t>(ci.start_place)], nullptr, 1);
-  } catch (...) {
-    // A failed invocation leaves nothing behind (the caller gives the consumed tokens back).
-    if (SimStateInstance* o = state_.find(id); o != nullptr) state_.destroy(*o);
-    throw;
+  auto& inv = static_cast<Invocation&>(inst);
+  SimStateInstance* m = mark != 0 ? state_.find(mark) : nullptr;
+  if (m != nullptr && m->as<Node>() != nullptr) inv.set_mark(SharedRef<Node>(m->as<Node>()));
+  if (t.invoke_args >= 0) {
+    Val self{};
+    self.id = id;
+    run(t.invoke_args, tn.id(), mark, &self, nullptr);
   }
+  setup(ci, inst, nullptr, nullptr, 0);
+  NetInst* n = net_of(id);
+  if (n == nullptr || ci.start_place < 0)
+    fail("net " + ci.decl->name + " has no start place to receive the invocation's token");
+  put_token(*n->places[static_cast<std::size_t>(ci.start_place)], nullptr, 1);
   return inst;
 }
 
@@ -93,7 +88,8 @@ std::pair<NetInst*, int> ProgramImpl::complete_action(const NetInst& inner) {
   const auto ci_it = by_meta_.find(&inv.meta());
   const ClassInfo* ci = ci_it != by_meta_.end() ? ci_it->second : nullptr;
   const std::string name = ci != nullptr ? ci->decl->name : inv.meta().name();
-  try {
+  {
+    // An error here leaves `finished` set; the caller undoes the whole firing, that included.
     // The invoking transition: the instance's parent, a transition of a live net that invokes this net.
     Node* parent = inv.parent();
     auto it = parent != nullptr ? node_net_.find(parent->id()) : node_net_.end();
@@ -116,10 +112,6 @@ std::pair<NetInst*, int> ProgramImpl::complete_action(const NetInst& inner) {
       run(t.action, parent->id(), mark, &r, &str);
     }
     return {outer, index};
-  } catch (...) {
-    // Not finished after all: the instance stays, its firing is undone by the caller.
-    if (state_.find(inner.owner) == &inv) inv.set_finished(false);
-    throw;
   }
 }
 
@@ -129,7 +121,9 @@ void ProgramImpl::complete_outputs(NetInst& outer, int index, std::uint64_t inst
   if (o != nullptr) {
     const SimStateInstance* m = o->as<Invocation>()->mark().get();
     mark = m != nullptr ? m->id() : 0;
-    state_.destroy(*o);  // the instance, its places, transitions and nested invocations
+    // The instance, its places, transitions and nested invocations go once the whole firing stands and
+    // its trace is out (fire()): the outputs below may still fail, and the trace names its transition.
+    finished_instance_ = instance;
   }
   if (outer.dead) return;
   const TransitionInfo& t = outer.cls->transitions[static_cast<std::size_t>(index)];
@@ -138,15 +132,15 @@ void ProgramImpl::complete_outputs(NetInst& outer, int index, std::uint64_t inst
   const auto ti = static_cast<std::uint32_t>(outer.first_ti + static_cast<std::uint32_t>(index));
   mark_dirty(ti);
   if (trace_)
-    trace_(Firing{firings_,
-                  outer.transitions[static_cast<std::size_t>(index)],
-                  mark,
-                  nullptr,
-                  to,
-                  FiringKind::Complete,
-                  instance,
-                  {},
-                  std::move(given)});
+    pending_.push_back(Firing{firings_,
+                              outer.transitions[static_cast<std::size_t>(index)],
+                              mark,
+                              nullptr,
+                              to,
+                              FiringKind::Complete,
+                              instance,
+                              {},
+                              std::move(given)});
 }
 
 }  // namespace vsd::soml

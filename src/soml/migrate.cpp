@@ -487,6 +487,17 @@ MigrationReport migrate(ProgramImpl& old, ProgramImpl& nw, std::string name, std
   nw.tests_ = old.tests_;
   nw.condition_errors_ = old.condition_errors_;
   nw.previous_ = nullptr;
+  // The executor's database state (docs/soml.md 8.7) moved to the new script object with the old one's
+  // other children; from now on it describes the new version's run (so attach works after a reload).
+  nw.exec_ = nullptr;
+  for (Node* c : nw.root_->children())
+    if (auto* e = c != nullptr ? c->as<Executor>() : nullptr; e != nullptr) nw.exec_ = e;
+  if (nw.exec_ == nullptr) {
+    nw.exec_ = &state.create<Executor>();
+    nw.exec_->set_name("(executor)");
+    nw.root_->add_child(*nw.exec_);
+  }
+  nw.sync_state();
   // The retired classes and enums go (a class something else still uses stays, under its retired name).
   for (const MetaInstance* m : old_classes) try {
       reg.undefine(*m);

@@ -18,6 +18,7 @@ void Module::register_types(vsd::Registry& registry) {
   registry.add<Transition>();
   registry.add<Arrow>();
   registry.add<Invocation>();
+  registry.add<Executor>();
 }
 
 void Module::attach(vsd::Environment& env) {
@@ -40,7 +41,15 @@ void Module::detach(vsd::Environment& env) {
 }
 
 Program& Module::load(SimState& state, std::string name, std::string text, RunOptions options) {
-  programs_.push_back(Program::load(state, std::move(name), std::move(text), options));
+  return add(Program::load(state, std::move(name), std::move(text), options));
+}
+
+Program& Module::adopt(SimState& state, std::string name, std::string text, RunOptions options) {
+  return add(Program::attach(state, std::move(name), std::move(text), options));
+}
+
+Program& Module::add(std::unique_ptr<Program> program) {
+  programs_.push_back(std::move(program));
   Program& p = *programs_.back();
   if (env_ != nullptr && has_task_) {
     Scheduler* s = &env_->scheduler();

@@ -162,7 +162,7 @@ void ProgramImpl::define(std::string name, std::string text) {
     EnumBuilder b("soml::" + qualified(e));
     b.underlying(meta_type<std::int64_t>());
     for (std::size_t i = 0; i < e.values.size(); ++i) b.value(e.values[i], static_cast<std::int64_t>(i));
-    enums_[&e] = &b.define(reg);
+    enums_[&e] = attaching_ ? &adopt_enum(b, "soml::" + qualified(e), e) : &b.define(reg);
   });
 
   // 3. Class-like declarations, bases first.
@@ -198,6 +198,7 @@ void ProgramImpl::define(std::string name, std::string text) {
         const MetaType* t = storage_type(*this, reg, pd.type);
         if (t == nullptr) not_supported(*this, pd.loc, "a property of type '" + pd.type.name() + "'");
         b.property(pd.name, *t);
+        if (attaching_) adopted_props_.emplace_back(pd.name, t);
       } else if (m->kind == DeclKind::Function && !m->as<FunctionDecl>().is_constructor) {
         const auto& fd = m->as<FunctionDecl>();
         std::vector<const MetaType*> args;
@@ -241,8 +242,9 @@ void ProgramImpl::define(std::string name, std::string text) {
       const MetaType* t = storage_type(*this, reg, c->result_type);
       if (t == nullptr) not_supported(*this, c->loc, "a net result of type '" + c->result_type.name() + "'");
       b.property("result", *t);
+      if (attaching_) adopted_props_.emplace_back("result", t);
     }
-    ci->meta = &b.define(reg);
+    ci->meta = attaching_ ? &adopt_class(b, cname, *base, *c) : &b.define(reg);
     scope_meta_[c] = ci->meta;
     by_meta_[ci->meta] = ci.get();
     // Places and transitions with members of their own get a class of their own.
@@ -259,7 +261,7 @@ void ProgramImpl::define(std::string name, std::string text) {
       }
       ClassBuilder pb(cname + "::" + m->name, sb);
       add_members(pb, s);
-      scope_meta_[m.get()] = &pb.define(reg);
+      scope_meta_[m.get()] = attaching_ ? &adopt_class(pb, cname + "::" + m->name, sb, s) : &pb.define(reg);
     }
     class_info_[c] = std::move(ci);
   }
@@ -522,6 +524,8 @@ void ProgramImpl::define(std::string name, std::string text) {
               ti.mark_in = static_cast<int>(ti.in.size() - 1);
           }
           for (const ArrowDecl* a : t.outputs) ti.out.push_back(arrow_info(*a, a->to_decl));
+          ti.guarded = ti.action >= 0 || ti.invoke != nullptr;
+          for (const ArrowInfo& a : ti.out) ti.guarded = ti.guarded || a.cond >= 0;
           ci.net->transitions.push_back(std::move(ti));
         };
     for (const DeclPtr& m : c->members) {
@@ -596,6 +600,10 @@ void ProgramImpl::populate() {
   const ClassDecl& root = *checked_->script.root;
   // 8. The database content: source components, the script object and its objects.
   connect_listeners();
+  if (attaching_) {  // the content is there already (attach.cpp)
+    attach_content();
+    return;
+  }
   make_source();
 
   // Static instances first (their ids are constants of the code), then their values, nets and constructors.
@@ -615,6 +623,11 @@ void ProgramImpl::populate() {
   for (OuterPlan& p : outer_plans_)
     if (p.static_decl != nullptr) p.static_id = object_ids_.at(p.static_decl);
   for (auto& [decl, inst] : statics) setup(*class_info_.at(decl), *inst, nullptr, nullptr, 0);
+  // What decides the continuation of the run, as database state (attach.cpp).
+  exec_ = &state_.create<Executor>();
+  exec_->set_name("(executor)");
+  root_->add_child(*exec_);
+  sync_state();
 }
 
 SimStateInstance& ProgramImpl::create_node(const ClassInfo& ci, Node* parent, const std::string& name) {
@@ -743,12 +756,18 @@ void ProgramImpl::build_net(const ClassInfo& ci, SimStateInstance& inst) {
   for (std::size_t i = 0; i < ci.net->transitions.size(); ++i)
     if (auto it = scope_init_.find(ci.net->transitions[i].decl); it != scope_init_.end())
       run(it->second, net->transitions[i]->id(), 0, nullptr, nullptr);
+  register_net(std::move(net), ci, inst);
+}
+
+void ProgramImpl::register_net(std::unique_ptr<NetInst> net, const ClassInfo& ci, SimStateInstance& inst) {
   // Register with the executor: every transition is tested once.
   net->first_ti = static_cast<std::uint32_t>(tis_.size());
   NetInst* n = net.get();
   node_net_[inst.id()] = n;
   for (Place* p : n->places) node_net_[p->id()] = n;
   for (Transition* t : n->transitions) node_net_[t->id()] = n;
+  if (auto old = nets_.find(inst.id()); old != nets_.end())
+    dead_nets_.push_back(std::move(old->second));  // a dead net revived (roll_back): tis_ still point at it
   nets_[inst.id()] = std::move(net);
   net_order_.push_back(n);
   for (std::size_t t = 0; t < ci.net->transitions.size(); ++t) {
@@ -846,6 +865,15 @@ std::unique_ptr<Program> Program::load(SimState& state, std::string name, std::s
   return std::unique_ptr<Program>(new Program(std::move(impl)));
 }
 
+std::unique_ptr<Program> Program::attach(SimState& state, std::string name, std::string text,
+                                         RunOptions options) {
+  auto impl = std::make_shared<ProgramImpl>(state, options);
+  impl->weak_self_ = impl;
+  impl->attaching_ = true;
+  impl->load(std::move(name), std::move(text));
+  return std::unique_ptr<Program>(new Program(std::move(impl)));
+}
+
 Node& Program::root() const noexcept { return *impl_->root_; }
 
 Node* Program::object(std::string_view name) const {
@@ -884,7 +912,11 @@ const MetaInstance* Program::script_class(std::string_view name) const {
 
 std::uint64_t Program::step(std::uint64_t n) { return impl_->step(n); }
 std::uint64_t Program::run_until_quiet(std::uint64_t limit) { return impl_->step(limit); }
-bool Program::enabled_any() { return impl_->refresh(); }
+bool Program::enabled_any() {
+  const bool any = impl_->refresh();
+  impl_->sync_state();
+  return any;
+}
 std::uint64_t Program::firings() const noexcept { return impl_->firings_; }
 void Program::on_firing(std::function<void(const Firing&)> fn) { impl_->trace_ = std::move(fn); }
 std::size_t Program::watched_properties() const noexcept { return impl_->deps_map_.size(); }

@@ -12,6 +12,7 @@
 #include "vsd/core/meta_instance.hpp"
 #include "vsd/core/signal.hpp"
 #include "vsd/core/sim_state.hpp"
+#include "vsd/core/type_builder.hpp"
 #include "vsd/soml/checker.hpp"
 #include "vsd/soml/net_classes.hpp"
 #include "vsd/soml/runtime.hpp"
@@ -194,6 +195,9 @@ struct TransitionInfo {
   // Invocation: the net it invokes and the function that sets the new instance's value parameters.
   const struct ClassInfo* invoke = nullptr;
   int invoke_args = -1;
+  // It runs SOML++ code when it fires (action, invocation, output arrow conditions): it fires under a
+  // savepoint, so that an error undoes it whole.
+  bool guarded = false;
 };
 
 // The net of a class-like declaration (its own places and transitions, bases' first).
@@ -272,7 +276,8 @@ class ProgramImpl {
   [[noreturn]] void fail(const std::string& what);
 
   // ---- executor ----
-  std::uint64_t step(std::uint64_t n);
+  std::uint64_t step(std::uint64_t n);  // step_loop, then sync_state (also on an error)
+  std::uint64_t step_loop(std::uint64_t n);
   bool refresh();  // re-tests dirty transitions; true when some is enabled
   void put_token(Place& p, SimStateInstance* obj, std::int64_t n);
 
@@ -282,6 +287,23 @@ class ProgramImpl {
   void setup(const ClassInfo& ci, SimStateInstance& inst, const Val* args, const std::string* sargs,
              int nargs);
   void build_net(const ClassInfo& ci, SimStateInstance& inst);
+  // Hands a net (built or found) to the executor: its transitions are listed and marked for a test.
+  void register_net(std::unique_ptr<NetInst> net, const ClassInfo& ci, SimStateInstance& inst);
+
+  // ---- attaching to content already in the state (attach.cpp) ----
+  bool attaching_ = false;
+  Executor* exec_ = nullptr;  // the executor's database state (a child of the script object)
+  // A class the state has already (a file defined it): checked against the script's, then used.
+  const MetaInstance& adopt_class(ClassBuilder& b, const std::string& name, const MetaInstance& base,
+                                  const ScopeDecl& decl);
+  const MetaType& adopt_enum(EnumBuilder& b, const std::string& name, const EnumDecl& decl);
+  std::vector<std::pair<std::string, const MetaType*>> adopted_props_;  // the class being adopted's
+  void attach_content();
+  // The places and transitions of @p owner's net, found among its children as build_net made them.
+  // @throws vsd::Error naming what does not match.
+  std::unique_ptr<NetInst> find_net(const ClassInfo& ci, SimStateInstance& owner);
+  // Writes rng_, firings_, enabled_ and dirty_ into exec_ (where they differ).
+  void sync_state();
   // Invocation (invocation.cpp): the first half of an invoking transition's firing (a new net instance
   // under the transition, its parameters, its start token) and the second, when the instance finished.
   SimStateInstance& start_invocation(const TransitionInfo& t, Transition& tn, std::uint64_t mark);
@@ -343,6 +365,7 @@ class ProgramImpl {
   // executor state
   std::unordered_map<std::uint64_t, std::unique_ptr<NetInst>> nets_;  // owner id -> net
   std::vector<NetInst*> net_order_;
+  std::vector<std::unique_ptr<NetInst>> dead_nets_;  // replaced by a revived one, kept for tis_
   struct DepKey {
     std::uint64_t id;
     const MetaProperty* prop;
@@ -369,7 +392,6 @@ class ProgramImpl {
   };
   std::unordered_map<DepKey, std::vector<std::uint32_t>, DepHash> deps_map_;
   std::vector<std::pair<std::uint64_t, const MetaProperty*>> dep_scratch_;
-  std::vector<Place*> remote_scratch_;
   Connection listener_;
   Connection deleted_listener_;
   std::unordered_map<std::uint64_t, NetInst*> node_net_;  // owner, place and transition ids -> net
@@ -398,6 +420,15 @@ class ProgramImpl {
   // it read as dependencies while a test runs.
   Place* remote_place(const ArrowInfo& a, std::uint64_t owner);
   void fire(std::uint32_t ti);
+  void fire_body(std::uint32_t ti);  // fire() without the savepoint
+  // Undoes a failed firing: the SimState back to @p sp, nets killed since killed_[killed] revived.
+  void roll_back(const SimState::Savepoint& sp, std::size_t killed, const std::string& why);
+  // A net whose nodes a rolled-back firing deleted and re-created: registered again from its nodes.
+  void revive(NetInst* dead);
+  std::vector<NetInst*> killed_;  // nets that died in the guarded firing under way (roll_back revives them)
+  bool guarding_ = false;         // a guarded firing is under way
+  std::vector<Firing> pending_;   // the trace of the firing under way, reported once it succeeded
+  Id finished_instance_ = 0;      // an invocation the firing under way finished: deleted after the trace
   // Produces the output tokens of a firing; returns the place the mark went to (null: it left the net).
   /// Produces the outputs of @p t; appends the black tokens given to @p given when it is not null.
   Place* produce(NetInst& net, const TransitionInfo& t, std::uint64_t mark,

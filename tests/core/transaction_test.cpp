@@ -332,3 +332,80 @@ TEST_F(TransactionTest, UnknownClassesAndPropertiesAreReported) {
 }
 
 }  // namespace
+
+namespace {
+
+// Savepoints (SimState::savepoint, roll_back, release): what SOML++ uses to make a net firing all or
+// nothing.
+TEST_F(TransactionTest, RollBackUndoesEveryChangeSinceTheSavepointAndRecordsNothing) {
+  auto& r = source.create<TRobot>();
+  source.database().add_child(r);
+  auto& kept = source.create<vsd::Node>();
+  r.add_child(kept);
+  r.edit_watched().push_back(kept);
+  auto& gone = source.create<vsd::Node>();
+  gone.set_name("gone");
+  source.database().add_child(gone);
+  const vsd::Id gone_id = gone.id();
+  replica.copy_from(source);
+  EXPECT_FALSE(source.recording());
+  const vsd::SimState::Savepoint sp = source.savepoint();
+  EXPECT_TRUE(source.recording());
+  r.set_speed(5.0);
+  auto& made = source.create<TTool>();
+  r.set_tool(vsd::Ref<TTool>(&made));
+  r.edit_watched().erase(0);
+  source.destroy(gone);  // deleted: comes back with its id and values
+  int heard = 0;
+  auto c = source.on_property_changed().connect(
+      [&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++heard; });
+  source.roll_back(sp);
+  EXPECT_GT(heard, 0);  // the undo signals like any change
+  EXPECT_FALSE(source.recording());
+  expect_equal(source, replica);
+  ASSERT_NE(source.find(gone_id), nullptr);
+  EXPECT_EQ(source.find<vsd::Node>(gone_id)->name(), "gone");
+  EXPECT_EQ(r.speed(), 1.0);
+  EXPECT_EQ(r.tool().get(), nullptr);
+  EXPECT_EQ(r.watched().size(), 1u);
+  // Nothing of it is left in a later recording.
+  source.start_recording();
+  EXPECT_TRUE(source.stop_recording().empty());
+}
+
+TEST_F(TransactionTest, SavepointsNestInsideARecordingThatKeepsOnlyWhatStood) {
+  auto& r = source.create<TRobot>();
+  source.database().add_child(r);
+  replica.copy_from(source);
+  source.start_recording();
+  r.set_speed(2.0);
+  const auto outer = source.savepoint();
+  r.set_axes(7);
+  const auto inner = source.savepoint();
+  r.set_speed(3.0);
+  source.roll_back(inner);  // speed back to 2
+  EXPECT_TRUE(source.recording());
+  source.release(outer);  // axes = 7 stays
+  EXPECT_TRUE(source.recording());
+  const vsd::Transaction t = source.stop_recording();
+  const std::string ir = std::to_string(r.id());
+  EXPECT_EQ(t.describe(), "set #" + ir + ".speed\nset #" + ir + ".axes\n");
+  replica.apply(t);
+  expect_equal(source, replica);
+  EXPECT_EQ(r.speed(), 2.0);
+  EXPECT_EQ(r.axes(), 7);
+}
+
+TEST_F(TransactionTest, ReleasingASavepointOfAStateThatDidNotRecordStopsRecording) {
+  auto& r = source.create<TRobot>();
+  const auto sp = source.savepoint();
+  r.set_speed(4.0);
+  source.release(sp);
+  EXPECT_FALSE(source.recording());
+  EXPECT_EQ(r.speed(), 4.0);
+  source.start_recording();
+  r.set_axes(3);
+  EXPECT_EQ(source.stop_recording().size(), 1u);  // only what came after start_recording
+}
+
+}  // namespace

@@ -6,9 +6,14 @@
 
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "vsd/core.hpp"
 #include "vsd/soml.hpp"
+
+#if VSD_SOML_TEST_IO
+#include "vsd/io/snapshot.hpp"
+#endif
 
 namespace migrate_test {
 
@@ -325,3 +330,32 @@ TEST_F(Migrate, TheModuleRunsTheNewVersionInTheSchedulerStep) {
 }
 
 }  // namespace
+
+// The executor's database state (docs/soml.md 8.7) describes the new version after a reload, so a run
+// saved after a reload continues after attaching the new text.
+TEST_F(Migrate, TheExecutorStateFollowsTheReloadAndAttachContinues) {
+  Program& p = running();
+  p.reload("test.soml", v2);
+  std::vector<const vsd::Node*> execs;
+  for (const vsd::Node* c : p.root().children())
+    if (c->as<vsd::soml::Executor>() != nullptr) execs.push_back(c);
+  ASSERT_EQ(execs.size(), 1u);
+  EXPECT_EQ(execs[0]->as<vsd::soml::Executor>()->firings(), 1u);
+  EXPECT_TRUE(p.enabled_any());
+#if VSD_SOML_TEST_IO
+  const auto bytes = vsd::io::save_bytes(state);
+  vsd::Registry reg2;
+  reg2.add<Holder>();
+  vsd::Environment env2{0, reg2};
+  auto& soml2 = env2.use<vsd::soml::Module>();
+  vsd::io::load_bytes(env2.main_state(), bytes);
+  vsd::soml::RunOptions o;
+  std::ostringstream out2;
+  o.out = &out2;
+  Program& q = soml2.adopt(env2.main_state(), "test.soml", v2, o);
+  EXPECT_EQ(q.firings(), 1u);
+  EXPECT_EQ(q.run_until_quiet(), p.run_until_quiet());
+  EXPECT_EQ(q.root().get<std::int64_t>("count"), p.root().get<std::int64_t>("count"));
+  EXPECT_EQ(q.firings(), p.firings());
+#endif
+}

@@ -12,22 +12,22 @@
  *  }
  *  @endcode
  *
- *  A savepoint records the changes made after it (through the state's recording, which it starts when
- *  the state does not record yet) and rolls them back by applying their inverse (Transaction::inverted).
- *  Rolled back changes vanish from the state's recording too, so a replica fed from it never sees them;
- *  committed ones stay in it when the state was recording and are dropped from it otherwise.
- *  Instances deleted after the savepoint come back with their ids and values, but at other addresses:
- *  pointers to them are invalid. Do not take the state's recording (SimState::take_recording) while a
- *  savepoint is open; rollback() then throws. Savepoints nest (the inner one is closed first).
+ *  A scope around SimState::savepoint(), roll_back() and release(). A savepoint records the changes made
+ *  after it (through the state's recording, which it starts when the state does not record yet) and rolls
+ * them back by applying their inverse (Transaction::inverted). Rolled back changes vanish from the state's
+ * recording too, so a replica fed from it never sees them; committed ones stay in it when the state was
+ * recording and are dropped from it otherwise. Instances deleted after the savepoint come back with their ids
+ * and values, but at other addresses: pointers to them are invalid. Do not take the state's recording
+ * (SimState::take_recording) while a savepoint is open; rollback() then throws. Savepoints nest (the inner
+ * one is closed first).
  */
 #pragma once
 
-#include <cstddef>
+#include "vsd/core/sim_state.hpp"
 
 namespace vsd {
 
-class SimState;
-
+/// @brief A scope around SimState::savepoint(): rolled back unless committed.
 class Savepoint {
  public:
   /// @brief Starts recording the changes to @p state.
@@ -47,12 +47,9 @@ class Savepoint {
   [[nodiscard]] bool open() const noexcept { return open_; }
 
  private:
-  void close() noexcept;
   SimState& state_;
-  bool was_recording_ = false;
+  SimState::Savepoint point_;
   bool open_ = true;
-  std::size_t mark_bytes_ = 0;
-  std::size_t mark_ops_ = 0;
 };
 
 }  // namespace vsd

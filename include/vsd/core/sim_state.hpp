@@ -111,6 +111,24 @@ class SimState : public Instance {
   Transaction take_recording();
   /// @brief Stops recording and returns what was recorded.
   Transaction stop_recording();
+  /// @brief A point in the changes of this state that roll_back() returns to (see savepoint()).
+  struct Savepoint {
+    std::size_t bytes = 0;       ///< size of the recording at the savepoint
+    std::size_t ops = 0;         ///< operations recorded at the savepoint
+    bool was_recording = false;  ///< whether the state recorded before the savepoint
+  };
+  /// @brief Marks the present state so that every later change can be undone with roll_back(); records
+  /// from now on if the state did not record yet. End it with release() or roll_back(), innermost first.
+  Savepoint savepoint();
+  /// @brief Keeps the changes since @p sp. When the state did not record before @p sp, recording stops
+  /// again and the changes since @p sp are dropped from the buffer (they stay in the state).
+  void release(const Savepoint& sp) noexcept;
+  /// @brief Undoes every change since @p sp — property values, reference lists, created and deleted
+  /// instances (re-created with their ids and last values) — by applying their inverse, which emits the
+  /// ordinary signals, and removes them from the recording; then release(sp). Transient properties are
+  /// not recorded, so they are not undone. @throws vsd::Error when the inverse does not apply (the
+  /// state then records as before @p sp).
+  void roll_back(const Savepoint& sp);
   /// @brief Applies a bundle. Everything is checked first (ids, classes, properties, values, list
   /// positions): a bundle that does not fit this state throws vsd::Error and changes nothing.
   void apply(const Transaction& t);
@@ -124,7 +142,6 @@ class SimState : public Instance {
 
  private:
   friend class SimStateInstance;
-  friend class Savepoint;
   friend class Node;
   friend class Database;
   friend struct detail::RefAccess;

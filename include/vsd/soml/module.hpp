@@ -32,12 +32,16 @@ class Module : public vsd::Module {
 
   /// @brief Loads a script (see Program::load) and runs its nets in every step of the scheduler.
   Program& load(SimState& state, std::string name, std::string text, RunOptions options = {});
+  /// @brief Attaches to a run already in @p state (see Program::attach) and runs its nets in every step
+  /// of the scheduler, like load().
+  Program& adopt(SimState& state, std::string name, std::string text, RunOptions options = {});
   /// @brief The programs loaded so far.
   [[nodiscard]] const std::vector<std::unique_ptr<Program>>& programs() const noexcept { return programs_; }
   /// @brief Firings per step at most (a guard against nets that never become quiet).
   std::uint64_t step_limit = 1'000'000;
 
  private:
+  Program& add(std::unique_ptr<Program> program);
   vsd::Environment* env_ = nullptr;
   std::uint32_t task_ = 0;
   bool has_task_ = false;

@@ -70,6 +70,23 @@ class Invocation : public vsd::Node {
   VSD_PROPERTY(bool, finished, false)
 };
 
+/// @brief What decides how a loaded script's run continues, kept as database state
+/// ("soml::Executor", a child of the script object named "(executor)"): so a state saved by vsd::io, or a
+/// replica that applied the recorded bundles, continues exactly like the original once a Program attaches
+/// to it (Program::attach). The executor writes it at the end of every step(), run_until_quiet() and
+/// enabled_any() call.
+class Executor : public vsd::Node {
+  VSD_INSTANCE(Executor, vsd::Node)
+  /// The state of the generator that chooses among the enabled transitions (xorshift64*).
+  VSD_PROPERTY(std::uint64_t, rng, 0)
+  /// Firings so far (the next firing's step number is one more).
+  VSD_PROPERTY(std::uint64_t, firings, 0)
+  /// The enabled transitions, in the order the choice indexes them.
+  VSD_PROPERTY(vsd::SharedRefList<vsd::Node>, enabled, {})
+  /// The transitions waiting for a test (something they read changed), in the order they are tested.
+  VSD_PROPERTY(vsd::SharedRefList<vsd::Node>, dirty, {})
+};
+
 /// @brief Arrow types (normal, inhibitor, communication).
 enum class ArrowType : std::uint8_t { Normal, Inhibitor, Communication };
 VSD_ENUM(ArrowType, Normal, Inhibitor, Communication)

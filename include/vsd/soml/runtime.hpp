@@ -96,6 +96,19 @@ class Program {
   /// position of a construct the runtime cannot run yet; nothing is added to the state then.
   static std::unique_ptr<Program> load(SimState& state, std::string name, std::string text,
                                        RunOptions options = {});
+  /// @brief Attaches to a run of @p text that is already in @p state — loaded by vsd::io, or a replica
+  /// that applied the recorded bundles — and continues it exactly as the original would have: the script
+  /// is checked and compiled as for load(), the run-time classes and enums the state has are checked
+  /// against the script's and used, and the script object, its objects, every net (invocations included)
+  /// and the executor's state (its "(executor)" node: generator, firings, enabled transitions in choice
+  /// order) are found in the state instead of created. Nothing is created or changed. @p options.seed is
+  /// not used (the state's generator goes on). Script functions of classes the state defined (a file's)
+  /// are not MetaMethods: a file carries no code.
+  /// @throws vsd::Error when the script has errors, or naming what of the state does not match it (no
+  /// script object, a different source text, a class, object, place or transition that differs, no
+  /// executor state).
+  static std::unique_ptr<Program> attach(SimState& state, std::string name, std::string text,
+                                         RunOptions options = {});
   ~Program();
   Program(const Program&) = delete;
   Program& operator=(const Program&) = delete;
@@ -123,7 +136,8 @@ class Program {
   [[nodiscard]] const MetaInstance* script_class(std::string_view name) const;
 
   /// @brief Fires at most @p n transitions. @return how many fired.
-  /// @throws vsd::Error (with the SOML++ call stack) when an action fails; that firing is undone.
+  /// @throws vsd::Error (with the SOML++ call stack) when an action fails; that firing is undone whole
+  /// (docs/soml.md 5.2): every property, marking, created and deleted instance is as before it.
   std::uint64_t step(std::uint64_t n = 1);
   /// @brief Fires until no transition is enabled or @p limit firings happened. @return how many fired.
   std::uint64_t run_until_quiet(std::uint64_t limit = 10'000'000);

@@ -18,6 +18,8 @@ class MetaProperty;
 
 namespace vsd::detail {
 
+/// Bytes of the bundle header ("VSDT" and the version) that write_tx_header() writes.
+inline constexpr std::size_t tx_header_size = 5;
 void write_tx_header(std::vector<std::uint8_t>& out);
 /// Create or Delete with the values of every non-reference, non-transient property.
 void write_lifecycle(std::vector<std::uint8_t>& out, Transaction::Op op, const SimStateInstance& inst);
