@@ -208,7 +208,7 @@ SimStateInstance* MetaInstance::construct(void* memory) const {
   obj->set_meta(*this);
   for (const MetaProperty* p : ref_props_) {
     void* at = static_cast<char*>(memory) + p->offset();
-    p->type().ops().bind(p->type(), at, obj, p);
+    detail::RefBinding::bind(at, p->type().is_ref_list(), obj, p);
   }
   // Only run-time classes are counted: an atomic add costs more than the rest of a pooled create.
   if (runtime_) live_.fetch_add(1, std::memory_order_relaxed);

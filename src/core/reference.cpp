@@ -129,18 +129,6 @@ struct RefAccess {
   }
 
   static std::vector<RefLink*>& links(RefListBase& r) noexcept { return r.links_; }
-  static void bind(RefListBase& r, SimStateInstance* holder, const MetaProperty* prop) noexcept {
-    r.holder_ = holder;
-    r.prop_ = prop;
-    for (RefLink* l : r.links_) {
-      l->holder = holder;
-      l->prop = prop;
-    }
-  }
-  static void bind(RefBase& r, SimStateInstance* holder, const MetaProperty* prop) noexcept {
-    r.link_.holder = holder;
-    r.link_.prop = prop;
-  }
 };
 
 void RefLink::reset(SimStateInstance* t) { RefAccess::reset(*this, t); }
@@ -192,8 +180,6 @@ RefListBase& RefListBase::operator=(RefListBase&& o) {
   }
   return *this;
 }
-
-RefListBase::~RefListBase() { clear_all(); }
 
 std::size_t RefListBase::index_of(const SimStateInstance* p) const noexcept {
   for (std::size_t i = 0; i < links_.size(); ++i)
@@ -333,7 +319,7 @@ void ref_read_bytes(const MetaType& t, void* p, ByteReader& in, const RefResolve
   static_cast<RefCore*>(p)->reset_target(target);
 }
 void ref_bind(const MetaType&, void* p, SimStateInstance* holder, const MetaProperty* prop) {
-  RefAccess::bind(*static_cast<RefBase*>(p), holder, prop);
+  RefBinding::bind(p, false, holder, prop);
 }
 
 void list_construct(const MetaType& t, void* dst) { ::new (dst) ListCore(is_composite_kind(t)); }
@@ -396,7 +382,7 @@ void list_read_bytes(const MetaType& t, void* p, ByteReader& in, const RefResolv
   *static_cast<RefListBase*>(p) = fresh;
 }
 void list_bind(const MetaType&, void* p, SimStateInstance* holder, const MetaProperty* prop) {
-  RefAccess::bind(*static_cast<RefListBase*>(p), holder, prop);
+  RefBinding::bind(p, true, holder, prop);
 }
 
 }  // namespace

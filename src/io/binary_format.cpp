@@ -269,7 +269,7 @@ class BinaryReader final : public LoadModel {
       const std::size_t frame_at = in_.position();
       const auto frame = read_frame();
       if (s.prop == nullptr) continue;  // reported once per class
-      SavedValue v{&s, frame_at, {}, static_cast<std::uint32_t>(ids_.size()), 0};
+      SavedValue v = new_value(s, x.offset, frame_at);
       const MetaType& type = s.prop->type();
       if (type.is_reference()) {
         read_references(frame_at, *s.prop, frame);
@@ -285,13 +285,12 @@ class BinaryReader final : public LoadModel {
         std::vector<std::uint8_t> bytes;
         ByteWriter w(bytes);
         type.write_bytes(converted.data(), w);
-        v.bytes = own(bytes);
+        set_bytes(v, own(bytes), frame_at);
       } else {
         check_value(frame_at, type, frame);
-        v.bytes = frame;
+        set_bytes(v, frame, frame_at);
       }
-      v.ids_count = static_cast<std::uint32_t>(ids_.size() - v.ids_first);
-      values_.push_back(v);
+      keep_value(v);
     }
     x.count = values_.size() - x.first;
     instances_.push_back(x);

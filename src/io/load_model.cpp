@@ -184,14 +184,15 @@ void LoadModel::finish() {
         if (id == null_id) continue;
         const SavedInstance* it = find(id);
         if (it == nullptr)
-          fail_at(v.offset, "dangling reference: #" + std::to_string(x.id) + "." + v.slot->prop->name() +
-                                " names #" + std::to_string(id) + ", which is not in the file");
+          fail_at(offset_of(x, v), "dangling reference: #" + std::to_string(x.id) + "." +
+                                       v.slot->prop->name() + " names #" + std::to_string(id) +
+                                       ", which is not in the file");
         const MetaInstance& target = *v.slot->prop->type().target();
         const MetaInstance& found = *it->entry->cls;
         if (!found.is_a(target))
-          fail_at(v.offset, "#" + std::to_string(x.id) + "." + v.slot->prop->name() + " names #" +
-                                std::to_string(id) + ", a '" + found.name() + "', which is not a '" +
-                                target.name() + "'");
+          fail_at(offset_of(x, v), "#" + std::to_string(x.id) + "." + v.slot->prop->name() + " names #" +
+                                       std::to_string(id) + ", a '" + found.name() + "', which is not a '" +
+                                       target.name() + "'");
       }
   check_composite_cycles();
   check_top();
@@ -241,9 +242,9 @@ void LoadModel::check_top() {
       if (!v.slot->prop->type().is_composite()) continue;
       for (Id id : ids_of(v))
         if (listed.count(id) != 0)
-          fail_at(v.offset, "top-level node #" + std::to_string(id) + " is held by #" + std::to_string(x.id) +
-                                "." + v.slot->prop->name() +
-                                ": a load attaches it, so nothing in the file may hold it");
+          fail_at(offset_of(x, v), "top-level node #" + std::to_string(id) + " is held by #" +
+                                       std::to_string(x.id) + "." + v.slot->prop->name() +
+                                       ": a load attaches it, so nothing in the file may hold it");
     }
 }
 
@@ -284,7 +285,7 @@ void LoadModel::check_composite_cycles() const {
         auto from = std::find_if(path.begin(), path.end(), [&](const Frame& p) { return p.inst == next; });
         for (bool first = true; from != path.end(); ++from, first = false)
           chain += (first ? " holds #" : ", which holds #") + std::to_string(instances_[from->inst].id);
-        fail_at(v.offset, "composite references form a cycle: " + chain);
+        fail_at(offset_of(instances_[f.inst], v), "composite references form a cycle: " + chain);
       }
       if (mark[next] == unvisited) {
         mark[next] = on_path;
@@ -303,6 +304,31 @@ LoadReport LoadModel::summary() const {
   report.version = version_;
   report.warnings = warnings_;
   return report;
+}
+
+// An upper bound of the size of the bundle that apply() writes (every varint counted at its widest).
+// Reserved at once, a bundle of a million instances is written without the copies and the fresh pages of
+// a vector grown by doubling: the reservation beyond what is written is never touched, so costs nothing.
+std::size_t LoadModel::bundle_bound(bool whole) const {
+  constexpr std::size_t varint_max = 10;
+  constexpr std::size_t frame = 4;
+  std::size_t n = 64;  // the header
+  for (const SavedInstance& x : instances_) {
+    n += 1 + 3 * varint_max + x.entry->cls->name().size();  // create: op, id, class, count
+    for (const SavedValue& v : values_of(x)) {
+      if (v.slot->prop == nullptr) continue;
+      const std::size_t name = varint_max + v.slot->prop->name().size();
+      if (v.slot->prop->type().is_reference()) {  // list inserts, or a set with two small frames
+        n += (std::max<std::size_t>(v.ids_count, 1)) * (1 + 4 * varint_max + name + 2 * frame);
+      } else {
+        n += name + frame + v.size;
+        // The Database's own values are sets, the old value being the state's (a guess: it may grow).
+        if (whole && &x == file_root_) n += 1 + varint_max + name + 2 * frame + 2 * v.size;
+      }
+    }
+  }
+  n += roots_.size() * (1 + 4 * varint_max + varint_max + Node::vsd_prop_children().name().size());
+  return n;
 }
 
 // Builds the bundle that creates the file's instances in @p state, under @p parent (nullptr: the state
@@ -344,6 +370,7 @@ LoadReport LoadModel::apply(SimState& state, Node* parent) {
   };
 
   std::vector<std::uint8_t> bundle;
+  bundle.reserve(bundle_bound(whole));
   vsd::detail::write_tx_header(bundle);
   std::size_t ops = 0;
   std::vector<vsd::detail::TxValue> values;
@@ -352,7 +379,7 @@ LoadReport LoadModel::apply(SimState& state, Node* parent) {
     values.clear();
     for (const SavedValue& v : values_of(x))
       if (v.slot->prop != nullptr && vsd::detail::carried_in_payload(*v.slot->prop))
-        values.emplace_back(v.slot->prop->name(), v.bytes);
+        values.emplace_back(v.slot->prop->name(), v.bytes());
     vsd::detail::write_create(bundle, mapped(x.id), x.entry->cls->name(), values);
     ++ops;
   }
@@ -362,7 +389,7 @@ LoadReport LoadModel::apply(SimState& state, Node* parent) {
       std::vector<std::uint8_t> now;
       ByteWriter w(now);
       v.slot->prop->type().write_bytes(v.slot->prop->address(state.database()), w);
-      vsd::detail::write_set(bundle, state.database().id(), v.slot->prop->name(), now, v.bytes);
+      vsd::detail::write_set(bundle, state.database().id(), v.slot->prop->name(), now, v.bytes());
       ++ops;
     }
   }

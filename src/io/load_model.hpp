@@ -41,12 +41,17 @@ struct ClassEntry {
   std::vector<Slot> slots;
 };
 
+// One value of a saved instance. 32 bytes: a load of a million instances holds several million of them,
+// and every byte of them is fresh memory the kernel faults in (40 bytes each cost ~60 ms more per 1M).
 struct SavedValue {
   const Slot* slot;
-  std::size_t offset;                   // in the file, for messages
-  std::span<const std::uint8_t> bytes;  // the value in the property's type (binary form)
-  std::uint32_t ids_first = 0;          // reference targets (file ids): ids_[ids_first, + ids_count)
+  const std::uint8_t* data = nullptr;  // the value in the property's type (binary form); not for references
+  std::uint32_t size = 0;
+  std::uint32_t delta = 0;      // its file position minus its instance's, for messages
+  std::uint32_t ids_first = 0;  // reference targets (file ids): ids_[ids_first, + ids_count)
   std::uint32_t ids_count = 0;
+
+  [[nodiscard]] std::span<const std::uint8_t> bytes() const noexcept { return {data, size}; }
 };
 
 struct SavedInstance {
@@ -122,6 +127,34 @@ class LoadModel {
   [[nodiscard]] std::span<const Id> ids_of(const SavedValue& v) const {
     return std::span<const Id>(ids_).subspan(v.ids_first, v.ids_count);
   }
+  /// A value of property slot @p s at file position @p at of the instance at @p instance_at; its
+  /// references are the ids that the reader appends to ids_ next.
+  [[nodiscard]] SavedValue new_value(const Slot& s, std::size_t instance_at, std::size_t at) const {
+    if (at - instance_at > UINT32_MAX) fail_at(at, "an instance cannot take more than 4 GiB of the file");
+    return SavedValue{
+        &s, nullptr, 0, static_cast<std::uint32_t>(at - instance_at), static_cast<std::uint32_t>(ids_.size()),
+        0};
+  }
+  /// Sets the bytes of @p v (at most 4 GiB: a value's frame in a bundle is that big at most).
+  void set_bytes(SavedValue& v, std::span<const std::uint8_t> bytes, std::size_t at) const {
+    if (bytes.size() > UINT32_MAX) fail_at(at, "a value cannot take more than 4 GiB");
+    v.data = bytes.data();
+    v.size = static_cast<std::uint32_t>(bytes.size());
+  }
+  /// Keeps @p v unless it is a reference value without targets: the property then keeps its default (an
+  /// empty list or null, as a new instance has), and most lists of a tree (a leaf's children) cost no value.
+  void keep_value(SavedValue& v) {
+    v.ids_count = static_cast<std::uint32_t>(ids_.size() - v.ids_first);
+    if (v.slot->prop->type().is_reference() &&
+        (v.ids_count == 0 || (v.ids_count == 1 && ids_[v.ids_first] == null_id))) {
+      ids_.resize(v.ids_first);
+      return;
+    }
+    values_.push_back(v);
+  }
+  [[nodiscard]] static std::size_t offset_of(const SavedInstance& x, const SavedValue& v) {
+    return x.offset + v.delta;
+  }
   [[nodiscard]] std::span<const SavedValue> values_of(const SavedInstance& x) const {
     return std::span<const SavedValue>(values_).subspan(x.first, x.count);
   }
@@ -144,6 +177,7 @@ class LoadModel {
 
  private:
   void check_composite_cycles() const;
+  [[nodiscard]] std::size_t bundle_bound(bool whole) const;
 
   std::deque<std::vector<std::uint8_t>> arena_;  // chunks that are filled, never grown
   [[nodiscard]] const SavedInstance* find(Id id) const {

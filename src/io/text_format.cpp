@@ -663,14 +663,14 @@ class TextSnapshotReader final : public LoadModel {
         const std::size_t resume = in_.position();
         for (const auto& [name, value_at] : early) {
           in_.seek(value_at);
-          read_property(*tc, name, value_at);
+          read_property(*tc, name, value_at, x.offset);
         }
         in_.seek(resume);
       } else if (tc == nullptr) {
         early.emplace_back(key, in_.token_start());
         in_.skip_value();
       } else {
-        read_property(*tc, key, key_at);
+        read_property(*tc, key, key_at, x.offset);
       }
     });
     if (!has_id) fail_at(x.offset, "an instance needs an \"@id\"");
@@ -679,7 +679,7 @@ class TextSnapshotReader final : public LoadModel {
     instances_.push_back(x);
   }
 
-  void read_property(TextClass& tc, const std::string& key, std::size_t key_at) {
+  void read_property(TextClass& tc, const std::string& key, std::size_t key_at, std::size_t instance_at) {
     const ClassEntry& e = *tc.entry;
     const MetaProperty* prop = e.cls->find_property(key);  // through aliases too
     std::size_t index = e.slots.size();
@@ -703,7 +703,7 @@ class TextSnapshotReader final : public LoadModel {
       return;
     }
     const std::size_t at = in_.token_start();
-    SavedValue v{&s, at, {}, static_cast<std::uint32_t>(ids_.size()), 0};
+    SavedValue v = new_value(s, instance_at, at);
     const MetaType& type = s.prop->type();
     if (type.is_ref_list()) {
       read_array([&] {
@@ -732,10 +732,9 @@ class TextSnapshotReader final : public LoadModel {
       } else {
         type.write_bytes(scratch.data(), w);
       }
-      v.bytes = own(bytes_);
+      set_bytes(v, own(bytes_), at);
     }
-    v.ids_count = static_cast<std::uint32_t>(ids_.size() - v.ids_first);
-    values_.push_back(v);
+    keep_value(v);
   }
 
   TextReader in_;

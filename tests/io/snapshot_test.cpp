@@ -47,6 +47,41 @@ TEST_P(Snapshot, WholeStateRoundTripKeepsIdsAndEverything) {
   EXPECT_EQ(vsd::io::save_bytes(copy, format()), bytes) << "saving what was loaded gives the same bytes";
 }
 
+// A load keeps no value for a reference without targets (an empty list, a null reference): the property
+// keeps what a new instance has. Whole state and under a node, the result is the saved state.
+TEST_P(Snapshot, EmptyListsAndNullReferencesLoadAsDefaults) {
+  vsd::Environment env;
+  vsd::SimState& s = env.main_state();
+  auto& bare = s.create<TRobot>();  // no tool, no target, no children, extensions or watched
+  bare.set_name("bare");
+  s.database().add_child(bare);
+  auto& held = s.create<TRobot>();
+  held.set_name("held");
+  bare.add_child(held);
+  const auto bytes = vsd::io::save_bytes(s, format());
+
+  auto& copy = env.create_state("copy");
+  vsd::io::load_bytes(copy, bytes);
+  EXPECT_EQ(diff_of(s, copy), "");
+  EXPECT_EQ(vsd_test::check_reference_counts(copy), "");
+  EXPECT_EQ(vsd::io::save_bytes(copy, format()), bytes);
+
+  auto& under = env.create_state("under");
+  auto& parent = under.create<vsd::Node>();
+  under.database().add_child(parent);
+  const vsd::io::LoadReport report = vsd::io::load_bytes(parent, bytes);
+  ASSERT_EQ(report.roots.size(), 1u);
+  auto* loaded = dynamic_cast<TRobot*>(report.roots[0]);
+  ASSERT_NE(loaded, nullptr);
+  EXPECT_EQ(loaded->tool().get(), nullptr);
+  EXPECT_EQ(loaded->target().get(), nullptr);
+  EXPECT_TRUE(loaded->extensions().empty());
+  ASSERT_EQ(loaded->children().size(), 1u);
+  EXPECT_EQ(loaded->children()[0]->name(), "held");
+  EXPECT_TRUE(loaded->children()[0]->children().empty());
+  EXPECT_EQ(vsd_test::check_reference_counts(under), "");
+}
+
 // A frame's rotation is stored as its exact matrix: an arbitrary rotation comes back bit for bit.
 TEST_P(Snapshot, FramesRoundTripExactly) {
   vsd::Environment env;

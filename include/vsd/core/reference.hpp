@@ -32,7 +32,8 @@ namespace vsd {
 
 namespace detail {
 
-struct RefAccess;  // the SimState's access to link internals (reference.cpp, sim_state.cpp)
+struct RefAccess;   // the SimState's access to link internals (reference.cpp, sim_state.cpp)
+struct RefBinding;  // binds a property's reference storage to its holder (below)
 
 /// One reference: an entry in the intrusive list of its target's holders.
 struct RefLink {
@@ -89,6 +90,7 @@ class RefBase {
 
  private:
   friend struct detail::RefAccess;
+  friend struct detail::RefBinding;
   detail::RefLink link_;
 };
 
@@ -137,7 +139,10 @@ class RefListBase {
   RefListBase& operator=(const RefListBase& o);
   RefListBase(RefListBase&& o) noexcept;
   RefListBase& operator=(RefListBase&& o);
-  ~RefListBase();
+  // Inline: most lists die empty (the children of a deleted leaf), and then cost no call.
+  ~RefListBase() {
+    if (!links_.empty()) clear_all();
+  }
 
   [[nodiscard]] std::size_t size() const noexcept { return links_.size(); }
   [[nodiscard]] bool empty() const noexcept { return links_.empty(); }
@@ -158,6 +163,7 @@ class RefListBase {
 
  private:
   friend struct detail::RefAccess;
+  friend struct detail::RefBinding;
   std::vector<detail::RefLink*> links_;
   SimStateInstance* holder_ = nullptr;
   const MetaProperty* prop_ = nullptr;
@@ -165,6 +171,26 @@ class RefListBase {
 };
 
 namespace detail {
+/// Binds the reference storage of a property (a RefBase or a RefListBase at @p at) to the instance and
+/// property holding it: inline, so that constructing an instance binds its references without a call.
+struct RefBinding {
+  static void bind(void* at, bool list, SimStateInstance* holder, const MetaProperty* prop) noexcept {
+    if (list) {
+      auto& r = *static_cast<RefListBase*>(at);
+      r.holder_ = holder;
+      r.prop_ = prop;
+      for (RefLink* l : r.links_) {
+        l->holder = holder;
+        l->prop = prop;
+      }
+    } else {
+      RefLink& l = static_cast<RefBase*>(at)->link_;
+      l.holder = holder;
+      l.prop = prop;
+    }
+  }
+};
+
 template <class T, class Base>
 class TypedRefList : public Base {
  public:
