@@ -49,7 +49,6 @@ class FieldbusAxisAdapter final : public HardwareAdapter {
   fieldbus::SimulatedDrive drive_;
   bool on_ = false;
   bool reset_requested_ = false;
-  bool resetting_ = false;
   int enabling_cycles_ = 0;
 };
 
