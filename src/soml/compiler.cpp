@@ -1252,7 +1252,7 @@ class Compiler {
         if (r.value) {
           const int v = temp();
           expr_to(*r.value, v, F.result_type);
-          emit(OP_RET, v);
+          emit(F.result == RK::V ? OP_RETV : OP_RET, v);
         } else {
           emit(OP_RET0);
         }

@@ -88,6 +88,7 @@ enum Op : std::uint8_t {
   OP_VCALL,    // like CALL, but b is a virtual slot resolved on the class of self
   OP_RET,      // return register a
   OP_RET0,     // return nothing
+  OP_RETV,     // return vector register a (a function whose result is a vector)
   OP_SELF,     // a = instance of scope b levels out (outer plan b)
   OP_MARK,     // a = mark
   OP_OBJ,      // a = id of object consts[b]
@@ -273,6 +274,9 @@ class ProgramImpl {
   // ---- VM ----
   // Runs function @p f on @p self with arguments in args (count f.nparams); returns the result.
   Val exec(std::size_t entry);
+  void vector_op(Ins in, const Frame& frame);  // OP_MOVV .. OP_PVGET (vm.cpp)
+  void store_vector(const MetaProperty& p, SimStateInstance& o, const VecReg& v);
+  std::uint64_t new_instance(Ins in, const Frame& frame);  // OP_NEW
   // Vector arguments come from @p vargs (indexed like args), a vector result goes to @p vresult.
   Val run(int f, std::uint64_t self, std::uint64_t mark, const Val* args, const std::string* sargs,
           std::string* sresult = nullptr, const VecReg* vargs = nullptr, VecReg* vresult = nullptr);

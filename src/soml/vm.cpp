@@ -248,6 +248,127 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
   }
 }
 
+// `new C(args)`, out of line (its argument arrays would weigh on the interpreter loop's frame).
+[[gnu::noinline]] std::uint64_t ProgramImpl::new_instance(const Ins in, const Frame& frame) {
+  const Val* R = regs_.data() + frame.base;
+  const std::string* S = sregs_.data() + frame.base;
+  const ClassInfo* ci = classes_[in.b];
+  if (ci == nullptr) return state_.create(*class_metas_[in.b]).id();
+  const Function* ctor = ci->ctor >= 0 ? functions_[static_cast<std::size_t>(ci->ctor)].get() : nullptr;
+  if (in.c > 8) fail("more than 8 constructor arguments");
+  std::string sargs[8];
+  VecReg vargs[8];
+  Val args[8];
+  for (int i = 0; i < in.c; ++i) {
+    const RK k = ctor != nullptr ? ctor->param_kinds[static_cast<std::size_t>(i)] : RK::None;
+    if (k == RK::S) sargs[i] = S[in.a + 1 + i];
+    if (k == RK::V) vargs[i] = vregs_[frame.base + in.a + 1 + i];
+    args[i] = R[in.a + 1 + i];
+  }
+  return instantiate(*ci, nullptr, "", args, sargs, in.c, vargs).id();
+}
+
+// A vector property store, out of line like the vector instructions: through the setter like every
+// other store, so the change signals and records.
+[[gnu::noinline]] void ProgramImpl::store_vector(const MetaProperty& p, SimStateInstance& o,
+                                                 const VecReg& v) {
+  const Value value = vector_value(p.type(), v, "property '" + p.name() + "'");
+  p.assign_raw(o, value.data());
+}
+
+// The vector instructions, out of line: they are rare next to the arithmetic and calls that the
+// interpreter loop keeps in registers (fib(27) and the 10^7 loop of benchmarks/ must not pay for them).
+[[gnu::noinline]] void ProgramImpl::vector_op(const Ins in, const Frame& frame) {
+  Val* R = regs_.data() + frame.base;
+  std::string* S = sregs_.data() + frame.base;
+  VecReg* V = vregs_.data() + frame.base;
+  auto obj = [&](std::uint64_t id) -> SimStateInstance& {
+    SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
+    if (o == nullptr)
+      fail(id == 0 ? "null reference" : "reference to a deleted instance (id " + std::to_string(id) + ")");
+    return *o;
+  };
+  switch (in.op) {
+    case OP_MOVV:
+      V[in.a] = V[in.b];
+      break;
+    case OP_VCLEAR: {
+      VecReg& v = V[in.a];
+      v.v.clear();
+      v.s.clear();
+      break;
+    }
+    case OP_VSIZE:
+      R[in.a].i = static_cast<std::int64_t>(V[in.b].size());
+      break;
+    case OP_VGET:
+    case OP_VSET: {
+      VecReg& v = V[(in.op == OP_VGET ? in.b : in.a)];
+      const std::int64_t i = R[in.op == OP_VGET ? in.c : in.b].i;
+      if (i < 0 || static_cast<std::size_t>(i) >= v.size()) {
+        fail("index " + std::to_string(i) + " out of range (size " + std::to_string(v.size()) + ")");
+      }
+      const auto k = static_cast<std::size_t>(i);
+      if (in.op == OP_VGET) {
+        if (in.x != 0)
+          S[in.a] = v.s[k];
+        else
+          R[in.a] = v.v[k];
+      } else if (in.x != 0) {
+        v.s[k] = S[in.c];
+      } else {
+        v.v[k] = R[in.c];
+      }
+      break;
+    }
+    case OP_VPUSH: {
+      VecReg& v = V[in.a];
+      if (in.x != 0)
+        v.s.push_back(S[in.b]);
+      else
+        v.v.push_back(R[in.b]);
+      break;
+    }
+    case OP_EQV: {
+      const VecReg& l = V[in.b];
+      const VecReg& r = V[in.c];
+      bool eq = l.size() == r.size();
+      if (eq && in.x == 2) {
+        eq = l.s == r.s;
+      } else {
+        for (std::size_t k = 0; eq && k < l.v.size(); ++k)
+          eq = in.x == 1 ? l.v[k].d == r.v[k].d : l.v[k].i == r.v[k].i;
+      }
+      R[in.a].i = eq ? 1 : 0;
+      break;
+    }
+    case OP_PVSIZE:
+    case OP_PVGET: {
+      const std::uint64_t id = R[in.b].id;
+      SimStateInstance& o = obj(id);
+      const MetaProperty& p = *props_[in.c].prop;
+      if (!o.meta().is_a(p.owner())) {
+        fail("instance of " + o.meta().name() + " has no property '" + p.name() + "'");
+      }
+      if (deps_ != nullptr) deps_->emplace_back(id, &p);
+      const void* addr = p.address(o);
+      const std::size_t n = vector_size(p.type(), addr);
+      if (in.op == OP_PVSIZE) {
+        R[in.a].i = static_cast<std::int64_t>(n);
+        break;
+      }
+      const std::int64_t i = R[in.a].i;
+      if (i < 0 || static_cast<std::size_t>(i) >= n) {
+        fail("index " + std::to_string(i) + " out of range (size " + std::to_string(n) + ")");
+      }
+      vector_at(p.type(), addr, static_cast<std::size_t>(i), R[in.a], S[in.a]);
+      break;
+    }
+    default:
+      fail("bad instruction");
+  }
+}
+
 Val ProgramImpl::exec(std::size_t entry) {
   Frame* fr = &frames_.back();
   const Ins* code = fr->fn->code.data();
@@ -490,17 +611,15 @@ Val ProgramImpl::exec(std::size_t entry) {
         VSD_REFRESH();
         break;
       }
+      case OP_RETV:  // a vector result: into the frame's first vector register, then as OP_RET
+        if (in.a != 0) vregs_[fr->base] = std::move(vregs_[fr->base + in.a]);
+        [[fallthrough]];
       case OP_RET:
       case OP_RET0: {
         Val v{};
-        if (in.op == OP_RET) {
+        if (in.op != OP_RET0) {
           v = R[in.a];
-          if (in.a != 0 && fr->fn->result >= RK::S) {
-            if (fr->fn->result == RK::S)
-              S[0] = std::move(S[in.a]);
-            else if (fr->fn->result == RK::V)
-              vregs_[fr->base] = std::move(vregs_[fr->base + in.a]);
-          }
+          if (fr->fn->result == RK::S && in.a != 0) S[0] = std::move(S[in.a]);
         }
         R[0] = v;
         frames_.pop_back();
@@ -627,12 +746,9 @@ Val ProgramImpl::exec(std::size_t entry) {
             }
             break;
           }
-          case PK::Vector: {
-            // Through the setter like every other store, so the change signals and records.
-            const Value v = vector_value(p.type(), vregs_[fr->base + in.b], "property '" + p.name() + "'");
-            p.assign_raw(o, v.data());
+          case PK::Vector:
+            store_vector(p, o, vregs_[fr->base + in.b]);
             break;
-          }
           default:
             if (p.type().kind() == TypeKind::Float) {
               const auto f = static_cast<float>(R[in.b].d);
@@ -713,27 +829,9 @@ Val ProgramImpl::exec(std::size_t entry) {
       }
       case OP_NEW: {
         VSD_SAVE();
-        const ClassInfo* ci = classes_[in.b];
-        SimStateInstance* made;
-        if (ci != nullptr) {
-          const Function* ctor =
-              ci->ctor >= 0 ? functions_[static_cast<std::size_t>(ci->ctor)].get() : nullptr;
-          std::string sargs[8];
-          VecReg vargs[8];
-          if (in.c > 8) fail("more than 8 constructor arguments");
-          for (int i = 0; i < in.c; ++i) {
-            const RK k = ctor != nullptr ? ctor->param_kinds[static_cast<std::size_t>(i)] : RK::None;
-            if (k == RK::S) sargs[i] = S[in.a + 1 + i];
-            if (k == RK::V) vargs[i] = vregs_[fr->base + in.a + 1 + i];
-          }
-          Val args[8];
-          for (int i = 0; i < in.c; ++i) args[i] = R[in.a + 1 + i];
-          made = &instantiate(*ci, nullptr, "", args, sargs, in.c, vargs);
-        } else {
-          made = &state_.create(*class_metas_[in.b]);
-        }
+        const std::uint64_t made = new_instance(in, *fr);
         VSD_REFRESH();
-        R[in.a].id = made->id();
+        R[in.a].id = made;
         break;
       }
       case OP_ISA:
@@ -892,83 +990,17 @@ Val ProgramImpl::exec(std::size_t entry) {
         pc = VSD_TARGET(in);
         break;
       case OP_MOVV:
-        vregs_[fr->base + in.a] = vregs_[fr->base + in.b];
-        break;
-      case OP_VCLEAR: {
-        VecReg& v = vregs_[fr->base + in.a];
-        v.v.clear();
-        v.s.clear();
-        break;
-      }
+      case OP_VCLEAR:
       case OP_VSIZE:
-        R[in.a].i = static_cast<std::int64_t>(vregs_[fr->base + in.b].size());
-        break;
       case OP_VGET:
-      case OP_VSET: {
-        VecReg& v = vregs_[fr->base + (in.op == OP_VGET ? in.b : in.a)];
-        const std::int64_t i = R[in.op == OP_VGET ? in.c : in.b].i;
-        if (i < 0 || static_cast<std::size_t>(i) >= v.size()) {
-          VSD_SAVE();
-          fail("index " + std::to_string(i) + " out of range (size " + std::to_string(v.size()) + ")");
-        }
-        const auto k = static_cast<std::size_t>(i);
-        if (in.op == OP_VGET) {
-          if (in.x != 0)
-            S[in.a] = v.s[k];
-          else
-            R[in.a] = v.v[k];
-        } else if (in.x != 0) {
-          v.s[k] = S[in.c];
-        } else {
-          v.v[k] = R[in.c];
-        }
-        break;
-      }
-      case OP_VPUSH: {
-        VecReg& v = vregs_[fr->base + in.a];
-        if (in.x != 0)
-          v.s.push_back(S[in.b]);
-        else
-          v.v.push_back(R[in.b]);
-        break;
-      }
-      case OP_EQV: {
-        const VecReg& l = vregs_[fr->base + in.b];
-        const VecReg& r = vregs_[fr->base + in.c];
-        bool eq = l.size() == r.size();
-        if (eq && in.x == 2) {
-          eq = l.s == r.s;
-        } else {
-          for (std::size_t k = 0; eq && k < l.v.size(); ++k)
-            eq = in.x == 1 ? l.v[k].d == r.v[k].d : l.v[k].i == r.v[k].i;
-        }
-        R[in.a].i = eq ? 1 : 0;
-        break;
-      }
+      case OP_VSET:
+      case OP_VPUSH:
+      case OP_EQV:
       case OP_PVSIZE:
-      case OP_PVGET: {
-        const std::uint64_t id = R[in.b].id;
-        SimStateInstance& o = obj(id);
-        const MetaProperty& p = *props_[in.c].prop;
-        if (!o.meta().is_a(p.owner())) {
-          VSD_SAVE();
-          fail("instance of " + o.meta().name() + " has no property '" + p.name() + "'");
-        }
-        if (deps_ != nullptr) deps_->emplace_back(id, &p);
-        const void* addr = p.address(o);
-        const std::size_t n = vector_size(p.type(), addr);
-        if (in.op == OP_PVSIZE) {
-          R[in.a].i = static_cast<std::int64_t>(n);
-          break;
-        }
-        const std::int64_t i = R[in.a].i;
-        if (i < 0 || static_cast<std::size_t>(i) >= n) {
-          VSD_SAVE();
-          fail("index " + std::to_string(i) + " out of range (size " + std::to_string(n) + ")");
-        }
-        vector_at(p.type(), addr, static_cast<std::size_t>(i), R[in.a], S[in.a]);
+      case OP_PVGET:
+        VSD_SAVE();
+        vector_op(in, *fr);
         break;
-      }
       default:
         VSD_SAVE();
         fail("bad instruction");
