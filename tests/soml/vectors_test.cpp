@@ -222,4 +222,28 @@ TEST_F(Vectors, WhatTheVmCannotHoldIsRefusedWithAPosition) {
               HasSubstr("c.soml:2:18: error: printing a value of type 'vector<int64>'"));
 }
 
+TEST_F(Vectors, TheDebuggerShowsVectorLocalsAndPrintsThem) {
+  Program& p = load(R"(vector<string> names;
+int f() {
+  vector<double> v;
+  v.push(1.5);
+  v.push(2);
+  vector<string> w = names;
+  return v.size() + w.size();
+}
+)");
+  p.root().set("names", vsd::Value(std::vector<std::string>{"a", "b\"c"}));
+  vsd::soml::Debugger d(p);
+  d.break_at_line(7);
+  std::string locals, printed;
+  d.on_stop([&](vsd::soml::Debugger& dd, const vsd::soml::Stop&) {
+    for (const auto& v : dd.locals()) locals += v.type + " " + v.name + " = " + v.value + "; ";
+    printed = dd.print("w");
+    return vsd::soml::Resume::Continue;
+  });
+  EXPECT_EQ(p.root().call("f", {}).as<std::int64_t>(), 4);
+  EXPECT_EQ(locals, "vector<double> v = [1.5, 2.0]; vector<string> w = [\"a\", \"b\\\"c\"]; ");
+  EXPECT_EQ(printed, "w = [\"a\", \"b\\\"c\"]");
+}
+
 }  // namespace
