@@ -1034,6 +1034,13 @@ class Compiler {
         top_ = base + 1;
         return base;
       }
+      case Builtin::Find: {
+        const int path = expr(*e.args.at(0));
+        const int r = temp();
+        at(e.loc);
+        emit(OP_FIND, r, path);
+        return r;
+      }
       case Builtin::PlaceCount: {
         const int p = place_reg();
         const int r = temp();

@@ -121,7 +121,8 @@ enum Op : std::uint8_t {
   OP_VPUSH,   // V[a].push(b)
   OP_EQV,     // a = V[b] == V[c]
   OP_PVSIZE,  // a = size of vector property props[c] of instance b (no copy)
-  OP_PVGET    // a = element R[a] of vector property props[c] of instance b (no copy; range-checked)
+  OP_PVGET,   // a = element R[a] of vector property props[c] of instance b (no copy; range-checked)
+  OP_FIND     // a = the node at path S[b] from the database, or null
 };
 
 struct Ins {
@@ -277,6 +278,7 @@ class ProgramImpl {
   void vector_op(Ins in, const Frame& frame);  // OP_MOVV .. OP_PVGET (vm.cpp)
   void store_vector(const MetaProperty& p, SimStateInstance& o, const VecReg& v);
   std::uint64_t new_instance(Ins in, const Frame& frame);  // OP_NEW
+  std::uint64_t find_node(const std::string& path) const;  // OP_FIND
   // Vector arguments come from @p vargs (indexed like args), a vector result goes to @p vresult.
   Val run(int f, std::uint64_t self, std::uint64_t mark, const Val* args, const std::string* sargs,
           std::string* sresult = nullptr, const VecReg* vargs = nullptr, VecReg* vresult = nullptr);

@@ -11,6 +11,7 @@
 #include <type_traits>
 
 #include "program_impl.hpp"
+#include "vsd/core/database.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/core/instance.hpp"
 #include "vsd/core/meta_method.hpp"
@@ -266,6 +267,25 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
     args[i] = R[in.a + 1 + i];
   }
   return instantiate(*ci, nullptr, "", args, sargs, in.c, vargs).id();
+}
+
+// find(path): names from the database down, separated by '/', as Node::path() writes them (a leading
+// '/' is optional; "/" is the database). Each step is the first child of that name; null when a step
+// is missing or a name is empty.
+[[gnu::noinline]] std::uint64_t ProgramImpl::find_node(const std::string& path) const {
+  const Node* n = &state_.database();
+  std::string_view rest = path;
+  if (!rest.empty() && rest.front() == '/') rest.remove_prefix(1);
+  if (rest.empty()) return path.empty() ? 0 : n->id();
+  while (n != nullptr) {
+    const std::size_t slash = rest.find('/');
+    const std::string_view name = rest.substr(0, slash);
+    if (name.empty()) return 0;
+    n = n->find_child(name);
+    if (slash == std::string_view::npos) break;
+    rest.remove_prefix(slash + 1);
+  }
+  return n != nullptr ? n->id() : 0;
 }
 
 // A vector property store, out of line like the vector instructions: through the setter like every
@@ -1000,6 +1020,9 @@ Val ProgramImpl::exec(std::size_t entry) {
       case OP_PVGET:
         VSD_SAVE();
         vector_op(in, *fr);
+        break;
+      case OP_FIND:
+        R[in.a].id = find_node(S[in.b]);
         break;
       default:
         VSD_SAVE();
