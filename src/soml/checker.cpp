@@ -126,8 +126,9 @@ struct BuiltinFn {
   Builtin id;
 };
 constexpr BuiltinFn builtin_functions[] = {
-    {"print", Builtin::Print}, {"sqrt", Builtin::Sqrt}, {"abs", Builtin::Abs}, {"floor", Builtin::Floor},
-    {"ceil", Builtin::Ceil},   {"min", Builtin::Min},   {"max", Builtin::Max}, {"len", Builtin::Len}};
+    {"print", Builtin::Print}, {"sqrt", Builtin::Sqrt}, {"abs", Builtin::Abs},
+    {"floor", Builtin::Floor}, {"ceil", Builtin::Ceil}, {"min", Builtin::Min},
+    {"max", Builtin::Max},     {"len", Builtin::Len},   {"find", Builtin::Find}};
 
 class CheckerImpl {
  public:
@@ -1153,6 +1154,9 @@ Type CheckerImpl::check_builtin_call(CallExpr& e, Builtin id, std::string_view n
     case Builtin::Len:
       if (arity(1)) expect_type(*e.args[0], Type::of(K::String), cx, "the argument of 'len'");
       return integer;
+    case Builtin::Find:
+      if (arity(1)) expect_type(*e.args[0], Type::of(K::String), cx, "the path of 'find'");
+      return Type::reference(ClassRef{nullptr, &Node::static_meta()}, true);
     case Builtin::PlaceCount:
       diag_.error(e.loc, "'count' is a property of the place, not a function: write 'p.count'");
       return Type::error();

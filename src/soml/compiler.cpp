@@ -4,6 +4,7 @@
 #include <bit>
 #include <cstring>
 #include <string>
+#include <tuple>
 
 #include "program_impl.hpp"
 #include "vsd/core/error.hpp"
@@ -28,10 +29,33 @@ RK reg_kind(const Type& t) noexcept {
     case K::Null:
     case K::Place:
       return RK::R;
+    case K::Vector:
+      return t.meta != nullptr && vector_elem_kind(*t.meta) != RK::None ? RK::V : RK::None;
     default:
       return RK::None;
   }
 }
+
+namespace {
+
+// The static type of the elements of vector type t (a register holds them as int, double or string).
+Type element_type(const Type& t) {
+  const MetaType* e = t.meta != nullptr ? t.meta->element() : nullptr;
+  if (e == nullptr) return Type::error();
+  switch (e->kind()) {
+    case TypeKind::Bool:
+      return Type::of(K::Bool);
+    case TypeKind::Float:
+    case TypeKind::Double:
+      return Type::of(K::Double);
+    case TypeKind::String:
+      return Type::of(K::String);
+    default:
+      return Type::of(K::Int);
+  }
+}
+
+}  // namespace
 
 std::string where(const ProgramImpl& p, SourceLoc loc) {
   return p.checked_->source->name() + ":" + std::to_string(loc.line) + ":" + std::to_string(loc.column);
@@ -67,6 +91,12 @@ class Compiler {
                          static_cast<std::uint16_t>(c)});
     F.lines.push_back(line_);
     return F.code.size() - 1;
+  }
+  // A vector instruction whose x says the element kind (1: strings).
+  std::size_t emit_v(Op op, const Type& vec, int a = 0, int b = 0, int c = 0) {
+    const std::size_t i = emit(op, a, b, c);
+    F.code[i].x = element_type(vec).kind == K::String ? 1 : 0;
+    return i;
   }
   std::size_t emit_jump(Op op, int a = 0, int b = 0) {
     // The target goes into c (low 16 bits) and x (high 8 bits); a and b stay free for fused tests.
@@ -171,6 +201,9 @@ class Compiler {
       case TypeKind::SharedRefList:
         s.kind = PK::List;
         break;
+      case TypeKind::Vector:
+        s.kind = vector_elem_kind(t) != RK::None ? PK::Vector : PK::Other;
+        break;
       default:
         s.kind = PK::Other;
     }
@@ -216,7 +249,7 @@ class Compiler {
   }
   void move(int dst, int src, RK k) {
     if (dst == src) return;
-    emit(k == RK::S ? OP_MOVS : OP_MOV, dst, src);
+    emit(k == RK::S ? OP_MOVS : k == RK::V ? OP_MOVV : OP_MOV, dst, src);
   }
   void expr_to(const Expr& e, int dst, const Type& want) {
     const int save = top_;
@@ -431,7 +464,89 @@ class Compiler {
     not_supported(P, e.loc, "this list or vector expression (lists are reached as properties)");
   }
 
+  // The holder register and property slot when e is a vector property (read in place, written through
+  // the setter); {-1, -1} for any other vector expression (a value in a vector register).
+  std::pair<int, int> vector_property(const Expr& e) {
+    const Binding* b = nullptr;
+    if (e.kind == ExprKind::Member || e.kind == ExprKind::Name)
+      b = e.kind == ExprKind::Member ? &e.as<MemberExpr>().binding : &e.as<NameExpr>().binding;
+    if (b == nullptr || (b->kind != BK::Property && b->kind != BK::MetaProperty)) return {-1, -1};
+    const int slot = prop_slot(*b, e.loc);
+    if (P.props_[slot].kind != PK::Vector) not_supported(P, e.loc, "a value of type '" + e.type.name() + "'");
+    const int h = e.kind == ExprKind::Member ? expr(*e.as<MemberExpr>().object) : self_at(b->outer, e.loc);
+    return {h, slot};
+  }
+  // The vector register of a vector-valued expression that is not a property (a local: its slot).
+  int vector_reg(const Expr& e) {
+    value_check(e);
+    return expr(e);
+  }
+
+  int vector_index(const IndexExpr& e) {
+    auto [h, slot] = vector_property(*e.object);
+    if (h >= 0) {
+      const int r = temp();
+      expr_to(*e.index, r, e.index->type);
+      at(e.loc);
+      emit(OP_PVGET, r, h, slot);
+      return r;
+    }
+    const int v = vector_reg(*e.object);
+    const int i = expr(*e.index);
+    const int r = temp();
+    at(e.loc);
+    emit_v(OP_VGET, e.object->type, r, v, i);
+    return r;
+  }
+
+  // `v[i] = x` and `v[i] op= x`: a local is changed in its register; a property is read, changed and
+  // written back through its setter (so the change signals and records). @p op is None for `=`.
+  void store_element(const IndexExpr& ix, TokenKind op, const Expr* rhs, int value, const Type& vt) {
+    const Type& vec = ix.object->type;
+    const Type elem = element_type(vec);
+    int h = -1, slot = -1, v = -1;
+    if (ix.object->kind == ExprKind::Name && ix.object->as<NameExpr>().binding.kind == BK::Local) {
+      v = ix.object->as<NameExpr>().binding.slot;
+    } else {
+      std::tie(h, slot) = vector_property(*ix.object);
+      if (h < 0) not_supported(P, ix.loc, "assigning to an element of a temporary vector");
+      v = temp();
+      at(ix.loc);
+      emit(OP_GETP, v, h, slot);
+    }
+    const int i = expr_fresh(*ix.index, ix.index->type);
+    if (op != TokenKind::Eof) {  // compound: the current element, the operation, back
+      const int cur = temp();
+      at(ix.loc);
+      emit_v(OP_VGET, vec, cur, v, i);
+      int r;
+      Type rt;
+      if (rhs != nullptr) {
+        r = expr(*rhs);
+        rt = rhs->type;
+      } else {
+        r = temp();
+        load_int(r, 1);
+        rt = Type::of(K::Int);
+      }
+      Type result = elem;
+      if (result.kind == K::Int && rt.kind == K::Double) result = Type::of(K::Double);
+      value = arith(op, cur, elem, r, rt, result, ix.loc);
+      if (result.kind == K::Double && elem.kind == K::Int) {
+        const int t = temp();
+        emit(OP_D2I, t, value);
+        value = t;
+      }
+    } else {
+      value = coerce(value, vt, elem);
+    }
+    at(ix.loc);
+    emit_v(OP_VSET, vec, v, i, value);
+    if (h >= 0) emit(OP_SETP, h, v, slot);
+  }
+
   int index(const IndexExpr& e) {
+    if (e.object->type.kind == K::Vector) return vector_index(e);
     auto [h, slot] = list_of(*e.object);
     const int r = temp();
     expr_to(*e.index, r, e.index->type);
@@ -537,6 +652,13 @@ class Compiler {
 
   int compare(TokenKind op, int l, const Type& lt, int r, const Type& rt, int into = -1) {
     const int d = into >= 0 ? into : temp();
+    if (lt.kind == K::Vector) {  // == and != (the checker allows no other)
+      const K ek = element_type(lt).kind;
+      const std::size_t i = emit(OP_EQV, d, l, r);
+      F.code[i].x = ek == K::String ? 2 : ek == K::Double ? 1 : 0;
+      if (op == TokenKind::BangEqual) emit(OP_NOT, d, d);
+      return d;
+    }
     const bool dbl = (lt.kind == K::Double || rt.kind == K::Double);
     const bool str = lt.kind == K::String;
     if (dbl) {
@@ -670,6 +792,9 @@ class Compiler {
         emit(OP_SETP, o, coerce(v, vt, e.type), prop_slot(m.binding, e.loc));
         return;
       }
+    } else if (e.kind == ExprKind::Index && e.as<IndexExpr>().object->type.kind == K::Vector) {
+      store_element(e.as<IndexExpr>(), TokenKind::Eof, nullptr, v, vt);
+      return;
     }
     not_supported(P, e.loc, "assigning to this expression");
   }
@@ -684,6 +809,11 @@ class Compiler {
       if (op == TokenKind::Minus) k = -k;
       const int slot = target.as<NameExpr>().binding.slot;
       emit(OP_ADDIK, slot, slot, static_cast<std::uint16_t>(static_cast<std::int16_t>(k)));
+      return;
+    }
+    if (target.kind == ExprKind::Index && target.as<IndexExpr>().object->type.kind == K::Vector) {
+      store_element(target.as<IndexExpr>(), op, rhs, -1, Type());
+      top_ = save;
       return;
     }
     const int cur = expr(target);
@@ -790,12 +920,12 @@ class Compiler {
         top_ = r + 1;
         std::vector<Type> want;
         args_at(e.args, want);
-        if (reg_kind(e.type) == RK::None && e.type.kind != K::Void)
+        if ((reg_kind(e.type) == RK::None || reg_kind(e.type) == RK::V) && e.type.kind != K::Void)
           not_supported(P, e.loc, "a method returning '" + e.type.name() + "'");
         P.methods_.push_back(b.method);
         P.method_kinds_.emplace_back();
         for (const ExprPtr& a : e.args) {
-          if (reg_kind(a->type) == RK::None)
+          if (reg_kind(a->type) == RK::None || reg_kind(a->type) == RK::V)
             not_supported(P, a->loc, "an argument of type '" + a->type.name() + "'");
           P.method_kinds_.back().push_back(reg_kind(a->type));
         }
@@ -874,7 +1004,8 @@ class Compiler {
           int r = expr(a);
           if (a.type.kind == K::Enum || a.type.kind == K::Bool) r = to_string(r, a.type);
           RK k = a.type.kind == K::Enum || a.type.kind == K::Bool ? RK::S : reg_kind(a.type);
-          if (k == RK::None) not_supported(P, a.loc, "printing a value of type '" + a.type.name() + "'");
+          if (k == RK::None || k == RK::V)
+            not_supported(P, a.loc, "printing a value of type '" + a.type.name() + "'");
           move(base + static_cast<int>(i), r, k);
           kinds.push_back(k);
           top_ = save;
@@ -903,6 +1034,13 @@ class Compiler {
         top_ = base + 1;
         return base;
       }
+      case Builtin::Find: {
+        const int path = expr(*e.args.at(0));
+        const int r = temp();
+        at(e.loc);
+        emit(OP_FIND, r, path);
+        return r;
+      }
       case Builtin::PlaceCount: {
         const int p = place_reg();
         const int r = temp();
@@ -925,14 +1063,43 @@ class Compiler {
       }
       case Builtin::Size: {
         if (callee.kind != ExprKind::Member) break;
-        auto [h, slot] = list_of(*callee.as<MemberExpr>().object);
+        const Expr& o = *callee.as<MemberExpr>().object;
+        if (o.type.kind == K::Vector) {
+          auto [vh, vslot] = vector_property(o);
+          const int r = temp();
+          if (vh >= 0)
+            emit(OP_PVSIZE, r, vh, vslot);
+          else
+            emit(OP_VSIZE, r, vector_reg(o));
+          return r;
+        }
+        auto [h, slot] = list_of(o);
         const int r = temp();
         emit(OP_LSIZE, r, h, slot);
         return r;
       }
       case Builtin::Push: {
         if (callee.kind != ExprKind::Member) break;
-        auto [h, slot] = list_of(*callee.as<MemberExpr>().object);
+        const Expr& o = *callee.as<MemberExpr>().object;
+        if (o.type.kind == K::Vector) {
+          // A property: read, push, write back through the setter (signals and records).
+          auto [vh, vslot] = vector_property(o);
+          int v;
+          if (vh >= 0) {
+            v = temp();
+            emit(OP_GETP, v, vh, vslot);
+          } else if (o.kind == ExprKind::Name && o.as<NameExpr>().binding.kind == BK::Local) {
+            v = o.as<NameExpr>().binding.slot;
+          } else {
+            not_supported(P, e.loc, "pushing onto a temporary vector");
+          }
+          const int x = expr_fresh(*e.args.at(0), element_type(o.type));
+          at(e.loc);
+          emit_v(OP_VPUSH, o.type, v, x);
+          if (vh >= 0) emit(OP_SETP, vh, v, vslot);
+          return -1;
+        }
+        auto [h, slot] = list_of(o);
         const int v = expr(*e.args.at(0));
         at(e.loc);
         emit(OP_LPUSH, h, v, slot);
@@ -999,6 +1166,8 @@ class Compiler {
           expr_to(*l.init, l.slot, l.type);
         } else if (k == RK::S) {
           emit(OP_LOADS, l.slot, string_const(""));
+        } else if (k == RK::V) {
+          emit(OP_VCLEAR, l.slot);
         } else if (k == RK::D) {
           emit(OP_LOADK, l.slot, konst(std::bit_cast<std::int64_t>(0.0)));
         } else {
@@ -1059,6 +1228,10 @@ class Compiler {
       }
       case StmtKind::ForEach: {
         const auto& f = s.as<ForEachStmt>();
+        if (f.range->type.kind == K::Vector) {
+          for_vector(f);
+          break;
+        }
         auto [h, slot] = list_of(*f.range);
         const int hold = temp();
         move(hold, h, RK::R);
@@ -1086,7 +1259,7 @@ class Compiler {
         if (r.value) {
           const int v = temp();
           expr_to(*r.value, v, F.result_type);
-          emit(OP_RET, v);
+          emit(F.result == RK::V ? OP_RETV : OP_RET, v);
         } else {
           emit(OP_RET0);
         }
@@ -1110,6 +1283,33 @@ class Compiler {
   }
 
   void step_expr(const Expr& e) { (void)expr(e); }
+
+  // `for (T x : v)` over a vector: over a copy taken before the first iteration (a property is read
+  // once), so changing the vector in the body does not change the run.
+  void for_vector(const ForEachStmt& f) {
+    const Type& vec = f.range->type;
+    const Type elem = element_type(vec);
+    const int hold = temp();
+    expr_to(*f.range, hold, vec);
+    const int i = temp();
+    const int n = temp();
+    const int e = temp();
+    load_int(i, 0);
+    emit(OP_VSIZE, n, hold);
+    const std::size_t top = here();
+    const std::size_t jf = emit_jump(OP_JGEI, i, n);
+    emit_v(OP_VGET, vec, e, hold, i);
+    move(f.var->slot, coerce(e, elem, f.var->type), reg_kind(f.var->type));
+    declare(f.var->name, f.var->slot, f.var->type);
+    loops_.emplace_back();
+    stmt(*f.body);
+    const std::size_t cont = here();
+    emit(OP_ADDIK, i, i, 1);
+    const std::size_t back = emit_jump(OP_JMP);
+    patch(back, top);
+    patch(jf, here());
+    close_loop(cont, here());
+  }
 
   // `finish v;` (4.11): the result and `finished` become properties of the invoked net's instance (so
   // the finish is database state, recorded and saved); the executor completes the invocation after

@@ -312,9 +312,12 @@ class Debugger::Impl final : public DebugHooks {
     return o->meta().name() + "#" + std::to_string(id);
   }
 
-  std::string register_text(const Type& t, const Val& v, const std::string& s) const {
+  std::string register_text(const Type& t, const Val& v, const std::string& s, const VecReg& vr) const {
     using K = Type::Kind;
     switch (t.kind) {
+      case K::Vector:
+        if (t.meta != nullptr && vector_elem_kind(*t.meta) != RK::None) return vector_text(*t.meta, vr);
+        return "<" + t.name() + ">";
       case K::Bool:
         return v.i != 0 ? "true" : "false";
       case K::Int:
@@ -531,7 +534,7 @@ std::vector<Variable> Debugger::locals(std::size_t k) const {
     Variable v;
     v.name = l.name;
     v.type = l.type.name();
-    v.value = impl_->register_text(l.type, P.regs_[r], P.sregs_[r]);
+    v.value = impl_->register_text(l.type, P.regs_[r], P.sregs_[r], P.vregs_[r]);
     // A later local of the same name (an inner block) hides an earlier one.
     auto same = std::find_if(out.begin(), out.end(), [&](const Variable& o) { return o.name == v.name; });
     if (same != out.end())
@@ -580,7 +583,7 @@ std::string Debugger::print(std::string_view path, std::size_t k) const {
         cur = P.regs_[r].id;
         is_instance = true;
       } else {
-        value = impl_->register_text(found->type, P.regs_[r], P.sregs_[r]);
+        value = impl_->register_text(found->type, P.regs_[r], P.sregs_[r], P.vregs_[r]);
       }
       if (!is_instance && parts.size() > 1)
         throw Error("SOML++ debugger: '" + first + "' is a " + found->type.name() + ", it has no members");

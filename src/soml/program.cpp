@@ -91,6 +91,8 @@ static PK prop_kind(const Type& t, const MetaProperty& mp) {
       return PK::Ref;
     case K::List:
       return PK::List;
+    case K::Vector:
+      return vector_elem_kind(mp.type()) != RK::None ? PK::Vector : PK::Other;
     default:
       return PK::Other;
   }
@@ -639,14 +641,15 @@ SimStateInstance& ProgramImpl::create_node(const ClassInfo& ci, Node* parent, co
 }
 
 SimStateInstance& ProgramImpl::instantiate(const ClassInfo& ci, Node* parent, std::string name,
-                                           const Val* args, const std::string* sargs, int nargs) {
+                                           const Val* args, const std::string* sargs, int nargs,
+                                           const VecReg* vargs) {
   SimStateInstance& inst = create_node(ci, parent, name);
-  setup(ci, inst, args, sargs, nargs);
+  setup(ci, inst, args, sargs, nargs, vargs);
   return inst;
 }
 
 void ProgramImpl::setup(const ClassInfo& ci, SimStateInstance& inst, const Val* args,
-                        const std::string* sargs, int nargs) {
+                        const std::string* sargs, int nargs, const VecReg* vargs) {
   std::vector<const ClassInfo*> chain;
   for (const ClassInfo* c = &ci; c != nullptr; c = c->base) chain.push_back(c);
   std::reverse(chain.begin(), chain.end());
@@ -677,7 +680,7 @@ void ProgramImpl::setup(const ClassInfo& ci, SimStateInstance& inst, const Val* 
         (c == ci.base && ci.decl->kind == DeclKind::Object && ci.object_ctor < 0 && f.nparams == 0)) {
       if (c == &ci && f.nparams != nargs)
         fail("constructor of " + ci.decl->name + " needs " + std::to_string(f.nparams) + " arguments");
-      run(c->ctor, inst.id(), 0, args, sargs);
+      run(c->ctor, inst.id(), 0, args, sargs, nullptr, vargs);
     } else if (f.nparams == 0) {
       run(c->ctor, inst.id(), 0, nullptr, nullptr);
     }
@@ -788,6 +791,7 @@ Value ProgramImpl::call_from_cpp(int fi, SimStateInstance& self, std::span<const
                 std::to_string(args.size()) + " given");
   std::vector<Val> v(args.size());
   std::vector<std::string> s(args.size());
+  std::vector<VecReg> vs(args.size());
   for (std::size_t i = 0; i < args.size(); ++i) {
     const Value& a = args[i];
     const MetaType* t = a.type();
@@ -820,12 +824,21 @@ Value ProgramImpl::call_from_cpp(int fi, SimStateInstance& self, std::span<const
         v[i].id = o != nullptr ? o->id() : 0;
         break;
       }
+      case RK::V: {
+        const MetaType* want = i < f.locals.size() ? f.locals[i].type.meta : nullptr;  // params come first
+        if (want == nullptr || !detail::same_definition(*t, *want))
+          throw Error("SOML++ function " + f.name + ": argument " + std::to_string(i + 1) + " must be a " +
+                      (want != nullptr ? want->name() : std::string("vector")) + ", not " + t->name());
+        vector_load(*t, a.data(), vs[i]);
+        break;
+      }
       default:
         throw Error("SOML++ function " + f.name + ": unsupported argument type");
     }
   }
   std::string sres;
-  const Val r = run(fi, self.id(), 0, v.data(), s.data(), &sres);
+  VecReg vres;
+  const Val r = run(fi, self.id(), 0, v.data(), s.data(), &sres, vs.data(), &vres);
   switch (f.result_type.kind) {
     case K::Bool:
       return Value(r.i != 0);
@@ -846,6 +859,8 @@ Value ProgramImpl::call_from_cpp(int fi, SimStateInstance& self, std::span<const
       SimStateInstance* o = r.id == 0 ? nullptr : state_.find(r.id);
       return Value(SharedRef<Node>(o != nullptr ? o->as<Node>() : nullptr));
     }
+    case K::Vector:
+      return vector_value(*f.result_type.meta, vres, "the result of " + f.name);
     default:
       return {};
   }

@@ -13,6 +13,7 @@
 #include "vsd/core/signal.hpp"
 #include "vsd/core/sim_state.hpp"
 #include "vsd/core/type_builder.hpp"
+#include "vsd/core/value.hpp"
 #include "vsd/soml/checker.hpp"
 #include "vsd/soml/net_classes.hpp"
 #include "vsd/soml/runtime.hpp"
@@ -27,8 +28,17 @@ union Val {
   std::uint64_t id;
 };
 
-// Register kinds of a static type.
-enum class RK : std::uint8_t { I, D, S, R, None };
+// A vector register (`vector<T>` values in code): parallel to the registers like the strings. Elements
+// of int, bool and double vectors are Vals (the element kind is static, as for registers), elements of
+// string vectors strings; the other array stays empty, so the size is v.size() + s.size().
+struct VecReg {
+  std::vector<Val> v;
+  std::vector<std::string> s;
+  [[nodiscard]] std::size_t size() const noexcept { return v.size() + s.size(); }
+};
+
+// Register kinds of a static type (V: a vector, its elements of kind vector_elem_kind()).
+enum class RK : std::uint8_t { I, D, S, R, V, None };
 
 enum Op : std::uint8_t {
   OP_NOP,
@@ -79,6 +89,7 @@ enum Op : std::uint8_t {
   OP_VCALL,    // like CALL, but b is a virtual slot resolved on the class of self
   OP_RET,      // return register a
   OP_RET0,     // return nothing
+  OP_RETV,     // return vector register a (a function whose result is a vector)
   OP_SELF,     // a = instance of scope b levels out (outer plan b)
   OP_MARK,     // a = mark
   OP_OBJ,      // a = id of object consts[b]
@@ -101,7 +112,18 @@ enum Op : std::uint8_t {
   OP_RANGE,    // check that a fits the storage type consts[b] (int properties narrower than int64)
   OP_FAIL,     // run-time error strings[b]
   OP_BREAK,    // debugger: patched over a line start; calls the hook, then runs Function::tramp[2 pc]
-  OP_RESUME    // the second instruction of a trampoline: pc = target (no budget)
+  OP_RESUME,   // the second instruction of a trampoline: pc = target (no budget)
+  // Vectors (x: 1 when the elements are strings, else 0; for OP_EQV 0 int, 1 double, 2 string).
+  OP_MOVV,    // V[a] = V[b] (a copy: vectors are values)
+  OP_VCLEAR,  // V[a] = {}
+  OP_VSIZE,   // a = size of V[b]
+  OP_VGET,    // a = V[b][R[c]]            (range-checked)
+  OP_VSET,    // V[a][R[b]] = c            (range-checked)
+  OP_VPUSH,   // V[a].push(b)
+  OP_EQV,     // a = V[b] == V[c]
+  OP_PVSIZE,  // a = size of vector property props[c] of instance b (no copy)
+  OP_PVGET,   // a = element R[a] of vector property props[c] of instance b (no copy; range-checked)
+  OP_FIND     // a = the node at path S[b] from the database, or null
 };
 
 struct Ins {
@@ -156,7 +178,7 @@ struct OuterPlan {
   int parents = 0;
 };
 
-enum class PK : std::uint8_t { I64, Bool, Double, String, Int, Enum, Ref, List, Other };
+enum class PK : std::uint8_t { I64, Bool, Double, String, Int, Enum, Ref, List, Vector, Other };
 
 struct PropSlot {
   const MetaProperty* prop = nullptr;
@@ -268,11 +290,16 @@ class ProgramImpl {
   // ---- VM ----
   // Runs function @p f on @p self with arguments in args (count f.nparams); returns the result.
   Val exec(std::size_t entry);
+  void vector_op(Ins in, const Frame& frame);  // OP_MOVV .. OP_PVGET (vm.cpp)
+  void store_vector(const MetaProperty& p, SimStateInstance& o, const VecReg& v);
+  std::uint64_t new_instance(Ins in, const Frame& frame);  // OP_NEW
+  std::uint64_t find_node(const std::string& path) const;  // OP_FIND
+  // Vector arguments come from @p vargs (indexed like args), a vector result goes to @p vresult.
   Val run(int f, std::uint64_t self, std::uint64_t mark, const Val* args, const std::string* sargs,
-          std::string* sresult = nullptr);
+          std::string* sresult = nullptr, const VecReg* vargs = nullptr, VecReg* vresult = nullptr);
   Value call_from_cpp(int f, SimStateInstance& self, std::span<const Value> args);
   SimStateInstance& instantiate(const ClassInfo& ci, Node* parent, std::string name, const Val* args,
-                                const std::string* sargs, int nargs);
+                                const std::string* sargs, int nargs, const VecReg* vargs = nullptr);
   [[noreturn]] void fail(const std::string& what);
 
   // ---- executor ----
@@ -285,7 +312,7 @@ class ProgramImpl {
   std::function<void()> on_dirty_;  // called when a transition needs a test (the Module triggers its task)
   SimStateInstance& create_node(const ClassInfo& ci, Node* parent, const std::string& name);
   void setup(const ClassInfo& ci, SimStateInstance& inst, const Val* args, const std::string* sargs,
-             int nargs);
+             int nargs, const VecReg* vargs = nullptr);
   void build_net(const ClassInfo& ci, SimStateInstance& inst);
   // Hands a net (built or found) to the executor: its transitions are listed and marked for a test.
   void register_net(std::unique_ptr<NetInst> net, const ClassInfo& ci, SimStateInstance& inst);
@@ -354,6 +381,7 @@ class ProgramImpl {
   // VM state
   std::vector<Val> regs_;
   std::vector<std::string> sregs_;
+  std::vector<VecReg> vregs_;
   std::vector<Frame> frames_;
   std::uint32_t top_ = 0;  // first free register of the outermost frame stack
   std::uint64_t budget_ = 0;
@@ -455,5 +483,22 @@ std::string where(const ProgramImpl& p, SourceLoc loc);
 
 /// SOML++'s text of a double (vm.cpp): what `string(x)` and `print` show, and the debugger too.
 std::string fmt_double(double d);
+
+// Vectors in code (vm.cpp). The element types a vector register holds: bool, the integers, float and
+// double (as Vals) and string; the C++ std::vector<T> of the registry is the storage.
+/// The register kind of the elements of vector MetaType @p vt (I, D or S); None when the VM cannot
+/// hold them (structs, enums).
+RK vector_elem_kind(const MetaType& vt) noexcept;
+/// Copies the std::vector<T> at @p addr (of MetaType @p vt) into @p out.
+void vector_load(const MetaType& vt, const void* addr, VecReg& out);
+/// The size of the std::vector<T> at @p addr.
+std::size_t vector_size(const MetaType& vt, const void* addr);
+/// Element @p i (in range) of the std::vector<T> at @p addr into @p v or @p s.
+void vector_at(const MetaType& vt, const void* addr, std::size_t i, Val& v, std::string& s);
+/// A Value of MetaType @p vt holding the elements of @p r. @throws vsd::Error (without the SOML++ prefix)
+/// when an element does not fit the element type, naming @p what ("property 'joints'").
+Value vector_value(const MetaType& vt, const VecReg& r, const std::string& what);
+/// The text of a vector register ("[1, 2]", strings quoted), for the debugger.
+std::string vector_text(const MetaType& vt, const VecReg& r);
 
 }  // namespace vsd::soml

@@ -8,13 +8,16 @@
 #include <cstring>
 #include <iostream>
 #include <limits>
+#include <type_traits>
 
 #include "program_impl.hpp"
+#include "vsd/core/database.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/core/instance.hpp"
 #include "vsd/core/meta_method.hpp"
 #include "vsd/core/node.hpp"
 #include "vsd/core/reference.hpp"
+#include "vsd/core/value.hpp"
 
 namespace vsd::soml {
 
@@ -61,6 +64,135 @@ void store_integer(const MetaProperty& p, SimStateInstance& o, std::int64_t v) {
 
 }  // namespace
 
+// ---- vectors ----
+// The VM holds vectors of the C++ element types below; the registry's vector<T> of each is the
+// std::vector<T> (a run-time vector type has run-time elements: enums and structs, which no register
+// holds).
+namespace {
+
+template <class... T>
+struct TypeList {};
+using VecElems = TypeList<bool, std::int8_t, std::int16_t, std::int32_t, std::int64_t, std::uint8_t,
+                          std::uint16_t, std::uint32_t, std::uint64_t, float, double, std::string>;
+
+// Calls f((T*)nullptr) for the element type T of vector type vt; false when vt is none of them.
+template <class F, class... T>
+bool with_vector(const MetaType& vt, F&& f, TypeList<T...> /*unused*/) {
+  return ((vt.is<std::vector<T>>() ? (f(static_cast<T*>(nullptr)), true) : false) || ...);
+}
+template <class F>
+bool with_vector(const MetaType& vt, F&& f) {
+  return with_vector(vt, std::forward<F>(f), VecElems{});
+}
+
+template <class T>
+void to_reg(const T& x, Val& v, std::string& s) {
+  if constexpr (std::is_same_v<T, std::string>)
+    s = x;
+  else if constexpr (std::is_floating_point_v<T>)
+    v.d = static_cast<double>(x);
+  else if constexpr (std::is_same_v<T, bool>)
+    v.i = x ? 1 : 0;
+  else
+    v.i = static_cast<std::int64_t>(x);
+}
+
+}  // namespace
+
+RK vector_elem_kind(const MetaType& vt) noexcept {
+  RK k = RK::None;
+  with_vector(vt, [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    k = std::is_same_v<T, std::string> ? RK::S : std::is_floating_point_v<T> ? RK::D : RK::I;
+  });
+  return k;
+}
+
+void vector_load(const MetaType& vt, const void* addr, VecReg& out) {
+  out.v.clear();
+  out.s.clear();
+  with_vector(vt, [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    const auto& src = *static_cast<const std::vector<T>*>(addr);
+    if constexpr (std::is_same_v<T, std::string>) {
+      out.s.assign(src.begin(), src.end());
+    } else {
+      out.v.resize(src.size());
+      std::string unused;
+      for (std::size_t i = 0; i < src.size(); ++i) to_reg<T>(src[i], out.v[i], unused);
+    }
+  });
+}
+
+std::size_t vector_size(const MetaType& vt, const void* addr) {
+  std::size_t n = 0;
+  with_vector(vt, [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    n = static_cast<const std::vector<T>*>(addr)->size();
+  });
+  return n;
+}
+
+void vector_at(const MetaType& vt, const void* addr, std::size_t i, Val& v, std::string& s) {
+  with_vector(vt, [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    const auto& src = *static_cast<const std::vector<T>*>(addr);
+    to_reg<T>(src[i], v, s);
+  });
+}
+
+Value vector_value(const MetaType& vt, const VecReg& r, const std::string& what) {
+  Value out(vt);
+  const MetaType& et = *vt.element();
+  const bool known = with_vector(vt, [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    auto& dst = *static_cast<std::vector<T>*>(out.data());
+    if constexpr (std::is_same_v<T, std::string>) {
+      dst.assign(r.s.begin(), r.s.end());
+    } else {
+      dst.reserve(r.v.size());
+      for (const Val& x : r.v) {
+        if constexpr (std::is_floating_point_v<T>) {
+          dst.push_back(static_cast<T>(x.d));
+        } else if constexpr (std::is_same_v<T, bool>) {
+          dst.push_back(x.i != 0);
+        } else {
+          if (!std::is_same_v<T, std::int64_t> && !std::is_same_v<T, std::uint64_t> && !et.integer_fits(x.i))
+            throw Error("the value " + std::to_string(x.i) + " does not fit " + what + " (elements " +
+                        et.name() + ")");
+          dst.push_back(static_cast<T>(x.i));
+        }
+      }
+    }
+  });
+  if (!known) throw Error(what + " of type " + vt.name() + " cannot be stored by the SOML++ runtime");
+  return out;
+}
+
+std::string vector_text(const MetaType& vt, const VecReg& r) {
+  std::string out = "[";
+  const RK k = vector_elem_kind(vt);
+  const bool is_bool = vt.element() != nullptr && vt.element()->kind() == TypeKind::Bool;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    if (i != 0) out += ", ";
+    if (k == RK::S) {
+      out += '"';
+      for (char c : r.s[i]) {
+        if (c == '"' || c == '\\') out += '\\';
+        out += c;
+      }
+      out += '"';
+    } else if (k == RK::D) {
+      out += fmt_double(r.v[i].d);
+    } else if (is_bool) {
+      out += r.v[i].i != 0 ? "true" : "false";
+    } else {
+      out += std::to_string(r.v[i].i);
+    }
+  }
+  return out + "]";
+}
+
 std::string ProgramImpl::stack_text(std::size_t from) const {
   std::string s;
   for (std::size_t i = frames_.size(); i-- > from;) {
@@ -75,7 +207,7 @@ std::string ProgramImpl::stack_text(std::size_t from) const {
 void ProgramImpl::fail(const std::string& what) { throw Error("SOML++ run-time error: " + what); }
 
 Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* args,
-                     const std::string* sargs, std::string* sresult) {
+                     const std::string* sargs, std::string* sresult, const VecReg* vargs, VecReg* vresult) {
   const Function& f = *functions_[static_cast<std::size_t>(fi)];
   const std::size_t entry = frames_.size();
   if (entry == 0) {
@@ -90,17 +222,21 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
   if (regs_.size() < base + static_cast<std::size_t>(f.nregs) + 1) {
     regs_.resize((base + static_cast<std::size_t>(f.nregs) + 1) * 2);
     sregs_.resize(regs_.size());
+    vregs_.resize(regs_.size());
   }
   for (int i = 0; i < f.nparams; ++i) {
     regs_[base + static_cast<std::size_t>(i)] = args[i];
     if (f.param_kinds[static_cast<std::size_t>(i)] == RK::S)
       sregs_[base + static_cast<std::size_t>(i)] = sargs[i];
+    else if (f.param_kinds[static_cast<std::size_t>(i)] == RK::V)
+      vregs_[base + static_cast<std::size_t>(i)] = vargs != nullptr ? vargs[i] : VecReg{};
   }
   frames_.push_back(Frame{&f, f.code.data(), base, self, mark});
   top_ = base + static_cast<std::uint32_t>(f.nregs);
   try {
     Val v = exec(entry);
     if (sresult != nullptr && f.result == RK::S) *sresult = std::move(sregs_[base]);
+    if (vresult != nullptr && f.result == RK::V) *vresult = std::move(vregs_[base]);
     top_ = saved_top;
     return v;
   } catch (const Error& e) {
@@ -110,6 +246,146 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
     frames_.resize(entry);
     top_ = saved_top;
     throw Error(msg);
+  }
+}
+
+// `new C(args)`, out of line (its argument arrays would weigh on the interpreter loop's frame).
+[[gnu::noinline]] std::uint64_t ProgramImpl::new_instance(const Ins in, const Frame& frame) {
+  const Val* R = regs_.data() + frame.base;
+  const std::string* S = sregs_.data() + frame.base;
+  const ClassInfo* ci = classes_[in.b];
+  if (ci == nullptr) return state_.create(*class_metas_[in.b]).id();
+  const Function* ctor = ci->ctor >= 0 ? functions_[static_cast<std::size_t>(ci->ctor)].get() : nullptr;
+  if (in.c > 8) fail("more than 8 constructor arguments");
+  std::string sargs[8];
+  VecReg vargs[8];
+  Val args[8];
+  for (int i = 0; i < in.c; ++i) {
+    const RK k = ctor != nullptr ? ctor->param_kinds[static_cast<std::size_t>(i)] : RK::None;
+    if (k == RK::S) sargs[i] = S[in.a + 1 + i];
+    if (k == RK::V) vargs[i] = vregs_[frame.base + in.a + 1 + i];
+    args[i] = R[in.a + 1 + i];
+  }
+  return instantiate(*ci, nullptr, "", args, sargs, in.c, vargs).id();
+}
+
+// find(path): names from the database down, separated by '/', as Node::path() writes them (a leading
+// '/' is optional; "/" is the database). Each step is the first child of that name; null when a step
+// is missing or a name is empty.
+[[gnu::noinline]] std::uint64_t ProgramImpl::find_node(const std::string& path) const {
+  const Node* n = &state_.database();
+  std::string_view rest = path;
+  if (!rest.empty() && rest.front() == '/') rest.remove_prefix(1);
+  if (rest.empty()) return path.empty() ? 0 : n->id();
+  while (n != nullptr) {
+    const std::size_t slash = rest.find('/');
+    const std::string_view name = rest.substr(0, slash);
+    if (name.empty()) return 0;
+    n = n->find_child(name);
+    if (slash == std::string_view::npos) break;
+    rest.remove_prefix(slash + 1);
+  }
+  return n != nullptr ? n->id() : 0;
+}
+
+// A vector property store, out of line like the vector instructions: through the setter like every
+// other store, so the change signals and records.
+[[gnu::noinline]] void ProgramImpl::store_vector(const MetaProperty& p, SimStateInstance& o,
+                                                 const VecReg& v) {
+  const Value value = vector_value(p.type(), v, "property '" + p.name() + "'");
+  p.assign_raw(o, value.data());
+}
+
+// The vector instructions, out of line: they are rare next to the arithmetic and calls that the
+// interpreter loop keeps in registers (fib(27) and the 10^7 loop of benchmarks/ must not pay for them).
+[[gnu::noinline]] void ProgramImpl::vector_op(const Ins in, const Frame& frame) {
+  Val* R = regs_.data() + frame.base;
+  std::string* S = sregs_.data() + frame.base;
+  VecReg* V = vregs_.data() + frame.base;
+  auto obj = [&](std::uint64_t id) -> SimStateInstance& {
+    SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
+    if (o == nullptr)
+      fail(id == 0 ? "null reference" : "reference to a deleted instance (id " + std::to_string(id) + ")");
+    return *o;
+  };
+  switch (in.op) {
+    case OP_MOVV:
+      V[in.a] = V[in.b];
+      break;
+    case OP_VCLEAR: {
+      VecReg& v = V[in.a];
+      v.v.clear();
+      v.s.clear();
+      break;
+    }
+    case OP_VSIZE:
+      R[in.a].i = static_cast<std::int64_t>(V[in.b].size());
+      break;
+    case OP_VGET:
+    case OP_VSET: {
+      VecReg& v = V[(in.op == OP_VGET ? in.b : in.a)];
+      const std::int64_t i = R[in.op == OP_VGET ? in.c : in.b].i;
+      if (i < 0 || static_cast<std::size_t>(i) >= v.size()) {
+        fail("index " + std::to_string(i) + " out of range (size " + std::to_string(v.size()) + ")");
+      }
+      const auto k = static_cast<std::size_t>(i);
+      if (in.op == OP_VGET) {
+        if (in.x != 0)
+          S[in.a] = v.s[k];
+        else
+          R[in.a] = v.v[k];
+      } else if (in.x != 0) {
+        v.s[k] = S[in.c];
+      } else {
+        v.v[k] = R[in.c];
+      }
+      break;
+    }
+    case OP_VPUSH: {
+      VecReg& v = V[in.a];
+      if (in.x != 0)
+        v.s.push_back(S[in.b]);
+      else
+        v.v.push_back(R[in.b]);
+      break;
+    }
+    case OP_EQV: {
+      const VecReg& l = V[in.b];
+      const VecReg& r = V[in.c];
+      bool eq = l.size() == r.size();
+      if (eq && in.x == 2) {
+        eq = l.s == r.s;
+      } else {
+        for (std::size_t k = 0; eq && k < l.v.size(); ++k)
+          eq = in.x == 1 ? l.v[k].d == r.v[k].d : l.v[k].i == r.v[k].i;
+      }
+      R[in.a].i = eq ? 1 : 0;
+      break;
+    }
+    case OP_PVSIZE:
+    case OP_PVGET: {
+      const std::uint64_t id = R[in.b].id;
+      SimStateInstance& o = obj(id);
+      const MetaProperty& p = *props_[in.c].prop;
+      if (!o.meta().is_a(p.owner())) {
+        fail("instance of " + o.meta().name() + " has no property '" + p.name() + "'");
+      }
+      if (deps_ != nullptr) deps_->emplace_back(id, &p);
+      const void* addr = p.address(o);
+      const std::size_t n = vector_size(p.type(), addr);
+      if (in.op == OP_PVSIZE) {
+        R[in.a].i = static_cast<std::int64_t>(n);
+        break;
+      }
+      const std::int64_t i = R[in.a].i;
+      if (i < 0 || static_cast<std::size_t>(i) >= n) {
+        fail("index " + std::to_string(i) + " out of range (size " + std::to_string(n) + ")");
+      }
+      vector_at(p.type(), addr, static_cast<std::size_t>(i), R[in.a], S[in.a]);
+      break;
+    }
+    default:
+      fail("bad instruction");
   }
 }
 
@@ -344,6 +620,7 @@ Val ProgramImpl::exec(std::size_t entry) {
         if (regs_.size() < need) {
           regs_.resize(need * 2);
           sregs_.resize(regs_.size());
+          vregs_.resize(regs_.size());
         }
         const std::uint64_t mark = fr->mark;
         frames_.push_back(Frame{&callee, callee.code.data(), nb, self, mark});
@@ -354,10 +631,13 @@ Val ProgramImpl::exec(std::size_t entry) {
         VSD_REFRESH();
         break;
       }
+      case OP_RETV:  // a vector result: into the frame's first vector register, then as OP_RET
+        if (in.a != 0) vregs_[fr->base] = std::move(vregs_[fr->base + in.a]);
+        [[fallthrough]];
       case OP_RET:
       case OP_RET0: {
         Val v{};
-        if (in.op == OP_RET) {
+        if (in.op != OP_RET0) {
           v = R[in.a];
           if (fr->fn->result == RK::S && in.a != 0) S[0] = std::move(S[in.a]);
         }
@@ -428,6 +708,9 @@ Val ProgramImpl::exec(std::size_t entry) {
             R[in.a].id = t != nullptr ? t->id() : 0;
             break;
           }
+          case PK::Vector:
+            vector_load(ps.prop->type(), addr, vregs_[fr->base + in.a]);
+            break;
           default:
             if (ps.prop->type().kind() == TypeKind::Float) {
               R[in.a].d = *static_cast<const float*>(addr);
@@ -483,6 +766,9 @@ Val ProgramImpl::exec(std::size_t entry) {
             }
             break;
           }
+          case PK::Vector:
+            store_vector(p, o, vregs_[fr->base + in.b]);
+            break;
           default:
             if (p.type().kind() == TypeKind::Float) {
               const auto f = static_cast<float>(R[in.b].d);
@@ -563,24 +849,9 @@ Val ProgramImpl::exec(std::size_t entry) {
       }
       case OP_NEW: {
         VSD_SAVE();
-        const ClassInfo* ci = classes_[in.b];
-        SimStateInstance* made;
-        if (ci != nullptr) {
-          const Function* ctor =
-              ci->ctor >= 0 ? functions_[static_cast<std::size_t>(ci->ctor)].get() : nullptr;
-          std::string sargs[8];
-          if (in.c > 8) fail("more than 8 constructor arguments");
-          for (int i = 0; i < in.c; ++i)
-            if (ctor != nullptr && ctor->param_kinds[static_cast<std::size_t>(i)] == RK::S)
-              sargs[i] = S[in.a + 1 + i];
-          Val args[8];
-          for (int i = 0; i < in.c; ++i) args[i] = R[in.a + 1 + i];
-          made = &instantiate(*ci, nullptr, "", args, sargs, in.c);
-        } else {
-          made = &state_.create(*class_metas_[in.b]);
-        }
+        const std::uint64_t made = new_instance(in, *fr);
         VSD_REFRESH();
-        R[in.a].id = made->id();
+        R[in.a].id = made;
         break;
       }
       case OP_ISA:
@@ -737,6 +1008,21 @@ Val ProgramImpl::exec(std::size_t entry) {
       }
       case OP_RESUME:
         pc = VSD_TARGET(in);
+        break;
+      case OP_MOVV:
+      case OP_VCLEAR:
+      case OP_VSIZE:
+      case OP_VGET:
+      case OP_VSET:
+      case OP_VPUSH:
+      case OP_EQV:
+      case OP_PVSIZE:
+      case OP_PVGET:
+        VSD_SAVE();
+        vector_op(in, *fr);
+        break;
+      case OP_FIND:
+        R[in.a].id = find_node(S[in.b]);
         break;
       default:
         VSD_SAVE();

@@ -112,7 +112,8 @@ enum class Builtin : unsigned char {
   PlacePut,    ///< place.put(n) / place.put(obj)
   PlaceClear,  ///< place.clear()
   Size,        ///< vector/list .size()
-  Push         ///< vector/list .push(x)
+  Push,        ///< vector/list .push(x)
+  Find         ///< find(path): the database node at a path ("/plant/tank", as Node::path()), or null
 };
 
 /// @brief What a name or member resolved to.
