@@ -514,8 +514,15 @@ TEST_F(CollisionTest, RayCastOnAMeshDescendsItsTreeAndAgreesWithEveryTriangle) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);
   const Eigen::Vector3d centre = pose.translation();
+  // Each ray is checked against all 6,240 triangles: 1,500 rays take 0.3 s optimised but over a minute
+  // unoptimised under AddressSanitizer, where 300 rays still check every path of the descent.
+#ifdef __SANITIZE_ADDRESS__
+  constexpr int rays = 300;
+#else
+  constexpr int rays = 1500;
+#endif
   int hits = 0;
-  for (int k = 0; k < 1500; ++k) {
+  for (int k = 0; k < rays; ++k) {
     // From outside towards a point near the surface (some miss), or from inside outwards.
     const bool inside = k % 5 == 0;
     const Eigen::Vector3d o =
@@ -534,8 +541,8 @@ TEST_F(CollisionTest, RayCastOnAMeshDescendsItsTreeAndAgreesWithEveryTriangle) {
     EXPECT_FALSE(w.ray_cast(o, d, *expected - 1e-6)) << "ray " << k;
     EXPECT_TRUE(w.ray_cast(o, d, *expected + 1e-6)) << "ray " << k;
   }
-  EXPECT_GT(hits, 1000);
-  EXPECT_LT(hits, 1500);
+  EXPECT_GT(hits, rays * 2 / 3);  // most rays aim at the blob, some pass beside it
+  EXPECT_LT(hits, rays);
 }
 
 TEST_F(CollisionTest, RaysThroughTheEdgesAndVerticesOfAFlatMeshAreNotLost) {

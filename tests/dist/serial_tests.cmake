@@ -1,5 +1,3 @@
-# Included by ctest after the file of gtest_discover_tests() that defines the vsd_dist_tests tests: the
-# multi-process ones run alone (they spawn processes, use ports and may make network namespaces).
-set_tests_properties("DistProcesses.AReaderThatDiesAndARejoinerFollowAWriterProcess"
-                     "DistProcesses.NetworkNamespacesWithLossDelayAndReordering"
-                     "DistProcesses.TenPercentPacketLossLosesNothingAndReordersNothing" PROPERTIES RUN_SERIAL TRUE)
+# Included by ctest after the file of vsd_gtest_suites() that defines the vsd_dist_tests suites: the
+# multi-process tests run alone (they spawn processes, use ports and may make network namespaces).
+set_tests_properties("DistProcesses.*" PROPERTIES RUN_SERIAL TRUE)

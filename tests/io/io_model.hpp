@@ -3,13 +3,24 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <random>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "../core/test_classes.hpp"
 
 namespace vsd_test {
+
+// Small conversions the io test files share (one definition: the files compile together in a unity build).
+inline std::vector<std::uint8_t> bytes_of(std::string_view s) { return {s.begin(), s.end()}; }
+inline std::string text_of(const std::vector<std::uint8_t>& b) { return {b.begin(), b.end()}; }
+/// Empty when @p a and @p b hold equal content, else the first difference.
+inline std::string diff_of(const vsd::SimState& a, const vsd::SimState& b) {
+  std::string d;
+  return a.equals(b, &d) ? std::string() : d;
+}
 
 class IoPlain : public vsd::Node {
   VSD_INSTANCE(IoPlain, vsd::Node)

@@ -5,6 +5,7 @@
 
 #include <random>
 
+#include "io_model.hpp"
 #include "vsd/io/file.hpp"
 #include "vsd/io/snapshot.hpp"
 #include "vsd/io/tool.hpp"
@@ -34,10 +35,11 @@ class Robot : public vsd::Node {
 };
 }  // namespace ion_robotics
 
+using vsd_test::bytes_of;
+using vsd_test::text_of;
+
 namespace {
 
-std::string text_of(const std::vector<std::uint8_t>& b) { return {b.begin(), b.end()}; }
-std::vector<std::uint8_t> bytes_of(std::string_view s) { return {s.begin(), s.end()}; }
 vsd::Registry& global() { return vsd::Registry::global(); }
 
 class Files : public testing::TestWithParam<Format> {

@@ -17,12 +17,9 @@ using vsd_test::TTool;
 using vsd_test::build_model;
 using vsd_test::IoPlain;
 
-namespace {
+using vsd_test::diff_of;
 
-std::string diff_of(const vsd::SimState& a, const vsd::SimState& b) {
-  std::string d;
-  return a.equals(b, &d) ? std::string() : d;
-}
+namespace {
 
 std::string format_name(vsd::io::Format f) { return f == vsd::io::Format::Text ? "Text" : "Binary"; }
 

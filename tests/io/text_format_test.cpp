@@ -17,10 +17,12 @@ using testing::HasSubstr;
 using testing::MatchesRegex;
 using vsd::io::Format;
 
+using vsd_test::bytes_of;
+using vsd_test::text_of;
+using vsd_test::diff_of;
+
 namespace {
 
-std::vector<std::uint8_t> bytes_of(std::string_view s) { return {s.begin(), s.end()}; }
-std::string text_of(const std::vector<std::uint8_t>& b) { return {b.begin(), b.end()}; }
 std::string golden_path(const std::string& name) { return std::string(VSD_TEST_GOLDEN_DIR) + "/" + name; }
 
 std::string read_golden(const std::string& name) {
@@ -47,11 +49,6 @@ void build_golden_model(vsd::SimState& s) {
   rich.set_attitude(Eigen::Quaterniond(0, 1, 0, 0));
   rich.set_offset(Eigen::Vector2d(std::numeric_limits<double>::infinity(), -0.0));
   s.database().find_child("cell")->add_child(rich);
-}
-
-std::string diff_of(const vsd::SimState& a, const vsd::SimState& b) {
-  std::string d;
-  return a.equals(b, &d) ? std::string() : d;
 }
 
 // The text file is stable: a change of the format shows up here first. Set VSD_UPDATE_GOLDEN=1 to

@@ -10,9 +10,10 @@ using testing::ElementsAre;
 using testing::HasSubstr;
 using vsd::io::Format;
 
+using vsd_test::bytes_of;
+
 namespace {
 
-std::vector<std::uint8_t> bytes_of(std::string_view s) { return {s.begin(), s.end()}; }
 
 std::string load_error(vsd::SimState& state, const std::vector<std::uint8_t>& bytes, const char* origin) {
   const std::size_t before = state.size();

@@ -345,12 +345,12 @@ TEST(HardwareConfig, ParsesAdaptersAndRejectsNonsense) {
 }
 
 // The iiwa with a controller and a binding, stepped by the Scheduler.
-struct Cell {
+struct HardwareCell {
   Environment env;
   KinematicTree* tree = nullptr;
   JointController* ctrl = nullptr;
   HardwareBinding* hw = nullptr;
-  explicit Cell(const std::string& config) {
+  explicit HardwareCell(const std::string& config) {
     env.use<Module>();
     scene::UrdfOptions o;
     o.load_meshes = false;
@@ -380,7 +380,7 @@ TEST(HardwareBinding, TheSameControllerRunsInSimulationOrAgainstTheSimulatorProc
   std::vector<double> reached[2];
   SimulatorProcess sim(VSD_ROBOT_SIMULATOR, args({"--dof", "7"}));
   for (int run = 0; run < 2; ++run) {
-    Cell c(run == 0 ? "sim" : udp_config(sim.port()));
+    HardwareCell c(run == 0 ? "sim" : udp_config(sim.port()));
     c.ctrl->set_target(goal);
     c.ctrl->set_mode(ControlMode::Position);
     run_until_done(c.env, *c.ctrl, 200);
@@ -403,7 +403,7 @@ TEST(HardwareBinding, TheSameControllerRunsInSimulationOrAgainstTheSimulatorProc
 TEST(HardwareBinding, ADeadRobotHoldsTheControllerAndReportsTheFaultUntilItIsBack) {
   auto sim = std::make_unique<SimulatorProcess>(VSD_ROBOT_SIMULATOR, args({"--dof", "7"}));
   const std::uint16_t port = sim->port();
-  Cell c(udp_config(port));
+  HardwareCell c(udp_config(port));
   std::vector<BindingStatus> changes;
   auto conn = c.env.main_state()
                   .on_property_changed(HardwareBinding::static_meta(), true)
@@ -443,7 +443,7 @@ TEST(HardwareBinding, ADeadRobotHoldsTheControllerAndReportsTheFaultUntilItIsBac
 }
 
 TEST(HardwareBinding, ABadConfigurationIsAFaultNotASimulation) {
-  Cell c("udp://127.0.0.1:4000?joints=no_such_joint");
+  HardwareCell c("udp://127.0.0.1:4000?joints=no_such_joint");
   c.ctrl->set_target(std::vector<double>(7, 0.2));
   c.ctrl->set_mode(ControlMode::Position);
   c.env.step();

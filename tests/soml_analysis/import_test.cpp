@@ -18,12 +18,12 @@ namespace an = vsd::soml::analysis;
 
 namespace {
 
-const std::string kData = VSD_SOML_TEST_DATA_DIR;
+const std::string kImportData = VSD_SOML_TEST_DATA_DIR;
 
 class Import : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(Import, TheExecutorPlaysThePtNetFiringRule) {
-  const an::PnmlImport pnml = an::read_pnml_file(kData + "/" + GetParam() + ".pnml");
+  const an::PnmlImport pnml = an::read_pnml_file(kImportData + "/" + GetParam() + ".pnml");
   // The mirror has the ids the database nodes are named by (ids that are not identifiers are renamed),
   // in the same order as the PNML net.
   const an::PtNet mirror = an::read_soml_net(an::write_soml(pnml.net)).net;

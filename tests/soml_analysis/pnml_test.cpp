@@ -27,7 +27,7 @@ std::string wrap(const std::string& page_content,
          type + "\">\n<page id=\"pg\">\n" + page_content + "</page>\n</net>\n</pnml>\n";
 }
 
-std::string error_of(const std::string& text) {
+std::string pnml_error_of(const std::string& text) {
   try {
     an::read_pnml(text, "t.pnml");
   } catch (const vsd::Error& e) {
@@ -117,60 +117,60 @@ TEST(Pnml, MalformedXmlGivesLineAndColumn) {
       "<?xml version=\"1.0\"?>\n<pnml>\n<net id=\"n\" "
       "type=\"http://www.pnml.org/version-2009/grammar/ptnet\">\n"
       "  <page id=\"g\"><place id=\"p\">\n</net>\n</pnml>\n";
-  const std::string e = error_of(text);
+  const std::string e = pnml_error_of(text);
   EXPECT_EQ(e.rfind("t.pnml:5:", 0), 0u) << e;
   EXPECT_NE(e.find("malformed XML"), std::string::npos) << e;
-  const std::string e2 = error_of("<pnml><net id=\"x\" type=\"y\"");
+  const std::string e2 = pnml_error_of("<pnml><net id=\"x\" type=\"y\"");
   EXPECT_EQ(e2.rfind("t.pnml:1:", 0), 0u) << e2;
-  EXPECT_NE(error_of("").find("t.pnml:1:1:"), std::string::npos);
+  EXPECT_NE(pnml_error_of("").find("t.pnml:1:1:"), std::string::npos);
 }
 
 TEST(Pnml, UnsupportedNetTypesAreRefused) {
-  const std::string e = error_of(wrap("", "http://www.pnml.org/version-2009/grammar/symmetricnet"));
+  const std::string e = pnml_error_of(wrap("", "http://www.pnml.org/version-2009/grammar/symmetricnet"));
   EXPECT_EQ(e.rfind("t.pnml:3:1:", 0), 0u) << e;
   EXPECT_NE(e.find("symmetric net"), std::string::npos) << e;
   EXPECT_NE(e.find("not supported"), std::string::npos);
-  EXPECT_NE(error_of(wrap("", "http://www.pnml.org/version-2009/grammar/highlevelnet")).find("high-level"),
+  EXPECT_NE(pnml_error_of(wrap("", "http://www.pnml.org/version-2009/grammar/highlevelnet")).find("high-level"),
             std::string::npos);
-  EXPECT_NE(error_of(wrap("", "")).find("net type '' is not supported"), std::string::npos);
+  EXPECT_NE(pnml_error_of(wrap("", "")).find("net type '' is not supported"), std::string::npos);
 }
 
 TEST(Pnml, StructuralErrorsNameTheElementAndPosition) {
   EXPECT_NE(
-      error_of(
+      pnml_error_of(
           wrap("<place id=\"p\"/>\n<transition id=\"t\"/>\n<arc id=\"a\" source=\"p\" target=\"nope\"/>\n"))
           .find("t.pnml:7:1: arc 'a' has unknown target 'nope'"),
       std::string::npos);
   EXPECT_NE(
-      error_of(wrap("<place id=\"p\"/>\n<place id=\"q\"/>\n<arc id=\"a\" source=\"p\" target=\"q\"/>\n"))
+      pnml_error_of(wrap("<place id=\"p\"/>\n<place id=\"q\"/>\n<arc id=\"a\" source=\"p\" target=\"q\"/>\n"))
           .find("joins two places"),
       std::string::npos);
   EXPECT_NE(
-      error_of(wrap("<place id=\"p\"/>\n<transition id=\"p\"/>\n")).find("t.pnml:6:1: duplicate id 'p'"),
+      pnml_error_of(wrap("<place id=\"p\"/>\n<transition id=\"p\"/>\n")).find("t.pnml:6:1: duplicate id 'p'"),
       std::string::npos);
-  EXPECT_NE(error_of(wrap("<place id=\"p\"><initialMarking><text>-1</text></initialMarking></place>\n"))
+  EXPECT_NE(pnml_error_of(wrap("<place id=\"p\"><initialMarking><text>-1</text></initialMarking></place>\n"))
                 .find("initial marking '-1' is not an integer"),
             std::string::npos);
   EXPECT_NE(
-      error_of(wrap("<place id=\"p\"><initialMarking><text>9999999999</text></initialMarking></place>\n"))
+      pnml_error_of(wrap("<place id=\"p\"><initialMarking><text>9999999999</text></initialMarking></place>\n"))
           .find("is not an integer in [0, 2^32-1]"),
       std::string::npos);
-  EXPECT_NE(error_of(wrap("<place id=\"p\"/><transition id=\"t\"/><arc id=\"a\" source=\"p\" target=\"t\">"
+  EXPECT_NE(pnml_error_of(wrap("<place id=\"p\"/><transition id=\"t\"/><arc id=\"a\" source=\"p\" target=\"t\">"
                           "<inscription><text>0</text></inscription></arc>\n"))
                 .find("arc weight is 0"),
             std::string::npos);
-  EXPECT_NE(error_of(wrap("<place/>\n")).find("<place> without an id"), std::string::npos);
-  EXPECT_NE(error_of(wrap("<place id=\"p\"/><transition id=\"t\"/><arc id=\"a\" source=\"t\" target=\"p\">"
+  EXPECT_NE(pnml_error_of(wrap("<place/>\n")).find("<place> without an id"), std::string::npos);
+  EXPECT_NE(pnml_error_of(wrap("<place id=\"p\"/><transition id=\"t\"/><arc id=\"a\" source=\"t\" target=\"p\">"
                           "<type value=\"inhibitor\"/></arc>\n"))
                 .find("must go from a place to a transition"),
             std::string::npos);
-  EXPECT_NE(error_of(wrap("<place id=\"p\"/><transition id=\"t\"/><arc id=\"a\" source=\"p\" target=\"t\">"
+  EXPECT_NE(pnml_error_of(wrap("<place id=\"p\"/><transition id=\"t\"/><arc id=\"a\" source=\"p\" target=\"t\">"
                           "<type value=\"reset\"/></arc>\n"))
                 .find("arc type 'reset' is not supported"),
             std::string::npos);
-  EXPECT_NE(error_of("<foo/>").find("expected <pnml>"), std::string::npos);
-  EXPECT_NE(error_of("<pnml/>").find("holds no <net>"), std::string::npos);
-  EXPECT_NE(error_of("<pnml><net id=\"a\" type=\"x\"/><net id=\"b\" type=\"x\"/></pnml>").find("2 nets"),
+  EXPECT_NE(pnml_error_of("<foo/>").find("expected <pnml>"), std::string::npos);
+  EXPECT_NE(pnml_error_of("<pnml/>").find("holds no <net>"), std::string::npos);
+  EXPECT_NE(pnml_error_of("<pnml><net id=\"a\" type=\"x\"/><net id=\"b\" type=\"x\"/></pnml>").find("2 nets"),
             std::string::npos);
   EXPECT_THROW(an::read_pnml_file(kData + "/does-not-exist.pnml"), vsd::Error);
 }
@@ -188,9 +188,9 @@ TEST(Pnml, ReferenceNodesNestedPagesAndParallelArcs) {
   EXPECT_EQ(imp.net.transitions()[0].inputs[0].id, "a1");
   ASSERT_EQ(imp.notes.size(), 1u);
   EXPECT_NE(imp.notes[0].find("arc 'a2' is parallel"), std::string::npos);
-  EXPECT_NE(error_of(wrap("<referencePlace id=\"r\" ref=\"nowhere\"/>\n")).find("reference to unknown place"),
+  EXPECT_NE(pnml_error_of(wrap("<referencePlace id=\"r\" ref=\"nowhere\"/>\n")).find("reference to unknown place"),
             std::string::npos);
-  EXPECT_NE(error_of(wrap("<referencePlace id=\"r\" ref=\"s\"/><referencePlace id=\"s\" ref=\"r\"/>\n"))
+  EXPECT_NE(pnml_error_of(wrap("<referencePlace id=\"r\" ref=\"s\"/><referencePlace id=\"s\" ref=\"r\"/>\n"))
                 .find("reference cycle"),
             std::string::npos);
 }

@@ -17,9 +17,9 @@ using an::PtNet;
 
 namespace {
 
-const std::string kData = VSD_SOML_TEST_DATA_DIR;
+const std::string kSomlNetData = VSD_SOML_TEST_DATA_DIR;
 
-std::string error_of(const std::string& script) {
+std::string soml_net_error_of(const std::string& script) {
   try {
     (void)an::read_soml_net(script, "s.soml");
   } catch (const vsd::Error& e) {
@@ -136,7 +136,7 @@ arrow p -> t;
 }
 
 TEST(SomlNet, ConstructsOutsideBlackTokenNetsAreRefusedWithTheirPositions) {
-  const std::string e = error_of(R"(class Job : Node { bool ready = true; start cell.waiting; }
+  const std::string e = soml_net_error_of(R"(class Job : Node { bool ready = true; start cell.waiting; }
 object cell {
   place<Job> waiting;
   place free = 1;
@@ -168,7 +168,7 @@ transition helper { do { fill(); } }
 }
 
 TEST(SomlNet, NetsAndSubstitutionAndInvocationAreRefused) {
-  const std::string e = error_of(R"(net Relay(place in, place out) {
+  const std::string e = soml_net_error_of(R"(net Relay(place in, place out) {
   transition pass;
   arrow in -> pass;
   arrow pass -> out;
@@ -184,10 +184,10 @@ transition call { invoke ask(); }
 }
 
 TEST(SomlNet, ScriptErrorsComeWithTheirDiagnostics) {
-  const std::string e = error_of("place p = 1;\narrow p -> nowhere;\n");
+  const std::string e = soml_net_error_of("place p = 1;\narrow p -> nowhere;\n");
   EXPECT_NE(e.find("s.soml:2:12: error:"), std::string::npos) << e;
   EXPECT_NE(e.find("nowhere"), std::string::npos) << e;
-  EXPECT_NE(error_of("place p = ;").find("s.soml:1:11: error:"), std::string::npos);
+  EXPECT_NE(soml_net_error_of("place p = ;").find("s.soml:1:11: error:"), std::string::npos);
 }
 
 TEST(SomlNet, MccNetsSurviveTheWayThroughSomlAndHaveTheSameStateSpace) {
@@ -195,7 +195,7 @@ TEST(SomlNet, MccNetsSurviveTheWayThroughSomlAndHaveTheSameStateSpace) {
                             "Philosophers-PT-000005", "SharedMemory-PT-000005", "FMS-PT-00002", "Dekker-PT-010",
                             "Peterson-PT-2"}) {
     SCOPED_TRACE(model);
-    const an::PnmlImport pnml = an::read_pnml_file(kData + "/" + std::string(model) + ".pnml");
+    const an::PnmlImport pnml = an::read_pnml_file(kSomlNetData + "/" + std::string(model) + ".pnml");
     std::vector<std::string> renamed;
     const std::string script = an::write_soml(pnml.net, &renamed);
     const an::SomlNetImport back = an::read_soml_net(script, std::string(model) + ".soml");
@@ -210,7 +210,7 @@ TEST(SomlNet, MccNetsSurviveTheWayThroughSomlAndHaveTheSameStateSpace) {
       }
   }
   // One full state space through SOML++, against expected.tsv's figures for TokenRing-PT-005.
-  const an::PnmlImport ring = an::read_pnml_file(kData + "/TokenRing-PT-005.pnml");
+  const an::PnmlImport ring = an::read_pnml_file(kSomlNetData + "/TokenRing-PT-005.pnml");
   const an::SomlNetImport back = an::read_soml_net(an::write_soml(ring.net));
   const an::ExploreResult a = an::explore(ring.net), b = an::explore(back.net);
   EXPECT_EQ(a.states, b.states);
