@@ -35,7 +35,7 @@ const MetaInstance& ProgramImpl::adopt_class(ClassBuilder& b, const std::string&
   const auto props = std::move(adopted_props_);
   adopted_props_.clear();
   const MetaInstance* known = reg.find_class_exact(name);
-  if (known == nullptr) return b.define(reg);  // the state has no instance of it: defined as by a load
+  if (known == nullptr) return define_class(b);  // the state has no instance of it: defined as by a load
   auto disagree = [&](const std::string& what) {
     throw Error(where(*this, decl.loc) + ": class '" + name +
                 "' of the state does not match the script: " + what);
@@ -63,7 +63,7 @@ const MetaInstance& ProgramImpl::adopt_class(ClassBuilder& b, const std::string&
 const MetaType& ProgramImpl::adopt_enum(EnumBuilder& b, const std::string& name, const EnumDecl& e) {
   Registry& reg = state_.environment().registry();
   const MetaType* known = reg.find_type(name);
-  if (known == nullptr) return b.define(reg);
+  if (known == nullptr) return define_enum(b);
   bool same = known->kind() == TypeKind::Enum && known->enum_values().size() == e.values.size();
   for (std::size_t i = 0; same && i < e.values.size(); ++i) {
     std::int64_t v = 0;

@@ -10,6 +10,7 @@
 #include "vsd/core/error.hpp"
 #include "vsd/core/meta_method.hpp"
 #include "vsd/core/registry.hpp"
+#include "vsd/core/savepoint.hpp"
 #include "vsd/core/type_builder.hpp"
 
 namespace vsd::soml {
@@ -104,6 +105,54 @@ void ProgramImpl::load(std::string name, std::string text) {
   populate();
 }
 
+void ProgramImpl::load_or_undo(std::string name, std::string text) {
+  Savepoint sp(state_);
+  try {
+    load(std::move(name), std::move(text));
+    sp.commit();
+  } catch (...) {
+    // The instances first (a class with instances cannot go), then the classes, subclasses first.
+    listener_.disconnect();
+    deleted_listener_.disconnect();
+    try {
+      sp.rollback();
+    } catch (const Error&) {  // NOLINT(bugprone-empty-catch): the load's error says more; classes with
+    }                         // instances left then stay defined (undefine_own skips them)
+    undefine_own();
+    throw;
+  }
+}
+
+const MetaInstance& ProgramImpl::define_class(ClassBuilder& b) {
+  const MetaInstance& m = b.define(state_.environment().registry());
+  defined_classes_.push_back(&m);
+  return m;
+}
+
+const MetaType& ProgramImpl::define_enum(EnumBuilder& b) {
+  const MetaType& t = b.define(state_.environment().registry());
+  defined_enums_.push_back(&t);
+  return t;
+}
+
+void ProgramImpl::undefine_own() noexcept {
+  Registry& reg = state_.environment().registry();
+  // Bases were defined before their subclasses: undefining in reverse order goes subclasses first.
+  for (auto it = defined_classes_.rbegin(); it != defined_classes_.rend(); ++it) try {
+      reg.undefine(**it);
+    } catch (const Error&) {  // NOLINT(bugprone-empty-catch): one that still has instances stays
+    }
+  for (auto it = defined_enums_.rbegin(); it != defined_enums_.rend(); ++it) try {
+      reg.undefine(**it);
+    } catch (const Error&) {  // NOLINT(bugprone-empty-catch)
+    }
+  defined_classes_.clear();
+  defined_enums_.clear();
+  scope_meta_.clear();
+  by_meta_.clear();
+  enums_.clear();
+}
+
 void ProgramImpl::define(std::string name, std::string text) {
   Registry& reg = state_.environment().registry();
   checked_ = check_source(name, std::move(text), reg);
@@ -164,7 +213,7 @@ void ProgramImpl::define(std::string name, std::string text) {
     EnumBuilder b("soml::" + qualified(e));
     b.underlying(meta_type<std::int64_t>());
     for (std::size_t i = 0; i < e.values.size(); ++i) b.value(e.values[i], static_cast<std::int64_t>(i));
-    enums_[&e] = attaching_ ? &adopt_enum(b, "soml::" + qualified(e), e) : &b.define(reg);
+    enums_[&e] = attaching_ ? &adopt_enum(b, "soml::" + qualified(e), e) : &define_enum(b);
   });
 
   // 3. Class-like declarations, bases first.
@@ -246,7 +295,7 @@ void ProgramImpl::define(std::string name, std::string text) {
       b.property("result", *t);
       if (attaching_) adopted_props_.emplace_back("result", t);
     }
-    ci->meta = attaching_ ? &adopt_class(b, cname, *base, *c) : &b.define(reg);
+    ci->meta = attaching_ ? &adopt_class(b, cname, *base, *c) : &define_class(b);
     scope_meta_[c] = ci->meta;
     by_meta_[ci->meta] = ci.get();
     // Places and transitions with members of their own get a class of their own.
@@ -263,7 +312,7 @@ void ProgramImpl::define(std::string name, std::string text) {
       }
       ClassBuilder pb(cname + "::" + m->name, sb);
       add_members(pb, s);
-      scope_meta_[m.get()] = attaching_ ? &adopt_class(pb, cname + "::" + m->name, sb, s) : &pb.define(reg);
+      scope_meta_[m.get()] = attaching_ ? &adopt_class(pb, cname + "::" + m->name, sb, s) : &define_class(pb);
     }
     class_info_[c] = std::move(ci);
   }
@@ -876,7 +925,7 @@ std::unique_ptr<Program> Program::load(SimState& state, std::string name, std::s
   auto impl = std::make_shared<ProgramImpl>(state, options);
   impl->weak_self_ = impl;
   impl->rng_ = options.seed == 0 ? 0x9E3779B97F4A7C15ULL : options.seed;
-  impl->load(std::move(name), std::move(text));
+  impl->load_or_undo(std::move(name), std::move(text));
   return std::unique_ptr<Program>(new Program(std::move(impl)));
 }
 
@@ -885,7 +934,7 @@ std::unique_ptr<Program> Program::attach(SimState& state, std::string name, std:
   auto impl = std::make_shared<ProgramImpl>(state, options);
   impl->weak_self_ = impl;
   impl->attaching_ = true;
-  impl->load(std::move(name), std::move(text));
+  impl->load_or_undo(std::move(name), std::move(text));
   return std::unique_ptr<Program>(new Program(std::move(impl)));
 }
 

@@ -286,6 +286,16 @@ class ProgramImpl {
   [[nodiscard]] std::vector<const MetaInstance*> runtime_classes() const;
   const ProgramImpl* previous_ = nullptr;      // the running version, while a reload defines this one
   std::vector<const MetaType*> reused_enums_;  // enums of previous_ this version kept
+  // The classes and enums define() added to the Registry (not those an attach adopted), in definition
+  // order: a refused load undefines them (undefine_own), so that loading the fixed script works.
+  std::vector<const MetaInstance*> defined_classes_;
+  std::vector<const MetaType*> defined_enums_;
+  void undefine_own() noexcept;
+  const MetaInstance& define_class(ClassBuilder& b);
+  const MetaType& define_enum(EnumBuilder& b);
+  // Program::load and Program::attach: define and populate, all or nothing (a refused load leaves the
+  // Registry and the SimState as they were).
+  void load_or_undo(std::string name, std::string text);
 
   // ---- VM ----
   // Runs function @p f on @p self with arguments in args (count f.nparams); returns the result.
