@@ -3,6 +3,7 @@
 // and their nets.
 #include <algorithm>
 #include <cctype>
+#include <mutex>
 
 #include "program_impl.hpp"
 #include "vsd/core/database.hpp"
@@ -109,6 +110,7 @@ void ProgramImpl::load_or_undo(std::string name, std::string text) {
   Savepoint sp(state_);
   try {
     load(std::move(name), std::move(text));
+    bind_pending_methods();
     sp.commit();
   } catch (...) {
     // The instances first (a class with instances cannot go), then the classes, subclasses first.
@@ -262,11 +264,11 @@ void ProgramImpl::define(std::string name, std::string text) {
             fd.result_type.kind == K::Void ? nullptr : storage_type(*this, reg, fd.result_type);
         const int fi = function_index_.at(&fd);
         std::weak_ptr<ProgramImpl> weak = weak_self_;
+        if (attaching_) adopted_methods_.push_back(AdoptedMethod{fd.name, args, result});
         b.method(fd.name, std::move(args), result,
-                 [weak, fi](SimStateInstance& self, std::span<const Value> a) {
-                   auto p = weak.lock();
-                   if (!p) throw Error("the SOML++ program of this method was unloaded");
-                   return p->call_from_cpp(fi, self, a);
+                 [weak, fi, fname = functions_[static_cast<std::size_t>(fi)]->name](
+                     SimStateInstance& self, std::span<const Value> a) {
+                   return dispatch(weak, fi, fname, self, a);
                  });
       }
     }
@@ -833,6 +835,48 @@ void ProgramImpl::register_net(std::unique_ptr<NetInst> net, const ClassInfo& ci
   }
 }
 
+namespace {
+// Every live program by the SimState it runs (a few per process: a linear search is enough).
+std::mutex programs_mutex;
+std::vector<std::pair<const SimState*, std::weak_ptr<ProgramImpl>>>& programs_by_state() {
+  static std::vector<std::pair<const SimState*, std::weak_ptr<ProgramImpl>>> all;
+  return all;
+}
+}  // namespace
+
+void ProgramImpl::register_program() {
+  std::lock_guard lock(programs_mutex);
+  auto& all = programs_by_state();
+  std::erase_if(all, [](const auto& e) { return e.second.expired(); });
+  all.emplace_back(&state_, weak_self_);
+}
+
+Value ProgramImpl::dispatch(const std::weak_ptr<ProgramImpl>& weak, int fi, const std::string& fname,
+                            SimStateInstance& self, std::span<const Value> args) {
+  if (std::shared_ptr<ProgramImpl> p = weak.lock(); p && &p->state_ == &self.state())
+    return p->call_from_cpp(fi, self, args);
+  // Another program runs this instance's state with the same classes (a replica's, or the program that
+  // attached again after this one went): its function of the same name.
+  std::shared_ptr<ProgramImpl> other;
+  {
+    std::lock_guard lock(programs_mutex);
+    for (const auto& [state, w] : programs_by_state()) {
+      if (state != &self.state()) continue;
+      std::shared_ptr<ProgramImpl> q = w.lock();
+      if (!q) continue;
+      for (const auto& [decl, m] : q->scope_meta_)
+        if (m == &self.meta()) other = q;
+    }
+  }
+  if (!other)
+    throw Error("no SOML++ program runs the state of " + self.meta().name() + " #" +
+                std::to_string(self.id()) + " (its program was unloaded, or the state was never attached)");
+  for (std::size_t i = 0; i < other->functions_.size(); ++i)
+    if (other->functions_[i]->name == fname) return other->call_from_cpp(static_cast<int>(i), self, args);
+  throw Error("the SOML++ program that runs " + self.meta().name() + " #" + std::to_string(self.id()) +
+              " has no function " + fname);
+}
+
 Value ProgramImpl::call_from_cpp(int fi, SimStateInstance& self, std::span<const Value> args) {
   const Function& f = *functions_[static_cast<std::size_t>(fi)];
   if (static_cast<int>(args.size()) != f.nparams)
@@ -926,6 +970,7 @@ std::unique_ptr<Program> Program::load(SimState& state, std::string name, std::s
   impl->weak_self_ = impl;
   impl->rng_ = options.seed == 0 ? 0x9E3779B97F4A7C15ULL : options.seed;
   impl->load_or_undo(std::move(name), std::move(text));
+  impl->register_program();
   return std::unique_ptr<Program>(new Program(std::move(impl)));
 }
 
@@ -935,6 +980,7 @@ std::unique_ptr<Program> Program::attach(SimState& state, std::string name, std:
   impl->weak_self_ = impl;
   impl->attaching_ = true;
   impl->load_or_undo(std::move(name), std::move(text));
+  impl->register_program();
   return std::unique_ptr<Program>(new Program(std::move(impl)));
 }
 
