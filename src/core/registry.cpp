@@ -316,6 +316,36 @@ void Registry::undefine(const MetaInstance& cls) {
   runtime_classes_.erase(it);  // ~MetaInstance unlinks it from its base
 }
 
+void Registry::add_methods(const MetaInstance& cls, ClassBuilder&& from) {
+  std::unique_lock lock(mutex_);
+  if (!cls.is_runtime()) detail::throw_error("built-in class '" + cls.name() + "' cannot be given methods");
+  if (!owns_locked(cls)) detail::throw_error("class '" + cls.name() + "' is not defined in this registry");
+  if (!from.meta_) detail::throw_error("add_methods: the ClassBuilder was used up");
+  auto& target = const_cast<MetaInstance&>(cls);  // this registry owns it
+  std::vector<std::unique_ptr<MetaMethod>> fresh;
+  for (auto& m : from.meta_->own_methods_) {
+    auto same = std::find_if(target.own_methods_.begin(), target.own_methods_.end(),
+                             [&](const auto& x) { return x->name() == m->name(); });
+    if (same == target.own_methods_.end()) {
+      fresh.push_back(std::move(m));
+    } else if ((*same)->result() != m->result() || (*same)->arguments() != m->arguments()) {
+      detail::throw_error("class '" + cls.name() + "' has method " + (*same)->signature() + ", not " +
+                          m->signature());
+    }
+  }
+  from.meta_.reset();
+  if (fresh.empty()) return;
+  for (auto& m : fresh) target.add_method(std::move(m));
+  // finish() copies the base's method list into each subclass: redo it down the hierarchy.
+  std::vector<MetaInstance*> todo{&target};
+  while (!todo.empty()) {
+    MetaInstance* m = todo.back();
+    todo.pop_back();
+    m->finish();
+    for (const MetaInstance* d : m->derived()) todo.push_back(const_cast<MetaInstance*>(d));
+  }
+}
+
 void Registry::rename(const MetaInstance& cls, std::string name) {
   std::unique_lock lock(mutex_);
   if (!cls.is_runtime()) detail::throw_error("built-in class '" + cls.name() + "' cannot be renamed");

@@ -5,6 +5,7 @@
 // state (generator, firings, the enabled transitions in choice order, the transitions waiting for a test)
 // is read from the script object's "(executor)" node, which the executor keeps current. Also here: the
 // executor's side of that node (sync_state) and the revival of nets a rolled-back firing had deleted.
+#include <algorithm>
 #include <unordered_map>
 
 #include "program_impl.hpp"
@@ -34,8 +35,10 @@ const MetaInstance& ProgramImpl::adopt_class(ClassBuilder& b, const std::string&
   Registry& reg = state_.environment().registry();
   const auto props = std::move(adopted_props_);
   adopted_props_.clear();
+  const auto methods = std::move(adopted_methods_);
+  adopted_methods_.clear();
   const MetaInstance* known = reg.find_class_exact(name);
-  if (known == nullptr) return b.define(reg);  // the state has no instance of it: defined as by a load
+  if (known == nullptr) return define_class(b);  // the state has no instance of it: defined as by a load
   auto disagree = [&](const std::string& what) {
     throw Error(where(*this, decl.loc) + ": class '" + name +
                 "' of the state does not match the script: " + what);
@@ -57,13 +60,31 @@ const MetaInstance& ProgramImpl::adopt_class(ClassBuilder& b, const std::string&
       disagree("property '" + props[i].first + "' is " + own[i]->type().name() + " in the state, " +
                type_name(props[i].second) + " in the script");
   }
+  // Its methods: none when a file defined it (they are bound once the attach succeeded), the script's
+  // when a program of this Registry defined it (a replica of its state).
+  for (const MetaMethod* m : known->methods()) {
+    if (&m->owner() != known) continue;
+    auto it =
+        std::find_if(methods.begin(), methods.end(), [&](const auto& x) { return x.name == m->name(); });
+    if (it == methods.end())
+      disagree("the state's has a method '" + m->name() + "' the script does not declare");
+    if (it->args != m->arguments() || it->result != m->result())
+      disagree("method '" + m->name() + "' is " + m->signature() + " in the state");
+  }
+  pending_methods_.emplace_back(known, std::move(b));
   return *known;
+}
+
+void ProgramImpl::bind_pending_methods() {
+  Registry& reg = state_.environment().registry();
+  for (auto& [cls, b] : pending_methods_) reg.add_methods(*cls, std::move(b));
+  pending_methods_.clear();
 }
 
 const MetaType& ProgramImpl::adopt_enum(EnumBuilder& b, const std::string& name, const EnumDecl& e) {
   Registry& reg = state_.environment().registry();
   const MetaType* known = reg.find_type(name);
-  if (known == nullptr) return b.define(reg);
+  if (known == nullptr) return define_enum(b);
   bool same = known->kind() == TypeKind::Enum && known->enum_values().size() == e.values.size();
   for (std::size_t i = 0; same && i < e.values.size(); ++i) {
     std::int64_t v = 0;

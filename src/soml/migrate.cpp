@@ -521,8 +521,112 @@ MigrationReport Program::reload(std::string name, std::string text) {
   auto fresh = std::make_shared<ProgramImpl>(impl_->state_, impl_->opt_);
   fresh->weak_self_ = fresh;
   MigrationReport report = migrate(*impl_, *fresh, std::move(name), std::move(text));
+  fresh->register_program();
   impl_ = std::move(fresh);
   return report;
+}
+
+void Program::follow_reload(std::string name, std::string text, const Transaction& bundle) {
+  ProgramImpl& old = *impl_;
+  if (old.debug_ != nullptr) throw Error("cannot follow a reload while a debugger is attached");
+  if (!old.frames_.empty() || old.entry_depth_ != 0)
+    throw Error("cannot follow a reload from the program's own code (it is running)");
+  SimState& state = old.state_;
+  Registry& reg = state.environment().registry();
+  auto fresh = std::make_shared<ProgramImpl>(state, old.opt_);
+  fresh->weak_self_ = fresh;
+
+  // As on the source: the running version's classes make room under retired names.
+  const std::vector<const MetaInstance*> old_classes = old.runtime_classes();
+  std::vector<std::string> old_names;
+  auto restore_names = [&] {
+    for (std::size_t i = old_names.size(); i-- > 0;) reg.rename(*old_classes[i], old_names[i]);
+  };
+  try {
+    for (const MetaInstance* m : old_classes) {
+      std::string retired;
+      for (int n = 1; retired.empty() || reg.find_class_exact(retired) != nullptr; ++n)
+        retired = m->name() + "~" + std::to_string(n);
+      const std::string was = m->name();
+      reg.rename(*m, retired);
+      old_names.push_back(was);
+    }
+    fresh->previous_ = &old;
+    fresh->define(std::move(name), std::move(text));
+  } catch (...) {
+    fresh->undefine_own();
+    restore_names();
+    throw;
+  }
+
+  // The bundle creates the new version's instances and deletes the old ones (checked whole first: one
+  // that does not apply changes nothing); then the new version attaches to what it made.
+  old.listener_.disconnect();
+  old.deleted_listener_.disconnect();
+  {
+    Savepoint sp(state);
+    bool applied = false;
+    try {
+      state.apply(bundle);
+      applied = true;
+      fresh->attaching_ = true;
+      fresh->populate();
+      sp.commit();
+    } catch (const Error& e) {
+      fresh->listener_.disconnect();
+      fresh->deleted_listener_.disconnect();
+      std::string extra;
+      try {
+        sp.rollback();
+      } catch (const Error& r) {
+        extra = "; rolling back failed too: " + std::string(r.what());
+      }
+      fresh->undefine_own();
+      restore_names();
+      if (!applied) {
+        old.connect_listeners();
+        throw;
+      }
+      // The old version's nodes came back at other addresses: attach it again to them.
+      try {
+        auto again = std::make_shared<ProgramImpl>(state, old.opt_);
+        again->weak_self_ = again;
+        again->attaching_ = true;
+        again->load_or_undo(old.checked_->source->name(), old.checked_->source->text());
+        again->attaching_ = false;
+        again->on_dirty_ = old.on_dirty_;
+        again->trace_ = old.trace_;
+        again->register_program();
+        impl_ = std::move(again);
+      } catch (const Error& r) {
+        extra += "; attaching the running version again failed: " + std::string(r.what());
+      }
+      throw Error(std::string(e.what()) + extra);
+    }
+  }
+  fresh->attaching_ = false;
+  fresh->previous_ = nullptr;
+  fresh->on_dirty_ = old.on_dirty_;
+  fresh->trace_ = old.trace_;
+  fresh->tests_ = old.tests_;
+  fresh->condition_errors_ = old.condition_errors_;
+  // The retired classes and enums go, as on the source (one something else still uses stays).
+  for (const MetaInstance* m : old_classes) try {
+      reg.undefine(*m);
+    } catch (const Error&) {  // NOLINT(bugprone-empty-catch): it stays under its retired name
+    }
+  for (const auto& [decl, t] : old.enums_)
+    if (std::find(fresh->reused_enums_.begin(), fresh->reused_enums_.end(), t) == fresh->reused_enums_.end())
+      try {
+        reg.undefine(*t);
+      } catch (const Error&) {  // NOLINT(bugprone-empty-catch)
+      }
+  old.enums_.clear();
+  old.scope_meta_.clear();
+  old.by_meta_.clear();
+  fresh->register_program();
+  impl_ = std::move(fresh);
+  if (!impl_->dirty_.empty() && impl_->on_dirty_) impl_->on_dirty_();
 }
 
 }  // namespace vsd::soml

@@ -3,6 +3,7 @@
 // and their nets.
 #include <algorithm>
 #include <cctype>
+#include <mutex>
 
 #include "program_impl.hpp"
 #include "vsd/core/database.hpp"
@@ -10,6 +11,7 @@
 #include "vsd/core/error.hpp"
 #include "vsd/core/meta_method.hpp"
 #include "vsd/core/registry.hpp"
+#include "vsd/core/savepoint.hpp"
 #include "vsd/core/type_builder.hpp"
 
 namespace vsd::soml {
@@ -104,6 +106,55 @@ void ProgramImpl::load(std::string name, std::string text) {
   populate();
 }
 
+void ProgramImpl::load_or_undo(std::string name, std::string text) {
+  Savepoint sp(state_);
+  try {
+    load(std::move(name), std::move(text));
+    bind_pending_methods();
+    sp.commit();
+  } catch (...) {
+    // The instances first (a class with instances cannot go), then the classes, subclasses first.
+    listener_.disconnect();
+    deleted_listener_.disconnect();
+    try {
+      sp.rollback();
+    } catch (const Error&) {  // NOLINT(bugprone-empty-catch): the load's error says more; classes with
+    }                         // instances left then stay defined (undefine_own skips them)
+    undefine_own();
+    throw;
+  }
+}
+
+const MetaInstance& ProgramImpl::define_class(ClassBuilder& b) {
+  const MetaInstance& m = b.define(state_.environment().registry());
+  defined_classes_.push_back(&m);
+  return m;
+}
+
+const MetaType& ProgramImpl::define_enum(EnumBuilder& b) {
+  const MetaType& t = b.define(state_.environment().registry());
+  defined_enums_.push_back(&t);
+  return t;
+}
+
+void ProgramImpl::undefine_own() noexcept {
+  Registry& reg = state_.environment().registry();
+  // Bases were defined before their subclasses: undefining in reverse order goes subclasses first.
+  for (auto it = defined_classes_.rbegin(); it != defined_classes_.rend(); ++it) try {
+      reg.undefine(**it);
+    } catch (const Error&) {  // NOLINT(bugprone-empty-catch): one that still has instances stays
+    }
+  for (auto it = defined_enums_.rbegin(); it != defined_enums_.rend(); ++it) try {
+      reg.undefine(**it);
+    } catch (const Error&) {  // NOLINT(bugprone-empty-catch)
+    }
+  defined_classes_.clear();
+  defined_enums_.clear();
+  scope_meta_.clear();
+  by_meta_.clear();
+  enums_.clear();
+}
+
 void ProgramImpl::define(std::string name, std::string text) {
   Registry& reg = state_.environment().registry();
   checked_ = check_source(name, std::move(text), reg);
@@ -164,7 +215,7 @@ void ProgramImpl::define(std::string name, std::string text) {
     EnumBuilder b("soml::" + qualified(e));
     b.underlying(meta_type<std::int64_t>());
     for (std::size_t i = 0; i < e.values.size(); ++i) b.value(e.values[i], static_cast<std::int64_t>(i));
-    enums_[&e] = attaching_ ? &adopt_enum(b, "soml::" + qualified(e), e) : &b.define(reg);
+    enums_[&e] = attaching_ ? &adopt_enum(b, "soml::" + qualified(e), e) : &define_enum(b);
   });
 
   // 3. Class-like declarations, bases first.
@@ -213,11 +264,11 @@ void ProgramImpl::define(std::string name, std::string text) {
             fd.result_type.kind == K::Void ? nullptr : storage_type(*this, reg, fd.result_type);
         const int fi = function_index_.at(&fd);
         std::weak_ptr<ProgramImpl> weak = weak_self_;
+        if (attaching_) adopted_methods_.push_back(AdoptedMethod{fd.name, args, result});
         b.method(fd.name, std::move(args), result,
-                 [weak, fi](SimStateInstance& self, std::span<const Value> a) {
-                   auto p = weak.lock();
-                   if (!p) throw Error("the SOML++ program of this method was unloaded");
-                   return p->call_from_cpp(fi, self, a);
+                 [weak, fi, fname = functions_[static_cast<std::size_t>(fi)]->name](
+                     SimStateInstance& self, std::span<const Value> a) {
+                   return dispatch(weak, fi, fname, self, a);
                  });
       }
     }
@@ -246,7 +297,7 @@ void ProgramImpl::define(std::string name, std::string text) {
       b.property("result", *t);
       if (attaching_) adopted_props_.emplace_back("result", t);
     }
-    ci->meta = attaching_ ? &adopt_class(b, cname, *base, *c) : &b.define(reg);
+    ci->meta = attaching_ ? &adopt_class(b, cname, *base, *c) : &define_class(b);
     scope_meta_[c] = ci->meta;
     by_meta_[ci->meta] = ci.get();
     // Places and transitions with members of their own get a class of their own.
@@ -263,7 +314,7 @@ void ProgramImpl::define(std::string name, std::string text) {
       }
       ClassBuilder pb(cname + "::" + m->name, sb);
       add_members(pb, s);
-      scope_meta_[m.get()] = attaching_ ? &adopt_class(pb, cname + "::" + m->name, sb, s) : &pb.define(reg);
+      scope_meta_[m.get()] = attaching_ ? &adopt_class(pb, cname + "::" + m->name, sb, s) : &define_class(pb);
     }
     class_info_[c] = std::move(ci);
   }
@@ -784,6 +835,48 @@ void ProgramImpl::register_net(std::unique_ptr<NetInst> net, const ClassInfo& ci
   }
 }
 
+namespace {
+// Every live program by the SimState it runs (a few per process: a linear search is enough).
+std::mutex programs_mutex;
+std::vector<std::pair<const SimState*, std::weak_ptr<ProgramImpl>>>& programs_by_state() {
+  static std::vector<std::pair<const SimState*, std::weak_ptr<ProgramImpl>>> all;
+  return all;
+}
+}  // namespace
+
+void ProgramImpl::register_program() {
+  std::lock_guard lock(programs_mutex);
+  auto& all = programs_by_state();
+  std::erase_if(all, [](const auto& e) { return e.second.expired(); });
+  all.emplace_back(&state_, weak_self_);
+}
+
+Value ProgramImpl::dispatch(const std::weak_ptr<ProgramImpl>& weak, int fi, const std::string& fname,
+                            SimStateInstance& self, std::span<const Value> args) {
+  if (std::shared_ptr<ProgramImpl> p = weak.lock(); p && &p->state_ == &self.state())
+    return p->call_from_cpp(fi, self, args);
+  // Another program runs this instance's state with the same classes (a replica's, or the program that
+  // attached again after this one went): its function of the same name.
+  std::shared_ptr<ProgramImpl> other;
+  {
+    std::lock_guard lock(programs_mutex);
+    for (const auto& [state, w] : programs_by_state()) {
+      if (state != &self.state()) continue;
+      std::shared_ptr<ProgramImpl> q = w.lock();
+      if (!q) continue;
+      for (const auto& [decl, m] : q->scope_meta_)
+        if (m == &self.meta()) other = q;
+    }
+  }
+  if (!other)
+    throw Error("no SOML++ program runs the state of " + self.meta().name() + " #" +
+                std::to_string(self.id()) + " (its program was unloaded, or the state was never attached)");
+  for (std::size_t i = 0; i < other->functions_.size(); ++i)
+    if (other->functions_[i]->name == fname) return other->call_from_cpp(static_cast<int>(i), self, args);
+  throw Error("the SOML++ program that runs " + self.meta().name() + " #" + std::to_string(self.id()) +
+              " has no function " + fname);
+}
+
 Value ProgramImpl::call_from_cpp(int fi, SimStateInstance& self, std::span<const Value> args) {
   const Function& f = *functions_[static_cast<std::size_t>(fi)];
   if (static_cast<int>(args.size()) != f.nparams)
@@ -876,7 +969,8 @@ std::unique_ptr<Program> Program::load(SimState& state, std::string name, std::s
   auto impl = std::make_shared<ProgramImpl>(state, options);
   impl->weak_self_ = impl;
   impl->rng_ = options.seed == 0 ? 0x9E3779B97F4A7C15ULL : options.seed;
-  impl->load(std::move(name), std::move(text));
+  impl->load_or_undo(std::move(name), std::move(text));
+  impl->register_program();
   return std::unique_ptr<Program>(new Program(std::move(impl)));
 }
 
@@ -885,7 +979,8 @@ std::unique_ptr<Program> Program::attach(SimState& state, std::string name, std:
   auto impl = std::make_shared<ProgramImpl>(state, options);
   impl->weak_self_ = impl;
   impl->attaching_ = true;
-  impl->load(std::move(name), std::move(text));
+  impl->load_or_undo(std::move(name), std::move(text));
+  impl->register_program();
   return std::unique_ptr<Program>(new Program(std::move(impl)));
 }
 

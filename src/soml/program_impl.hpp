@@ -286,6 +286,16 @@ class ProgramImpl {
   [[nodiscard]] std::vector<const MetaInstance*> runtime_classes() const;
   const ProgramImpl* previous_ = nullptr;      // the running version, while a reload defines this one
   std::vector<const MetaType*> reused_enums_;  // enums of previous_ this version kept
+  // The classes and enums define() added to the Registry (not those an attach adopted), in definition
+  // order: a refused load undefines them (undefine_own), so that loading the fixed script works.
+  std::vector<const MetaInstance*> defined_classes_;
+  std::vector<const MetaType*> defined_enums_;
+  void undefine_own() noexcept;
+  const MetaInstance& define_class(ClassBuilder& b);
+  const MetaType& define_enum(EnumBuilder& b);
+  // Program::load and Program::attach: define and populate, all or nothing (a refused load leaves the
+  // Registry and the SimState as they were).
+  void load_or_undo(std::string name, std::string text);
 
   // ---- VM ----
   // Runs function @p f on @p self with arguments in args (count f.nparams); returns the result.
@@ -298,6 +308,13 @@ class ProgramImpl {
   Val run(int f, std::uint64_t self, std::uint64_t mark, const Val* args, const std::string* sargs,
           std::string* sresult = nullptr, const VecReg* vargs = nullptr, VecReg* vresult = nullptr);
   Value call_from_cpp(int f, SimStateInstance& self, std::span<const Value> args);
+  // The body of the MetaMethod of function @p f of @p weak: runs it in the program that runs the state
+  // of @p self (the method's own program, or another attached to a replica or a loaded copy that uses
+  // the same classes; found by the function's name).
+  static Value dispatch(const std::weak_ptr<ProgramImpl>& weak, int f, const std::string& fname,
+                        SimStateInstance& self, std::span<const Value> args);
+  // Programs by the state they run (dispatch): registered once loaded or attached, gone with them.
+  void register_program();
   SimStateInstance& instantiate(const ClassInfo& ci, Node* parent, std::string name, const Val* args,
                                 const std::string* sargs, int nargs, const VecReg* vargs = nullptr);
   [[noreturn]] void fail(const std::string& what);
@@ -325,6 +342,16 @@ class ProgramImpl {
                                   const ScopeDecl& decl);
   const MetaType& adopt_enum(EnumBuilder& b, const std::string& name, const EnumDecl& decl);
   std::vector<std::pair<std::string, const MetaType*>> adopted_props_;  // the class being adopted's
+  struct AdoptedMethod {
+    std::string name;
+    std::vector<const MetaType*> args;
+    const MetaType* result = nullptr;
+  };
+  std::vector<AdoptedMethod> adopted_methods_;  // the class being adopted's
+  // Classes of the state that get the script's functions as MetaMethods once the attach succeeded (a
+  // class a file defined has properties only).
+  std::vector<std::pair<const MetaInstance*, ClassBuilder>> pending_methods_;
+  void bind_pending_methods();
   void attach_content();
   // The places and transitions of @p owner's net, found among its children as build_net made them.
   // @throws vsd::Error naming what does not match.

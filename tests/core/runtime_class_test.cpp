@@ -441,6 +441,49 @@ TEST(RuntimeClass, SubclassOfARuntimeClass) {
   EXPECT_THROW((void)child->property("extra").get<double>(state.create(*parent)), vsd::Error);
 }
 
+// A class defined without methods (from a file's schema) is given them later: the class and its
+// subclasses see them; one it declares already with the same signature stays; another signature is refused.
+TEST(RuntimeClass, AddMethodsToADefinedClassAndItsSubclasses) {
+  auto twice = [](vsd::SimStateInstance& self, std::span<const vsd::Value> a) {
+    return vsd::Value(2.0 * a[0].as<double>() + self.get<double>("v"));
+  };
+  Defined parent(vsd::ClassBuilder("RcAdd_Parent", vsd::Node::static_meta()).property("v", 0.5).define());
+  Defined child(vsd::ClassBuilder("RcAdd_Child", *parent).define());
+  vsd::Environment env;
+  vsd::SimStateInstance& x = env.main_state().create(*child);
+  EXPECT_THAT(error_of([&] { (void)x.call("twice", {vsd::Value(1.0)}); }), HasSubstr("'twice'"));
+  vsd::Registry::global().add_methods(
+      *parent,
+      std::move(vsd::ClassBuilder("RcAdd_Parent", vsd::Node::static_meta())
+                    .method("twice", {&vsd::meta_type<double>()}, &vsd::meta_type<double>(), twice)));
+  EXPECT_EQ(x.call("twice", {vsd::Value(1.0)}).as<double>(), 2.5) << "the subclass sees the new method";
+  EXPECT_EQ(parent->method("twice").owner().name(), "RcAdd_Parent");
+  EXPECT_EQ(child->properties().size(), parent->properties().size());
+  EXPECT_EQ(child->find_property("v"), &parent->property("v"));
+  // The same signature again: kept (no duplicate); another signature: refused, nothing changed.
+  const vsd::MetaMethod* kept = parent->find_method("twice");
+  vsd::Registry::global().add_methods(
+      *parent,
+      std::move(vsd::ClassBuilder("RcAdd_Parent", vsd::Node::static_meta())
+                    .method("twice", {&vsd::meta_type<double>()}, &vsd::meta_type<double>(), twice)));
+  EXPECT_EQ(parent->find_method("twice"), kept);
+  EXPECT_EQ(parent->methods().size(), child->methods().size());
+  const std::string e = error_of([&] {
+    vsd::Registry::global().add_methods(
+        *parent, std::move(vsd::ClassBuilder("RcAdd_Parent", vsd::Node::static_meta())
+                               .method("other", {}, nullptr, twice)
+                               .method("twice", {&vsd::meta_type<std::string>()}, nullptr, twice)));
+  });
+  EXPECT_THAT(e, HasSubstr("class 'RcAdd_Parent' has method twice(double) -> double, not twice(string)"));
+  EXPECT_EQ(parent->find_method("other"), nullptr);
+  EXPECT_THAT(error_of([&] {
+                vsd::Registry::global().add_methods(vsd::Node::static_meta(),
+                                                    vsd::ClassBuilder("RcAdd_X", vsd::Node::static_meta()));
+              }),
+              HasSubstr("built-in class 'Node' cannot be given methods"));
+  env.main_state().destroy(x);
+}
+
 TEST(RuntimeClass, BaseCannotBeUndefinedBeforeItsSubclass) {
   Defined parent(define_robot("RcOrder_Robot"));
   Defined child(vsd::ClassBuilder("RcOrder_Child", *parent).define());

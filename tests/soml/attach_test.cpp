@@ -325,6 +325,111 @@ TEST_F(BadAttach, ASyntaxErrorIsReportedLikeForALoad) {
   EXPECT_THAT(attach_error(saved(), text + "\nplace ;\n"), HasSubstr("golden.soml:15:"));
 }
 
+// The functions of classes a file defined are MetaMethods of the attached program (docs/soml.md 8.7):
+// C++ calls them with arguments and receives their results exactly as after a load; wrong arguments are a
+// clear vsd::Error; subclasses, objects, the script object and place classes have theirs.
+TEST(Attach, FunctionsOfClassesTheFileDefinedAreCallableFromCpp) {
+  const std::string text = R"(
+enum Mode { Idle, Busy }
+class Counter : Node {
+  int n = 0;
+  Mode mode = Mode::Idle;
+  int add(int k) { n += k; mode = Mode::Busy; return n; }
+  string label(string prefix, double x) { return prefix + string(x); }
+  bool busy() { return mode == Mode::Busy; }
+}
+class Twice : Counter { int add(int k) { n += 2 * k; return n; } }
+object c : Counter;
+object t : Twice;
+int total() { return c.n + t.n; }
+place tank { double level = 1.5; double half() { return level / 2.0; } }
+)";
+  Session a;
+  a.load(text, 1);
+  EXPECT_EQ(a.p->object("c")->call("add", {vsd::Value(std::int64_t{2})}).as<std::int64_t>(), 2);
+  const auto bytes = vsd::io::save_bytes(a.env.main_state(), vsd::io::Format::Binary);
+  Session b;
+  vsd::io::load_bytes(b.env.main_state(), bytes);
+  const vsd::MetaInstance* counter = b.reg.find_class_exact("soml::Counter");
+  ASSERT_NE(counter, nullptr);
+  EXPECT_EQ(counter->find_method("add"), nullptr);  // the file carries the properties only
+  Program& p = b.attach(b.env.main_state(), text);
+  vsd::Node& c = *p.object("c");
+  vsd::Node& t = *p.object("t");
+  EXPECT_EQ(&c.meta(), b.reg.find_class_exact("soml::c"));
+  EXPECT_EQ(c.call("add", {vsd::Value(std::int64_t{3})}).as<std::int64_t>(), 5);
+  EXPECT_EQ(c.get<std::int64_t>("n"), 5);
+  EXPECT_TRUE(c.call("busy").as<bool>());
+  EXPECT_EQ(c.call("label", {vsd::Value(std::string("x=")), vsd::Value(0.5)}).as<std::string>(), "x=0.5");
+  EXPECT_EQ(t.call("add", {vsd::Value(std::int64_t{4})}).as<std::int64_t>(), 8) << "the override";
+  EXPECT_FALSE(t.call("busy").as<bool>());
+  EXPECT_EQ(p.root().call("total").as<std::int64_t>(), 13);
+  vsd::soml::Place* tank = p.place("tank");
+  ASSERT_NE(tank, nullptr);
+  EXPECT_EQ(tank->call("half").as<double>(), 0.75);
+  // Wrong arguments: the MetaMethod's checks, then the program's.
+  EXPECT_THROW(c.call("add"), vsd::Error);
+  try {
+    (void)c.call("add", {vsd::Value(std::string("three"))});
+    FAIL() << "called";
+  } catch (const vsd::Error& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr("argument 1"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("int64"));
+  }
+  EXPECT_THROW((void)c.call("label", {vsd::Value(1.0), vsd::Value(0.5)}), vsd::Error);
+  EXPECT_THROW((void)c.call("nothing"), vsd::Error);
+  EXPECT_EQ(c.get<std::int64_t>("n"), 5);
+}
+
+// A script whose functions differ from the methods the state's classes have is refused with its
+// position; the classes keep their methods.
+TEST(Attach, MethodsOfTheStateThatDifferFromTheScriptAreNamed) {
+  const std::string text = "class A : Node { int n = 0; int f(int k) { return k; } }\nobject a : A;\n";
+  Session a;
+  a.load(text, 1);
+  vsd::SimState& replica = a.env.create_state("replica");
+  replica.copy_from(a.env.main_state());
+  std::string changed = text;
+  changed.replace(changed.find("int f(int k)"), 12, "int f(bool k)");
+  changed.replace(changed.find("return k;"), 9, "return 1;");
+  try {
+    Program::attach(replica, "golden.soml", changed);
+    FAIL() << "attached";
+  } catch (const vsd::Error& e) {
+    EXPECT_THAT(std::string(e.what()),
+                HasSubstr("golden.soml:1:7: class 'soml::A' of the state does not match the script: method "
+                          "'f' is f(int64) -> int64 in the state"));
+  }
+  EXPECT_EQ(a.p->object("a")->call("f", {vsd::Value(std::int64_t{7})}).as<std::int64_t>(), 7);
+}
+
 #endif
+
+// Two programs run the same classes (a replica with the Registry of the original): a C++ call on an
+// instance runs in the program of that instance's state, whichever program defined the class.
+TEST(Attach, ACallOnAReplicasInstanceRunsInTheReplicasProgram) {
+  const std::string text =
+      "class A : Node { int n = 0; int bump(int k) { n += k; return n; } }\nobject a : A;\n";
+  Session s;
+  s.load(text, 1);
+  vsd::SimState& replica = s.env.create_state("replica");
+  replica.copy_from(s.env.main_state());
+  std::unique_ptr<Program> r = Program::attach(replica, "golden.soml", text);
+  EXPECT_EQ(r->object("a")->call("bump", {vsd::Value(std::int64_t{5})}).as<std::int64_t>(), 5);
+  EXPECT_EQ(s.p->object("a")->get<std::int64_t>("n"), 0) << "the original is untouched";
+  EXPECT_EQ(s.p->object("a")->call("bump", {vsd::Value(std::int64_t{1})}).as<std::int64_t>(), 1);
+  EXPECT_EQ(r->object("a")->get<std::int64_t>("n"), 5);
+  // Without a program on its state, a call is a clear error.
+  vsd::SimState& bare = s.env.create_state("bare");
+  bare.copy_from(s.env.main_state());
+  vsd::Node* a = bare.database().find_child("golden")->find_child("a");
+  ASSERT_NE(a, nullptr);
+  try {
+    (void)a->call("bump", {vsd::Value(std::int64_t{1})});
+    FAIL() << "called";
+  } catch (const vsd::Error& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr("no SOML++ program runs the state of soml::a"));
+  }
+}
 
 }  // namespace

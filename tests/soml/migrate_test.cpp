@@ -359,3 +359,59 @@ TEST_F(Migrate, TheExecutorStateFollowsTheReloadAndAttachContinues) {
   EXPECT_EQ(q.firings(), p.firings());
 #endif
 }
+
+#if VSD_SOML_TEST_IO
+// A replica with a Registry of its own (here: loaded from a file, then attached) follows a reload on the
+// source with Program::follow_reload: the new classes are defined before the source's recording applies,
+// and the replica's program runs the new version from there exactly like the source's.
+TEST_F(Migrate, AReplicaWithItsOwnRegistryFollowsAReload) {
+  Program& p = running();
+  vsd::Registry reg2;
+  reg2.add<Holder>();
+  vsd::Environment env2{0, reg2};
+  auto& soml2 = env2.use<vsd::soml::Module>();
+  vsd::io::load_bytes(env2.main_state(), vsd::io::save_bytes(state));
+  vsd::soml::RunOptions o;
+  std::ostringstream out2;
+  o.out = &out2;
+  Program& q = soml2.adopt(env2.main_state(), "test.soml", v1, o);
+  // Without the new classes the recording of the reload does not apply (it creates soml::fresh).
+  state.start_recording();
+  p.reload("test.soml", v2);
+  const vsd::Transaction bundle = state.take_recording();
+  {
+    vsd::Registry reg3;
+    reg3.add<Holder>();
+    vsd::Environment env3{0, reg3};
+    env3.use<vsd::soml::Module>();
+    vsd::io::load_bytes(env3.main_state(), vsd::io::save_bytes(env2.main_state()));
+    EXPECT_THROW(env3.main_state().apply(bundle), vsd::Error);
+  }
+  // A text with errors, or another text than the source's: refused, the replica runs v1 on.
+  const vsd::MetaInstance* box1 = reg2.find_class_exact("soml::Box");
+  EXPECT_THAT(error_of([&] { q.follow_reload("test.soml", std::string(v2) + "\nint broken = ;\n", bundle); }),
+              HasSubstr("error: "));
+  std::string other = v2;
+  other.replace(other.find("int added = 9;"), 14, "int added = 8;");
+  EXPECT_THAT(error_of([&] { q.follow_reload("test.soml", other, bundle); }),
+              HasSubstr("the script differs from the one the state was loaded from"));
+  EXPECT_EQ(reg2.find_class_exact("soml::Box"), box1);
+  EXPECT_EQ(reg2.find_class_exact("soml::fresh"), nullptr);
+  EXPECT_EQ(q.root().get<std::int64_t>("count"), 6);
+  EXPECT_EQ(q.root().call("twice", {vsd::Value(std::int64_t{2})}).as<std::int64_t>(), 4);
+  // The right text: the replica equals the source and runs on like it.
+  q.follow_reload("test.soml", v2, bundle);
+  EXPECT_NE(reg2.find_class_exact("soml::fresh"), nullptr);
+  EXPECT_EQ(reg2.find_class_exact("soml::Box~1"), nullptr) << "the retired classes are gone";
+  EXPECT_EQ(q.root().get<std::int64_t>("count"), p.root().get<std::int64_t>("count"));
+  EXPECT_EQ(q.root().call("twice", {vsd::Value(std::int64_t{2})}).as<std::int64_t>(), 6);
+  std::vector<std::string> fired_p, fired_q;
+  p.on_firing([&](const vsd::soml::Firing& f) { fired_p.push_back(f.transition->name()); });
+  q.on_firing([&](const vsd::soml::Firing& f) { fired_q.push_back(f.transition->name()); });
+  EXPECT_EQ(q.run_until_quiet(), p.run_until_quiet());
+  EXPECT_EQ(fired_q, fired_p);
+  EXPECT_FALSE(fired_p.empty());
+  EXPECT_EQ(q.root().get<std::int64_t>("count"), p.root().get<std::int64_t>("count"));
+  EXPECT_EQ(q.firings(), p.firings());
+}
+#endif

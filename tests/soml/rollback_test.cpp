@@ -358,4 +358,64 @@ arrow t -> b;
   EXPECT_EQ(n, 1u) << ops;
 }
 
+// A load refused after the loader defined run-time classes (the compiler refuses a construct, or an
+// initialiser or constructor fails while the instances are made) leaves the Registry and the database as
+// they were: the fixed script then loads under the same name.
+TEST_F(Rollback, ARefusedLoadLeavesNoClassesEnumsOrInstances) {
+  const std::string good = R"(
+enum Mode { Idle, Busy }
+class Base : Node { Mode mode = Mode::Idle; double f(double x) { return x * 2.0; } }
+class Derived : Base { int n = 1; }
+object d : Derived;
+place p = 1;
+transition t { do { d.n += 1; } }
+arrow p -> t;
+)";
+  const std::size_t classes = reg.classes().size();
+  const std::size_t types = reg.types().size();
+  const std::string before = dump(state());
+  // The compiler refuses a construct (after the classes and the enum were defined).
+  std::string refused = good;
+  refused.replace(refused.find("return x * 2.0;"), 15, "Vector3d v; return x;");
+  try {
+    load(refused);
+    FAIL() << "loaded";
+  } catch (const vsd::Error& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr("net.soml:3:"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("is not supported by the SOML++ runtime yet"));
+  }
+  EXPECT_EQ(reg.classes().size(), classes);
+  EXPECT_EQ(reg.types().size(), types);
+  EXPECT_EQ(reg.find_class_exact("soml::Base"), nullptr);
+  EXPECT_EQ(reg.find_type("soml::Mode"), nullptr);
+  EXPECT_EQ(dump(state()), before);
+  // An initialiser fails while the instances are made: the instances made so far go too.
+  std::string failing = good;
+  failing.replace(failing.find("int n = 1;"), 10, "int n = 1 / (1 - 1);");
+  try {
+    load(failing);
+    FAIL() << "loaded";
+  } catch (const vsd::Error& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr("division by zero"));
+  }
+  EXPECT_EQ(reg.classes().size(), classes);
+  EXPECT_EQ(reg.types().size(), types);
+  EXPECT_EQ(dump(state()), before);
+  EXPECT_TRUE(soml->programs().empty());
+  // The fixed script loads under the same name and runs.
+  Program& p = load(good);
+  EXPECT_EQ(p.object("d")->call("f", {vsd::Value(1.5)}).as<double>(), 3.0);
+  EXPECT_EQ(p.step(5), 1u);
+  EXPECT_EQ(p.object("d")->get<std::int64_t>("n"), 2);
+}
+
+// A refused load while the state records (a replica is fed from it): the recording holds none of it.
+TEST_F(Rollback, ARefusedLoadLeavesNothingInTheRecording) {
+  state().start_recording();
+  EXPECT_THROW(load("class A : Node { int n = 1 / (1 - 1); }\nobject a : A;\n"), vsd::Error);
+  EXPECT_TRUE(state().recording());
+  EXPECT_EQ(state().stop_recording().describe(), "");
+  EXPECT_EQ(reg.find_class_exact("soml::A"), nullptr);
+}
+
 }  // namespace

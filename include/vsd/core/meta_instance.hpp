@@ -240,6 +240,7 @@ class ClassBuilder {
   const MetaInstance& define();
 
  private:
+  friend class Registry;  // add_methods takes the methods
   std::unique_ptr<MetaInstance> meta_;
 };
 

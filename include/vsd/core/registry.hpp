@@ -80,6 +80,14 @@ class Registry {
   /// @brief Removes a run-time class that has no live instances and no subclasses.
   /// @throws vsd::Error otherwise, or for built-in classes.
   void undefine(const MetaInstance& cls);
+  /// @brief Gives run-time class @p cls the methods that @p from declares (its name, base and properties
+  /// are ignored; @p from is used up). For a class defined from a file's schema, which carries properties
+  /// only: the program that runs the file's content binds its methods (vsd::soml attaching to a saved
+  /// run). A method @p cls already declares with the same name and signature is kept; subclasses see the
+  /// new ones. Call it before other threads use the class.
+  /// @throws vsd::Error for built-in classes, classes of another registry, and a method that @p cls
+  /// declares with another signature (then nothing changed).
+  void add_methods(const MetaInstance& cls, ClassBuilder&& from);
   /// @brief Gives run-time class @p cls the full name @p name (a script that redefines its classes at
   /// run time retires the old versions under other names; vsd::soml). Instances keep their class; changes
   /// recorded from now on carry the new name.

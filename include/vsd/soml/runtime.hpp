@@ -102,8 +102,9 @@ class Program {
   /// against the script's and used, and the script object, its objects, every net (invocations included)
   /// and the executor's state (its "(executor)" node: generator, firings, enabled transitions in choice
   /// order) are found in the state instead of created. Nothing is created or changed. @p options.seed is
-  /// not used (the state's generator goes on). Script functions of classes the state defined (a file's)
-  /// are not MetaMethods: a file carries no code.
+  /// not used (the state's generator goes on). The script's functions become MetaMethods of the classes
+  /// the state defined (a file's carry properties only) once the attach succeeded; a C++ call() runs in
+  /// the program that runs the instance's state.
   /// @throws vsd::Error when the script has errors, or naming what of the state does not match it (no
   /// script object, a different source text, a class, object, place or transition that differs, no
   /// executor state).
@@ -123,6 +124,14 @@ class Program {
   /// @throws vsd::Error with every diagnostic (file:line:col) of the new text, or what cannot be
   /// migrated; then the state, this Program and its classes are exactly as before.
   MigrationReport reload(std::string name, std::string text);
+  /// @brief Follows, on a replica with a Registry of its own, a reload made on the source (docs/soml.md
+  /// 8.6): retires this program's classes as reload() does, defines those of @p text (the new version
+  /// the source loaded), applies @p bundle — the source's recording from the reload on, which creates
+  /// instances of the new classes — and attaches to the result as attach() does. The bundles recorded
+  /// before the reload must have been applied first.
+  /// @throws vsd::Error with the diagnostics of @p text, when the bundle does not apply, or when the
+  /// result does not match @p text; then the state, this Program and its classes are as before.
+  void follow_reload(std::string name, std::string text, const Transaction& bundle);
 
   /// @brief The script object's node (a child of the Database).
   [[nodiscard]] vsd::Node& root() const noexcept;
