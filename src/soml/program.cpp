@@ -500,9 +500,15 @@ void ProgramImpl::define(std::string name, std::string text) {
               ai.path = comm_path(a, *c);
               ai.weight = a.weight;
               ai.object = !ai.remote_place->token.empty();
-              if (a.condition) not_supported(*this, a.loc, "a condition on a communication arrow");
-              if (ai.object && a.to_decl->kind == DeclKind::Transition)
-                not_supported(*this, a.loc, "a communication arrow taking object tokens");
+              if (a.condition) {
+                auto dotted = [](const std::vector<std::string>& path) {
+                  std::string s;
+                  for (const std::string& n : path) s += (s.empty() ? "" : ".") + n;
+                  return s;
+                };
+                ai.cond = compile_arrow_condition(*this, a,
+                                                  pre + "arrow " + dotted(a.from) + " ~> " + dotted(a.to));
+              }
               return ai;
             }
             if (map != nullptr) {

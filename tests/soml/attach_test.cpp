@@ -132,7 +132,7 @@ std::string joined(const std::vector<std::string>& v, std::size_t from = 0) {
 const char* const continuing[] = {
     "run_philosophers.soml", "run_communication.soml",    "invoke_fetch.soml",   "subst_relay.soml",
     "run_supervisor.soml",   "run_place_properties.soml", "run_nodes_meta.soml", "run_arrow_conditions.soml",
-    "run_enums.soml",        "run_weights_inhibitor.soml"};
+    "run_enums.soml",        "run_weights_inhibitor.soml", "run_comm_objects.soml"};
 constexpr std::uint64_t most = 40;  // firings per script at most (the philosophers never stop)
 
 TEST(Attach, AReplicaThatAppliedTheRecordedBundlesContinuesIdentically) {
