@@ -215,6 +215,10 @@ class Compiler {
 
   int place_index(const PlaceDecl& pd, SourceLoc loc) {
     const auto* owner = parent_scope(pd);
+    if (owner != nullptr && owner->kind == DeclKind::Net && owner->as<ClassDecl>().is_port_net)
+      not_supported(
+          P, loc,
+          "naming place '" + pd.name + "' of a port net in code (each copy of the net has other places)");
     if (owner == nullptr || !owner->is_class_like()) not_supported(P, loc, "this place");
     auto it = P.class_info_.find(&owner->as<ClassDecl>());
     if (it == P.class_info_.end() || !it->second->net) not_supported(P, loc, "this place");

@@ -72,8 +72,8 @@ void ProgramImpl::set_enabled(std::uint32_t i, bool on) {
   }
 }
 
-Place* ProgramImpl::remote_place(const ArrowInfo& a, std::uint64_t owner) {
-  std::uint64_t id = owner;
+Place* ProgramImpl::remote_place(const ArrowInfo& a, const NetInst& net) {
+  std::uint64_t id = arrow_self(net, a);
   for (const PathStep& st : a.path) {
     if (st.object != nullptr) {
       id = object_ids_.at(st.object);
@@ -91,7 +91,8 @@ Place* ProgramImpl::remote_place(const ArrowInfo& a, std::uint64_t owner) {
     if (n->cls->places[i] == a.remote_place) {
       Place* p = n->places[i];
       if (deps_ != nullptr)
-        deps_->emplace_back(p->id(), p->object_tokens() ? &Place::vsd_prop_objects() : &Place::vsd_prop_tokens());
+        deps_->emplace_back(p->id(),
+                            p->object_tokens() ? &Place::vsd_prop_objects() : &Place::vsd_prop_tokens());
       return p;
     }
   return nullptr;
@@ -117,7 +118,7 @@ bool ProgramImpl::test(TI& ti) {
       if (static_cast<int>(k) == t.mark_in) continue;
       const ArrowInfo& a = t.in[k];
       // A communication arrow's remote place is found now; a null reference disables.
-      const Place* rp = a.remote ? remote_place(a, net.owner) : net.places[static_cast<std::size_t>(a.place)];
+      const Place* rp = a.remote ? remote_place(a, net) : net.places[static_cast<std::size_t>(a.place)];
       if (rp == nullptr) {
         enabled = false;
         continue;
@@ -129,26 +130,26 @@ bool ProgramImpl::test(TI& ti) {
       } else if (p.object_tokens()) {
         for (std::size_t j = 0; j < p.objects().size(); ++j) {
           const SimStateInstance* o = p.objects().at(j);
-          if (o != nullptr && truth(a.cond, net.owner, o->id())) ++n;
+          if (o != nullptr && truth(a.cond, arrow_self(net, a), o->id())) ++n;
         }
       } else {
-        n = truth(a.cond, net.owner, 0) ? p.count() : 0;
+        n = truth(a.cond, arrow_self(net, a), 0) ? p.count() : 0;
       }
       enabled = a.inhibitor ? n < a.weight : n >= a.weight;
     }
     // A communication output arrow whose path meets a null reference disables too: its tokens would
     // have nowhere to go.
     for (std::size_t k = 0; k < t.out.size() && enabled; ++k)
-      if (t.out[k].remote) enabled = remote_place(t.out[k], net.owner) != nullptr;
+      if (t.out[k].remote) enabled = remote_place(t.out[k], net) != nullptr;
     if (enabled && t.mark_in >= 0) {
       const ArrowInfo& a = t.in[static_cast<std::size_t>(t.mark_in)];
       // The mark comes from a place of this net, or over a communication arrow from another's (5.4).
-      const Place* mp = a.remote ? remote_place(a, net.owner) : net.places[static_cast<std::size_t>(a.place)];
+      const Place* mp = a.remote ? remote_place(a, net) : net.places[static_cast<std::size_t>(a.place)];
       enabled = false;
       for (std::size_t j = 0; mp != nullptr && j < mp->objects().size() && !enabled; ++j) {
         const SimStateInstance* o = mp->objects().at(j);
         if (o == nullptr) continue;
-        if (a.cond >= 0 && !truth(a.cond, net.owner, o->id())) continue;
+        if (a.cond >= 0 && !truth(a.cond, arrow_self(net, a), o->id())) continue;
         if (t.cond >= 0 && !truth(t.cond, tid, o->id())) continue;
         enabled = true;
         mark = o->id();
@@ -287,7 +288,7 @@ void ProgramImpl::fire_body(std::uint32_t i) {
   for (std::size_t k = 0; k < t.in.size(); ++k) {
     const ArrowInfo& a = t.in[k];
     if (a.inhibitor) continue;
-    Place* pp = a.remote ? remote_place(a, net.owner) : net.places[static_cast<std::size_t>(a.place)];
+    Place* pp = a.remote ? remote_place(a, net) : net.places[static_cast<std::size_t>(a.place)];
     if (pp == nullptr) continue;  // a communication arrow whose path meets a null reference (not enabled)
     Place& p = *pp;
     if (static_cast<int>(k) == t.mark_in) {
@@ -345,16 +346,16 @@ Place* ProgramImpl::produce(NetInst& net, const TransitionInfo& t, std::uint64_t
   Place* to = nullptr;
   SimStateInstance* m = mark != 0 ? state_.find(mark) : nullptr;
   for (const ArrowInfo& a : t.out) {
-    Place* pp = a.remote ? remote_place(a, net.owner) : net.places[static_cast<std::size_t>(a.place)];
+    Place* pp = a.remote ? remote_place(a, net) : net.places[static_cast<std::size_t>(a.place)];
     if (pp == nullptr) continue;  // a communication arrow whose path meets a null reference
     Place& p = *pp;
     if (!a.object) {
-      if (a.cond < 0 || run(a.cond, net.owner, mark, nullptr, nullptr).i != 0) {
+      if (a.cond < 0 || run(a.cond, arrow_self(net, a), mark, nullptr, nullptr).i != 0) {
         p.set_tokens(p.tokens() + a.weight);
         if (given != nullptr) given->push_back(TokenMove{&p, a.weight});
       }
     } else if (to == nullptr && m != nullptr && m->as<Node>() != nullptr) {
-      if (a.cond >= 0 && run(a.cond, net.owner, mark, nullptr, nullptr).i == 0) continue;
+      if (a.cond >= 0 && run(a.cond, arrow_self(net, a), mark, nullptr, nullptr).i == 0) continue;
       p.edit_objects().push_back(*m->as<Node>());
       to = &p;
     }

@@ -202,6 +202,9 @@ struct ArrowInfo {
   bool inhibitor = false;
   bool object = false;  // the place holds object tokens
   int cond = -1;        // function index of the arrow condition
+  // An arrow of a substituted sub-net: the substitution transition (index in the net) whose node is the
+  // port net's instance, `this` of its condition and the start of its path; -1: the net's owner.
+  int holder = -1;
 };
 
 struct TransitionInfo {
@@ -446,7 +449,11 @@ class ProgramImpl {
   bool test(TI& ti);
   // The remote place of a communication arrow (null when the path meets a null reference); records what
   // it read as dependencies while a test runs.
-  Place* remote_place(const ArrowInfo& a, std::uint64_t owner);
+  Place* remote_place(const ArrowInfo& a, const NetInst& net);
+  // `this` of an arrow's condition and the start of a communication arrow's path (ArrowInfo::holder).
+  static std::uint64_t arrow_self(const NetInst& net, const ArrowInfo& a) {
+    return a.holder < 0 ? net.owner : net.transitions[static_cast<std::size_t>(a.holder)]->id();
+  }
   void fire(std::uint32_t ti);
   void fire_body(std::uint32_t ti);  // fire() without the savepoint
   // Undoes a failed firing: the SimState back to @p sp, nets killed since killed_[killed] revived.

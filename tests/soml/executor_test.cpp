@@ -244,8 +244,9 @@ object c2 : Client;
   std::vector<std::string> trace;
   p.on_firing([&](const vsd::soml::Firing& f) {
     trace.push_back(f.transition->parent()->name() + "." + f.transition->name() + " " +
-                    vsd::Value(f.mark != 0 ? env.main_state().find(f.mark)->as<vsd::Node>()->get<std::int64_t>("size")
-                                           : std::int64_t{0})
+                    vsd::Value(f.mark != 0
+                                   ? env.main_state().find(f.mark)->as<vsd::Node>()->get<std::int64_t>("size")
+                                   : std::int64_t{0})
                         .to_text() +
                     ":" + (f.from ? f.from->parent()->name() + "." + f.from->name() : "") + "->" +
                     (f.to ? f.to->parent()->name() + "." + f.to->name() : "-"));

@@ -232,14 +232,16 @@ TEST_F(Runtime, ScriptErrorsAndUnsupportedConstructsAreReportedWithPositions) {
               HasSubstr("test.soml:1:18: error: undefined name 'x'"));
   const std::string e = error_of([&] {
     load(R"(net Relay(place in, place out) {
-  int hops = 0;
-  transition pass;
+  transition pass { do { print(in.count); } }
   arrow in -> pass;
   arrow pass -> out;
 }
+place a = 1;
+place b;
+transition move = Relay(a, b);
 )");
   });
-  EXPECT_THAT(e, HasSubstr("test.soml:2:7"));
+  EXPECT_THAT(e, HasSubstr("test.soml:2:32"));
   EXPECT_THAT(e, HasSubstr("not supported"));
 }
 
