@@ -72,6 +72,19 @@ void ProgramImpl::set_enabled(std::uint32_t i, bool on) {
   }
 }
 
+std::uint64_t ProgramImpl::port_place_id(std::uint64_t copy, std::size_t k) const {
+  auto it = node_net_.find(copy);
+  if (it == node_net_.end() || it->second->dead || k >= port_places_.size()) return 0;
+  const NetInst& n = *it->second;
+  for (std::size_t t = 0; t < n.transitions.size(); ++t) {
+    if (n.transitions[t]->id() != copy) continue;
+    const auto& sub = n.cls->transitions[t].sub_places;
+    auto p = sub.find(port_places_[k]);
+    return p == sub.end() ? 0 : n.places[static_cast<std::size_t>(p->second)]->id();
+  }
+  return 0;
+}
+
 Place* ProgramImpl::remote_place(const ArrowInfo& a, const NetInst& net) {
   std::uint64_t id = arrow_self(net, a);
   for (const PathStep& st : a.path) {

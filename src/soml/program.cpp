@@ -482,8 +482,9 @@ void ProgramImpl::define(std::string name, std::string text) {
           ti.holder = holder;
           if (t.substituted != nullptr) {  // inert: its sub-net's transitions follow, children of its node
             ti.inert = true;
-            ci.net->transitions.push_back(std::move(ti));
             Expansion& e = expansions.at(c).at(next_expansion++);
+            ti.sub_places = e.places;
+            ci.net->transitions.push_back(std::move(ti));
             const int h = static_cast<int>(ci.net->transitions.size() - 1);
             for (int p : e.own) ci.net->place_holder[static_cast<std::size_t>(p)] = h;
             const std::unordered_map<const Decl*, int> sub = e.places;

@@ -95,7 +95,7 @@ enum Op : std::uint8_t {
   OP_OBJ,      // a = id of object consts[b]
   OP_GETP,     // a = property props[c] of instance b
   OP_SETP,     // property props[c] of instance a = b
-  OP_PLACE,    // a = place node number c of the net instance b
+  OP_PLACE,    // a = place node number c of the net instance b (c & kPortPlace: a port net's, of copy b)
   OP_PCOUNT,   // a = count of place b
   OP_PPUT,     // place a .put(b)
   OP_PCLEAR,   // place a .clear()
@@ -125,6 +125,10 @@ enum Op : std::uint8_t {
   OP_PVGET,   // a = element R[a] of vector property props[c] of instance b (no copy; range-checked)
   OP_FIND     // a = the node at path S[b] from the database, or null
 };
+
+// OP_PLACE's operand c with this bit: a place of a port net (index into port_places_), found from the
+// copy's instance.
+inline constexpr std::size_t kPortPlace = 0x8000;
 
 struct Ins {
   std::uint8_t op;
@@ -217,6 +221,8 @@ struct TransitionInfo {
   // transitions are its children); `holder` is the transition whose sub-net this one belongs to.
   bool inert = false;
   int holder = -1;
+  // A substitution transition: its port net's places (ports too) -> index in the net (OP_PLACE).
+  std::unordered_map<const Decl*, int> sub_places;
   // Invocation: the net it invokes and the function that sets the new instance's value parameters.
   const struct ClassInfo* invoke = nullptr;
   int invoke_args = -1;
@@ -367,7 +373,10 @@ class ProgramImpl {
   std::vector<std::vector<RK>> method_kinds_;              // MCALL argument kinds
   std::vector<RK> method_results_;
   std::vector<std::pair<int, const ClassDecl*>> object_refs_;  // consts_ slot -> object
-  std::unordered_map<const Decl*, int> scope_init_;            // place/transition property initialisers
+  std::vector<const PlaceDecl*> port_places_;                  // places of port nets named in code
+  // The node of place port_places_[k] in the copy of its port net whose instance is @p copy; 0: none.
+  std::uint64_t port_place_id(std::uint64_t copy, std::size_t k) const;
+  std::unordered_map<const Decl*, int> scope_init_;  // place/transition property initialisers
 
   std::unordered_map<const ClassDecl*, std::unique_ptr<ClassInfo>> class_info_;
   std::vector<const ClassDecl*> class_order_;  // bases first
