@@ -17,6 +17,7 @@
 #include "vsd/core/meta_method.hpp"
 #include "vsd/core/meta_property.hpp"
 #include "vsd/core/node.hpp"
+#include "vsd/soml/net_classes.hpp"
 #include "vsd/soml/parser.hpp"
 
 namespace vsd::soml {
@@ -509,10 +510,19 @@ void CheckerImpl::resolve_signatures() {
     }
     // A property may not hide one of a base class: instances have one value per name.
     const ScopeDecl& owner = *parent_scope(*p);
-    if (owner.kind == DeclKind::Class || owner.kind == DeclKind::Object) {
-      Found f = find_in_class(owner.as<ClassDecl>().base.empty() ? ClassRef{nullptr, &Node::static_meta()}
-                                                                 : owner.as<ClassDecl>().base,
-                              p->name);
+    // Places, transitions and port nets (whose instance is the substitution transition's node) with
+    // properties are run-time classes derived from soml::Place and soml::Transition.
+    bool port_net = owner.kind == DeclKind::Net && !owner.as<ClassDecl>().params.empty();
+    for (const Param& prm : owner.kind == DeclKind::Net ? owner.as<ClassDecl>().params : std::vector<Param>{})
+      port_net = port_net && prm.is_place;  // (resolve_net, which sets is_port_net, runs later)
+    const bool net_node = owner.kind == DeclKind::Place || owner.kind == DeclKind::Transition || port_net;
+    if (owner.kind == DeclKind::Class || owner.kind == DeclKind::Object || net_node) {
+      const ClassRef base =
+          net_node ? ClassRef{nullptr, owner.kind == DeclKind::Place ? &Place::static_meta()
+                                                                     : &Transition::static_meta()}
+          : owner.as<ClassDecl>().base.empty() ? ClassRef{nullptr, &Node::static_meta()}
+                                               : owner.as<ClassDecl>().base;
+      Found f = find_in_class(base, p->name);
       if (f.ok()) {
         const std::string where =
             f.decl != nullptr

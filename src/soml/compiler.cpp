@@ -1,6 +1,7 @@
 // The SOML++ bytecode compiler: annotated AST -> register bytecode (see program_impl.hpp for the
 // instruction set). The checker resolved every name and typed every expression, so the compiler does
 // no lookup: bindings become register numbers, property slots, function indices and outer plans.
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <string>
@@ -213,8 +214,27 @@ class Compiler {
     return i;
   }
 
+  static bool in_port_net(const PlaceDecl& pd) {
+    const auto* owner = parent_scope(pd);
+    return owner != nullptr && owner->kind == DeclKind::Net && owner->as<ClassDecl>().is_port_net;
+  }
+  // A place of a port net, named in its code: each copy has its own places (a port is its copy's
+  // socket), so OP_PLACE finds it at run time from the copy's instance, the substitution transition's
+  // node (operand c: kPortPlace | index into port_places_).
+  int port_place(const PlaceDecl& pd, SourceLoc loc) {
+    auto it = std::find(P.port_places_.begin(), P.port_places_.end(), &pd);
+    if (it == P.port_places_.end()) {
+      if (P.port_places_.size() >= kPortPlace - 1) not_supported(P, loc, "this many places of port nets");
+      P.port_places_.push_back(&pd);
+      it = P.port_places_.end() - 1;
+    }
+    return static_cast<int>(kPortPlace | static_cast<std::size_t>(it - P.port_places_.begin()));
+  }
+
   int place_index(const PlaceDecl& pd, SourceLoc loc) {
     const auto* owner = parent_scope(pd);
+    if (in_port_net(pd))
+      not_supported(P, loc, "naming place '" + pd.name + "' of a port net through another instance");
     if (owner == nullptr || !owner->is_class_like()) not_supported(P, loc, "this place");
     auto it = P.class_info_.find(&owner->as<ClassDecl>());
     if (it == P.class_info_.end() || !it->second->net) not_supported(P, loc, "this place");
@@ -392,7 +412,8 @@ class Compiler {
       }
       case BK::Place: {
         const int s = self_at(b.outer, e.loc);
-        emit(OP_PLACE, s, s, place_index(b.decl->as<PlaceDecl>(), e.loc));
+        const auto& pd = b.decl->as<PlaceDecl>();
+        emit(OP_PLACE, s, s, in_port_net(pd) ? port_place(pd, e.loc) : place_index(pd, e.loc));
         return s;
       }
       case BK::Builtin:

@@ -72,8 +72,21 @@ void ProgramImpl::set_enabled(std::uint32_t i, bool on) {
   }
 }
 
-Place* ProgramImpl::remote_place(const ArrowInfo& a, std::uint64_t owner) {
-  std::uint64_t id = owner;
+std::uint64_t ProgramImpl::port_place_id(std::uint64_t copy, std::size_t k) const {
+  auto it = node_net_.find(copy);
+  if (it == node_net_.end() || it->second->dead || k >= port_places_.size()) return 0;
+  const NetInst& n = *it->second;
+  for (std::size_t t = 0; t < n.transitions.size(); ++t) {
+    if (n.transitions[t]->id() != copy) continue;
+    const auto& sub = n.cls->transitions[t].sub_places;
+    auto p = sub.find(port_places_[k]);
+    return p == sub.end() ? 0 : n.places[static_cast<std::size_t>(p->second)]->id();
+  }
+  return 0;
+}
+
+Place* ProgramImpl::remote_place(const ArrowInfo& a, const NetInst& net) {
+  std::uint64_t id = arrow_self(net, a);
   for (const PathStep& st : a.path) {
     if (st.object != nullptr) {
       id = object_ids_.at(st.object);
@@ -90,7 +103,9 @@ Place* ProgramImpl::remote_place(const ArrowInfo& a, std::uint64_t owner) {
   for (std::size_t i = 0; i < n->cls->places.size(); ++i)
     if (n->cls->places[i] == a.remote_place) {
       Place* p = n->places[i];
-      if (deps_ != nullptr) deps_->emplace_back(p->id(), &Place::vsd_prop_tokens());
+      if (deps_ != nullptr)
+        deps_->emplace_back(p->id(),
+                            p->object_tokens() ? &Place::vsd_prop_objects() : &Place::vsd_prop_tokens());
       return p;
     }
   return nullptr;
@@ -115,37 +130,39 @@ bool ProgramImpl::test(TI& ti) {
     for (std::size_t k = 0; k < t.in.size() && enabled; ++k) {
       if (static_cast<int>(k) == t.mark_in) continue;
       const ArrowInfo& a = t.in[k];
-      if (a.remote) {  // communication: the remote place is found now; a null reference disables
-        const Place* rp = remote_place(a, net.owner);
-        enabled = rp != nullptr && rp->count() >= a.weight;
+      // A communication arrow's remote place is found now; a null reference disables.
+      const Place* rp = a.remote ? remote_place(a, net) : net.places[static_cast<std::size_t>(a.place)];
+      if (rp == nullptr) {
+        enabled = false;
         continue;
       }
-      const Place& p = *net.places[static_cast<std::size_t>(a.place)];
+      const Place& p = *rp;
       std::int64_t n = 0;
       if (a.cond < 0) {
         n = p.count();
       } else if (p.object_tokens()) {
         for (std::size_t j = 0; j < p.objects().size(); ++j) {
           const SimStateInstance* o = p.objects().at(j);
-          if (o != nullptr && truth(a.cond, net.owner, o->id())) ++n;
+          if (o != nullptr && truth(a.cond, arrow_self(net, a), o->id())) ++n;
         }
       } else {
-        n = truth(a.cond, net.owner, 0) ? p.count() : 0;
+        n = truth(a.cond, arrow_self(net, a), 0) ? p.count() : 0;
       }
       enabled = a.inhibitor ? n < a.weight : n >= a.weight;
     }
     // A communication output arrow whose path meets a null reference disables too: its tokens would
     // have nowhere to go.
     for (std::size_t k = 0; k < t.out.size() && enabled; ++k)
-      if (t.out[k].remote) enabled = remote_place(t.out[k], net.owner) != nullptr;
+      if (t.out[k].remote) enabled = remote_place(t.out[k], net) != nullptr;
     if (enabled && t.mark_in >= 0) {
       const ArrowInfo& a = t.in[static_cast<std::size_t>(t.mark_in)];
-      const Place& p = *net.places[static_cast<std::size_t>(a.place)];
+      // The mark comes from a place of this net, or over a communication arrow from another's (5.4).
+      const Place* mp = a.remote ? remote_place(a, net) : net.places[static_cast<std::size_t>(a.place)];
       enabled = false;
-      for (std::size_t j = 0; j < p.objects().size() && !enabled; ++j) {
-        const SimStateInstance* o = p.objects().at(j);
+      for (std::size_t j = 0; mp != nullptr && j < mp->objects().size() && !enabled; ++j) {
+        const SimStateInstance* o = mp->objects().at(j);
         if (o == nullptr) continue;
-        if (a.cond >= 0 && !truth(a.cond, net.owner, o->id())) continue;
+        if (a.cond >= 0 && !truth(a.cond, arrow_self(net, a), o->id())) continue;
         if (t.cond >= 0 && !truth(t.cond, tid, o->id())) continue;
         enabled = true;
         mark = o->id();
@@ -175,9 +192,13 @@ bool ProgramImpl::test(TI& ti) {
       if (v.empty()) deps_map_.erase(it);
     }
     ti.deps.clear();
+    // Each watcher list is kept in transition order, not in the order of the tests that happened to
+    // run: a change then marks its watchers dirty in the same order in a run that was saved and attached
+    // again (8.7), whose tests ran at other times, as in the run that was never saved.
     for (const auto& [id, prop] : dep_scratch_) {
       ti.deps.push_back(DepKey{id, prop});
-      deps_map_[DepKey{id, prop}].push_back(index);
+      auto& v = deps_map_[DepKey{id, prop}];
+      v.insert(std::upper_bound(v.begin(), v.end(), index), index);
     }
   }
   ti.mark = mark;
@@ -280,14 +301,9 @@ void ProgramImpl::fire_body(std::uint32_t i) {
   for (std::size_t k = 0; k < t.in.size(); ++k) {
     const ArrowInfo& a = t.in[k];
     if (a.inhibitor) continue;
-    if (a.remote) {
-      if (Place* rp = remote_place(a, net.owner); rp != nullptr) {
-        rp->set_tokens(rp->tokens() - a.weight);
-        if (trace_) taken.push_back(TokenMove{rp, a.weight});
-      }
-      continue;
-    }
-    Place& p = *net.places[static_cast<std::size_t>(a.place)];
+    Place* pp = a.remote ? remote_place(a, net) : net.places[static_cast<std::size_t>(a.place)];
+    if (pp == nullptr) continue;  // a communication arrow whose path meets a null reference (not enabled)
+    Place& p = *pp;
     if (static_cast<int>(k) == t.mark_in) {
       from = &p;
       const std::size_t at = p.objects().index_of(m);
@@ -343,16 +359,16 @@ Place* ProgramImpl::produce(NetInst& net, const TransitionInfo& t, std::uint64_t
   Place* to = nullptr;
   SimStateInstance* m = mark != 0 ? state_.find(mark) : nullptr;
   for (const ArrowInfo& a : t.out) {
-    Place* pp = a.remote ? remote_place(a, net.owner) : net.places[static_cast<std::size_t>(a.place)];
+    Place* pp = a.remote ? remote_place(a, net) : net.places[static_cast<std::size_t>(a.place)];
     if (pp == nullptr) continue;  // a communication arrow whose path meets a null reference
     Place& p = *pp;
     if (!a.object) {
-      if (a.cond < 0 || run(a.cond, net.owner, mark, nullptr, nullptr).i != 0) {
+      if (a.cond < 0 || run(a.cond, arrow_self(net, a), mark, nullptr, nullptr).i != 0) {
         p.set_tokens(p.tokens() + a.weight);
         if (given != nullptr) given->push_back(TokenMove{&p, a.weight});
       }
     } else if (to == nullptr && m != nullptr && m->as<Node>() != nullptr) {
-      if (a.cond >= 0 && run(a.cond, net.owner, mark, nullptr, nullptr).i == 0) continue;
+      if (a.cond >= 0 && run(a.cond, arrow_self(net, a), mark, nullptr, nullptr).i == 0) continue;
       p.edit_objects().push_back(*m->as<Node>());
       to = &p;
     }

@@ -171,17 +171,6 @@ void ProgramImpl::define(std::string name, std::string text) {
 
   // 1. What the runtime cannot run yet is refused with its position, never ignored.
   walk(root, [&](const Decl& d) {
-    // A port net is copied into the transitions it substitutes; it has no instance of its own, so its
-    // code cannot reach members of the net itself.
-    for (const Decl* up = d.parent; up != nullptr; up = up->parent)
-      if (up->kind == DeclKind::Net && up->as<ClassDecl>().is_port_net) {
-        if (d.kind == DeclKind::Property || d.kind == DeclKind::Function)
-          not_supported(*this, d.loc,
-                        "a property or function in a port net (a substituted net has no instance)");
-        if (d.kind == DeclKind::Arrow && d.as<ArrowDecl>().arrow == ArrowKind::Communication)
-          not_supported(*this, d.loc, "a communication arrow in a port net");
-        break;
-      }
     if (d.kind == DeclKind::Net && !d.as<ClassDecl>().is_port_net) {
       const auto& n = d.as<ClassDecl>();
       for (const DeclPtr& m : n.members)
@@ -274,6 +263,27 @@ void ProgramImpl::define(std::string name, std::string text) {
     }
   };
 
+  auto own_members = [](const ScopeDecl& s) {
+    bool own = false;
+    for (const DeclPtr& x : s.members)
+      own = own || x->kind == DeclKind::Property || x->kind == DeclKind::Function;
+    return own;
+  };
+  // Places and transitions with members of their own get a class of their own.
+  auto member_classes = [&](const ScopeDecl& c, const std::string& cname) {
+    for (const DeclPtr& m : c.members) {
+      if (m->kind != DeclKind::Place && m->kind != DeclKind::Transition) continue;
+      const auto& s = m->as<ScopeDecl>();
+      const MetaInstance& sb = m->kind == DeclKind::Place ? Place::static_meta() : Transition::static_meta();
+      if (!own_members(s)) {
+        scope_meta_[m.get()] = &sb;
+        continue;
+      }
+      ClassBuilder pb(cname + "::" + m->name, sb);
+      add_members(pb, s);
+      scope_meta_[m.get()] = attaching_ ? &adopt_class(pb, cname + "::" + m->name, sb, s) : &define_class(pb);
+    }
+  };
   for (const ClassDecl* c : class_order_) {
     auto ci = std::make_unique<ClassInfo>();
     ci->decl = c;
@@ -300,24 +310,31 @@ void ProgramImpl::define(std::string name, std::string text) {
     ci->meta = attaching_ ? &adopt_class(b, cname, *base, *c) : &define_class(b);
     scope_meta_[c] = ci->meta;
     by_meta_[ci->meta] = ci.get();
-    // Places and transitions with members of their own get a class of their own.
-    for (const DeclPtr& m : c->members) {
-      if (m->kind != DeclKind::Place && m->kind != DeclKind::Transition) continue;
-      const auto& s = m->as<ScopeDecl>();
-      bool own = false;
-      for (const DeclPtr& x : s.members)
-        own = own || x->kind == DeclKind::Property || x->kind == DeclKind::Function;
-      const MetaInstance& sb = m->kind == DeclKind::Place ? Place::static_meta() : Transition::static_meta();
-      if (!own) {
-        scope_meta_[m.get()] = &sb;
-        continue;
-      }
-      ClassBuilder pb(cname + "::" + m->name, sb);
-      add_members(pb, s);
-      scope_meta_[m.get()] = attaching_ ? &adopt_class(pb, cname + "::" + m->name, sb, s) : &define_class(pb);
-    }
+    member_classes(*c, cname);
     class_info_[c] = std::move(ci);
   }
+  // A port net (4.11, 5.5) with properties or functions of its own is a run-time class derived from
+  // soml::Transition: the class of the node of every substitution transition that copies the net, which
+  // is that copy's instance (its properties, its functions' `this`). Its places and transitions with
+  // members get classes of their own, as an object's do.
+  walk(root, [&](const Decl& d) {
+    if (d.kind != DeclKind::Net || !d.as<ClassDecl>().is_port_net) return;
+    const auto& n = d.as<ClassDecl>();
+    const std::string cname = "soml::" + qualified(n);
+    if (own_members(n)) {
+      const MetaInstance& sb = Transition::static_meta();
+      ClassBuilder b(cname, sb);
+      add_members(b, n);
+      scope_meta_[&n] = attaching_ ? &adopt_class(b, cname, sb, n) : &define_class(b);
+    }
+    member_classes(n, cname);
+  });
+  walk(root, [&](const Decl& d) {
+    if (d.kind != DeclKind::Transition) return;
+    const TransitionDecl& t = d.as<TransitionDecl>();
+    if (t.substituted == nullptr) return;
+    if (auto it = scope_meta_.find(t.substituted); it != scope_meta_.end()) scope_meta_[&t] = it->second;
+  });
 
   // 4. Linkage: property declarations -> MetaProperties (props_ slots).
   walk(root, [&](const Decl& d) {
@@ -516,8 +533,9 @@ void ProgramImpl::define(std::string name, std::string text) {
           ti.holder = holder;
           if (t.substituted != nullptr) {  // inert: its sub-net's transitions follow, children of its node
             ti.inert = true;
-            ci.net->transitions.push_back(std::move(ti));
             Expansion& e = expansions.at(c).at(next_expansion++);
+            ti.sub_places = e.places;
+            ci.net->transitions.push_back(std::move(ti));
             const int h = static_cast<int>(ci.net->transitions.size() - 1);
             for (int p : e.own) ci.net->place_holder[static_cast<std::size_t>(p)] = h;
             const std::unordered_map<const Decl*, int> sub = e.places;
@@ -545,15 +563,24 @@ void ProgramImpl::define(std::string name, std::string text) {
           auto arrow_info = [&](const ArrowDecl& a, const Decl* place) {
             ArrowInfo ai;
             ai.decl = &a;
+            // An arrow of a substituted sub-net belongs to the port net's copy: its condition's `this`
+            // and the start of its path are the copy's instance, the substitution transition's node.
+            if (map != nullptr) ai.holder = holder;
             if (a.arrow == ArrowKind::Communication) {
               ai.remote = true;
               ai.remote_place = &place->as<PlaceDecl>();
-              ai.path = comm_path(a, *c);
+              ai.path = comm_path(a, map != nullptr ? parent_scope(a)->as<ClassDecl>() : *c);
               ai.weight = a.weight;
               ai.object = !ai.remote_place->token.empty();
-              if (a.condition) not_supported(*this, a.loc, "a condition on a communication arrow");
-              if (ai.object && a.to_decl->kind == DeclKind::Transition)
-                not_supported(*this, a.loc, "a communication arrow taking object tokens");
+              if (a.condition) {
+                auto dotted = [](const std::vector<std::string>& path) {
+                  std::string s;
+                  for (const std::string& n : path) s += (s.empty() ? "" : ".") + n;
+                  return s;
+                };
+                ai.cond = compile_arrow_condition(*this, a,
+                                                  pre + "arrow " + dotted(a.from) + " ~> " + dotted(a.to));
+              }
               return ai;
             }
             if (map != nullptr) {
@@ -588,6 +615,26 @@ void ProgramImpl::define(std::string name, std::string text) {
       make_transition(m->as<TransitionDecl>(), nullptr, -1, prefix);
     }
   }
+  // Port nets: the initialisers of the net's instance (run for each substitution transition's node, which
+  // is the copy's instance) and of its places and transitions (run for each copy of them).
+  walk(root, [&](const Decl& d) {
+    if (d.kind != DeclKind::Net || !d.as<ClassDecl>().is_port_net) return;
+    const auto& n = d.as<ClassDecl>();
+    for (const DeclPtr& m : n.members)
+      if (m->kind == DeclKind::Place || m->kind == DeclKind::Transition)
+        scope_init_[m.get()] =
+            compile_init(*this, m->as<ScopeDecl>(), qualified(n) + "." + m->name + " (initialisers)");
+  });
+  std::unordered_map<const ClassDecl*, int> port_init;
+  walk(root, [&](const Decl& d) {
+    if (d.kind != DeclKind::Transition || d.as<TransitionDecl>().substituted == nullptr) return;
+    const ClassDecl& n = *d.as<TransitionDecl>().substituted;
+    if (!own_members(n)) return;
+    auto it = port_init.find(&n);
+    if (it == port_init.end())
+      it = port_init.emplace(&n, compile_init(*this, n, qualified(n) + " (initialisers)")).first;
+    scope_init_[&d] = it->second;
+  });
   // Subclasses copied their bases' transitions before these were compiled: copy again.
   for (const ClassDecl* c : class_order_) {
     ClassInfo& ci = *class_info_.at(c);

@@ -95,7 +95,7 @@ enum Op : std::uint8_t {
   OP_OBJ,      // a = id of object consts[b]
   OP_GETP,     // a = property props[c] of instance b
   OP_SETP,     // property props[c] of instance a = b
-  OP_PLACE,    // a = place node number c of the net instance b
+  OP_PLACE,    // a = place node number c of the net instance b (c & kPortPlace: a port net's, of copy b)
   OP_PCOUNT,   // a = count of place b
   OP_PPUT,     // place a .put(b)
   OP_PCLEAR,   // place a .clear()
@@ -125,6 +125,10 @@ enum Op : std::uint8_t {
   OP_PVGET,   // a = element R[a] of vector property props[c] of instance b (no copy; range-checked)
   OP_FIND     // a = the node at path S[b] from the database, or null
 };
+
+// OP_PLACE's operand c with this bit: a place of a port net (index into port_places_), found from the
+// copy's instance.
+inline constexpr std::size_t kPortPlace = 0x8000;
 
 struct Ins {
   std::uint8_t op;
@@ -202,6 +206,9 @@ struct ArrowInfo {
   bool inhibitor = false;
   bool object = false;  // the place holds object tokens
   int cond = -1;        // function index of the arrow condition
+  // An arrow of a substituted sub-net: the substitution transition (index in the net) whose node is the
+  // port net's instance, `this` of its condition and the start of its path; -1: the net's owner.
+  int holder = -1;
 };
 
 struct TransitionInfo {
@@ -214,6 +221,8 @@ struct TransitionInfo {
   // transitions are its children); `holder` is the transition whose sub-net this one belongs to.
   bool inert = false;
   int holder = -1;
+  // A substitution transition: its port net's places (ports too) -> index in the net (OP_PLACE).
+  std::unordered_map<const Decl*, int> sub_places;
   // Invocation: the net it invokes and the function that sets the new instance's value parameters.
   const struct ClassInfo* invoke = nullptr;
   int invoke_args = -1;
@@ -391,7 +400,10 @@ class ProgramImpl {
   std::vector<std::vector<RK>> method_kinds_;              // MCALL argument kinds
   std::vector<RK> method_results_;
   std::vector<std::pair<int, const ClassDecl*>> object_refs_;  // consts_ slot -> object
-  std::unordered_map<const Decl*, int> scope_init_;            // place/transition property initialisers
+  std::vector<const PlaceDecl*> port_places_;                  // places of port nets named in code
+  // The node of place port_places_[k] in the copy of its port net whose instance is @p copy; 0: none.
+  std::uint64_t port_place_id(std::uint64_t copy, std::size_t k) const;
+  std::unordered_map<const Decl*, int> scope_init_;  // place/transition property initialisers
 
   std::unordered_map<const ClassDecl*, std::unique_ptr<ClassInfo>> class_info_;
   std::vector<const ClassDecl*> class_order_;  // bases first
@@ -473,7 +485,11 @@ class ProgramImpl {
   bool test(TI& ti);
   // The remote place of a communication arrow (null when the path meets a null reference); records what
   // it read as dependencies while a test runs.
-  Place* remote_place(const ArrowInfo& a, std::uint64_t owner);
+  Place* remote_place(const ArrowInfo& a, const NetInst& net);
+  // `this` of an arrow's condition and the start of a communication arrow's path (ArrowInfo::holder).
+  static std::uint64_t arrow_self(const NetInst& net, const ArrowInfo& a) {
+    return a.holder < 0 ? net.owner : net.transitions[static_cast<std::size_t>(a.holder)]->id();
+  }
   void fire(std::uint32_t ti);
   void fire_body(std::uint32_t ti);  // fire() without the savepoint
   // Undoes a failed firing: the SimState back to @p sp, nets killed since killed_[killed] revived.

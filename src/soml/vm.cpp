@@ -781,6 +781,14 @@ Val ProgramImpl::exec(std::size_t entry) {
         break;
       }
       case OP_PLACE: {
+        if ((in.c & kPortPlace) != 0) {
+          R[in.a].id = port_place_id(R[in.b].id, in.c & (kPortPlace - 1));
+          if (R[in.a].id == 0) {
+            VSD_SAVE();
+            fail("instance " + std::to_string(R[in.b].id) + " is no copy of a port net");
+          }
+          break;
+        }
         const NetInst* n = net_of(R[in.b].id);
         if (n == nullptr || in.c >= n->places.size()) {
           VSD_SAVE();

@@ -199,6 +199,120 @@ object s2 : Station;
   EXPECT_EQ(p.place("collected", dispatcher)->tokens(), 5);
 }
 
+TEST_F(Exec, CommunicationArrowsCarryObjectTokensAndTestTheirConditions) {
+  Program& p = load(R"(
+class Job : Node {
+  int client = 0;
+  int size = 0;
+  Job(int c, int s) { client = c; size = s; }
+}
+object server {
+  bool open = false;
+  place<Job> outbox;
+  place tickets = 1;
+  void add(int c, int s) { outbox.put(new Job(c, s)); }
+}
+class Client : Node {
+  int id = 0;
+  shared<server> peer;
+  place<Job> mine;
+  place<Job> big;
+  place got;
+  transition take;
+  arrow peer.outbox ~> take when mark.client == id;   // the remote token is mark, id this client's
+  arrow peer.tickets ~> take when peer.open;          // a black remote input with a condition
+  arrow take ~> peer.tickets when mark.size > 5;      // a conditional deposit: only for big jobs
+  arrow take -> big when mark.size > 10;              // the mark: the first object place that takes it
+  arrow take -> mine;
+  arrow take -> got;
+}
+object c1 : Client;
+object c2 : Client;
+)");
+  vsd::Node* server = p.object("server");
+  vsd::Node* c1 = p.object("c1");
+  vsd::Node* c2 = p.object("c2");
+  c1->set("id", vsd::Value(std::int64_t{1}));
+  c2->set("id", vsd::Value(std::int64_t{2}));
+  server->call("add", {vsd::Value(std::int64_t{2}), vsd::Value(std::int64_t{20})});
+  server->call("add", {vsd::Value(std::int64_t{1}), vsd::Value(std::int64_t{7})});
+  server->call("add", {vsd::Value(std::int64_t{1}), vsd::Value(std::int64_t{3})});
+  EXPECT_EQ(p.run_until_quiet(), 0u) << "a null reference on the path disables";
+  c1->set("peer", vsd::Value(vsd::SharedRef<vsd::Node>(server)));
+  c2->set("peer", vsd::Value(vsd::SharedRef<vsd::Node>(server)));
+  EXPECT_EQ(p.run_until_quiet(), 0u) << "the server is closed: the tickets' arrow condition fails";
+  std::vector<std::string> trace;
+  p.on_firing([&](const vsd::soml::Firing& f) {
+    trace.push_back(f.transition->parent()->name() + "." + f.transition->name() + " " +
+                    vsd::Value(f.mark != 0
+                                   ? env.main_state().find(f.mark)->as<vsd::Node>()->get<std::int64_t>("size")
+                                   : std::int64_t{0})
+                        .to_text() +
+                    ":" + (f.from ? f.from->parent()->name() + "." + f.from->name() : "") + "->" +
+                    (f.to ? f.to->parent()->name() + "." + f.to->name() : "-"));
+  });
+  // Opening the server re-tests both clients (their conditions read `open`); one ticket: one firing,
+  // and a job bigger than 5 gives it back.
+  server->set("open", vsd::Value(true));
+  EXPECT_EQ(p.run_until_quiet(), 3u);
+  EXPECT_EQ(p.place("outbox", server)->objects().size(), 0u);
+  ASSERT_EQ(p.place("big", c2)->objects().size(), 1u);  // the 20 of client 2
+  EXPECT_EQ(p.place("big", c2)->objects()[0]->get<std::int64_t>("size"), 20);
+  EXPECT_EQ(p.place("mine", c1)->objects().size(), 2u);  // client 1's 7 and 3, each only by c1
+  EXPECT_EQ(p.place("got", c1)->tokens(), 2);
+  EXPECT_EQ(p.place("got", c2)->tokens(), 1);
+  EXPECT_EQ(p.place("tickets", server)->tokens(), 0) << "the job of size 3 kept its ticket";
+  EXPECT_THAT(trace, ::testing::UnorderedElementsAre("c2.take 20:server.outbox->c2.big",
+                                                     "c1.take 7:server.outbox->c1.mine",
+                                                     "c1.take 3:server.outbox->c1.mine"));
+  // Every change went through the setters: a replica that applies the recording ends equal.
+  vsd::SimState& replica = env.create_state("replica");
+  replica.copy_from(env.main_state());
+  env.main_state().start_recording();
+  server->call("add", {vsd::Value(std::int64_t{2}), vsd::Value(std::int64_t{9})});
+  p.place("tickets", server)->set_tokens(1);
+  EXPECT_EQ(p.run_until_quiet(), 1u);
+  EXPECT_EQ(p.place("mine", c2)->objects().size(), 1u);
+  EXPECT_EQ(p.place("tickets", server)->tokens(), 1);
+  replica.apply(env.main_state().stop_recording());
+  std::string diff;
+  EXPECT_TRUE(replica.equals(env.main_state(), &diff)) << diff;
+}
+
+TEST_F(Exec, AFailedFiringPutsARemoteObjectTokenBackWhereItWas) {
+  Program& p = load(R"(
+class Job : Node { int size = 0; Job(int s) { size = s; } }
+int zero = 0;
+object server {
+  place<Job> outbox;
+  void add(int s) { outbox.put(new Job(s)); }
+}
+object client {
+  place<Job> done;
+  transition take { do { mark.size = mark.size / zero; } }
+  arrow server.outbox ~> take when mark.size > 1;
+  arrow take -> done;
+}
+)");
+  vsd::Node* server = p.object("server");
+  server->call("add", {vsd::Value(std::int64_t{1})});
+  server->call("add", {vsd::Value(std::int64_t{4})});
+  server->call("add", {vsd::Value(std::int64_t{5})});
+  try {
+    p.step(1);
+    FAIL() << "no error";
+  } catch (const vsd::Error& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr("division by zero"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("at client.take (action) (net.soml:10)"));
+  }
+  // The first token that satisfies the arrow's condition was taken and is back in its position.
+  const auto& outbox = p.place("outbox", server)->objects();
+  ASSERT_EQ(outbox.size(), 3u);
+  EXPECT_EQ(outbox[1]->get<std::int64_t>("size"), 4);
+  EXPECT_EQ(outbox[2]->get<std::int64_t>("size"), 5);
+  EXPECT_EQ(p.place("done", p.object("client"))->objects().size(), 0u);
+}
+
 TEST_F(Exec, DeletingANetsNodesStopsThatNetOnly) {
   Program& p = load(R"(
 class Cell : Node {

@@ -154,6 +154,139 @@ object c2 : BigCell;
   EXPECT_EQ(p.place("extra", p.object("c2"))->tokens(), 1);
 }
 
+// A port net with members: the substitution transition's node is the copy's instance.
+constexpr const char* kCounted = R"(
+object log { place reports; }
+net Relay(place in, place out) {
+  int passed = 0;
+  int limit = 2;
+  shared<log> sink = log;
+  int left() { return limit - passed; }
+  int waiting() { return in.count; }   // the copy's port: its socket place
+  transition pass {
+    int moved = 0;
+    when passed < limit;
+    do { passed += 1; moved += 1; }
+  }
+  arrow in -> pass;
+  arrow pass -> out;
+  arrow pass ~> sink.reports when left() == 0;
+}
+class Cell : Node {
+  place in = 5;
+  place mid;
+  place out;
+  transition first = Relay(in, mid);
+  transition second = Relay(mid, out);
+}
+object c1 : Cell;
+object c2 : Cell;
+)";
+
+TEST_F(Nets, APortNetsPropertiesAndFunctionsBelongToEachCopy) {
+  Program& p = load(kCounted);
+  // Every copy is an instance of the port net's run-time class, a soml::Transition.
+  vsd::Node* c1 = p.object("c1");
+  auto* first = child<Transition>(*c1, "first");
+  auto* second = child<Transition>(*c1, "second");
+  ASSERT_NE(first, nullptr);
+  ASSERT_NE(second, nullptr);
+  EXPECT_EQ(first->meta().name(), "soml::Relay");
+  EXPECT_TRUE(first->meta().is_a(Transition::static_meta()));
+  EXPECT_EQ(&second->meta(), &first->meta());
+  EXPECT_EQ(p.run_until_quiet(), 8u);  // 2 copies per cell, each lets 2 tokens pass
+  for (const char* n : {"c1", "c2"}) {
+    SCOPED_TRACE(n);
+    vsd::Node* c = p.object(n);
+    EXPECT_EQ(p.place("in", c)->tokens(), 3);
+    EXPECT_EQ(p.place("mid", c)->tokens(), 0);
+    EXPECT_EQ(p.place("out", c)->tokens(), 2);
+    for (const char* t : {"first", "second"}) {
+      auto* copy = child<Transition>(*c, t);
+      EXPECT_EQ(copy->get<std::int64_t>("passed"), 2);
+      EXPECT_EQ(child<Transition>(*copy, "pass")->get<std::int64_t>("moved"), 2);
+      EXPECT_EQ(copy->call("left", {}).as<std::int64_t>(), 0);  // a MetaMethod on the copy
+    }
+    EXPECT_EQ(child<Transition>(*c, "first")->call("waiting", {}).as<std::int64_t>(), 3);   // in
+    EXPECT_EQ(child<Transition>(*c, "second")->call("waiting", {}).as<std::int64_t>(), 0);  // mid
+  }
+  // One report per copy that reached its limit (the arrow's condition calls the copy's function).
+  EXPECT_EQ(p.place("reports", p.object("log"))->tokens(), 4);
+  // C++ raises one copy's limit: its condition read it, so that copy is re-tested and goes on alone.
+  first->set("limit", vsd::Value(std::int64_t{4}));
+  EXPECT_EQ(p.run_until_quiet(), 2u);
+  EXPECT_EQ(first->get<std::int64_t>("passed"), 4);
+  EXPECT_EQ(second->get<std::int64_t>("passed"), 2);
+  EXPECT_EQ(child<Transition>(*p.object("c2"), "first")->get<std::int64_t>("passed"), 2);
+  EXPECT_EQ(p.place("mid", c1)->tokens(), 2);
+  EXPECT_EQ(p.place("reports", p.object("log"))->tokens(), 5);
+  // A null reference on the copy's path disables that copy only.
+  second->set("limit", vsd::Value(std::int64_t{3}));
+  second->set("sink", vsd::Value(vsd::SharedRef<vsd::Node>()));
+  EXPECT_EQ(p.run_until_quiet(), 0u);
+  second->set("sink", vsd::Value(vsd::SharedRef<vsd::Node>(p.object("log"))));
+  EXPECT_EQ(p.run_until_quiet(), 1u);
+  EXPECT_EQ(p.place("out", c1)->tokens(), 3);
+  EXPECT_EQ(p.place("reports", p.object("log"))->tokens(), 6);
+}
+
+TEST_F(Nets, APortNetsMembersAreRecordedReplayedAndKeptByAReload) {
+  Program& p = load(kCounted);
+  vsd::SimState& replica = env.create_state("replica");
+  replica.copy_from(env.main_state());
+  env.main_state().start_recording();
+  EXPECT_EQ(p.step(3), 3u);
+  replica.apply(env.main_state().stop_recording());
+  std::string diff;
+  EXPECT_TRUE(replica.equals(env.main_state(), &diff)) << diff;
+  // A new version: the copies' properties are kept by name, a new one gets its initialiser.
+  std::int64_t before = 0;
+  for (const char* n : {"c1", "c2"})
+    for (const char* t : {"first", "second"})
+      before += child<Transition>(*p.object(n), t)->get<std::int64_t>("passed");
+  std::string v2 = kCounted;
+  v2.replace(v2.find("int limit = 2;"), 14, "int limit = 2;\n  string tag = \"v2\";");
+  const vsd::soml::MigrationReport r = p.reload("net.soml", v2);
+  EXPECT_EQ(r.migrated, 4u);  // the script object, log, c1 and c2 (the copies are parts of their nets)
+  std::int64_t after = 0;
+  for (const char* n : {"c1", "c2"})
+    for (const char* t : {"first", "second"}) {
+      auto* copy = child<Transition>(*p.object(n), t);
+      after += copy->get<std::int64_t>("passed");
+      EXPECT_EQ(copy->get<std::string>("tag"), "v2");
+    }
+  EXPECT_EQ(after, before);
+  EXPECT_EQ(p.run_until_quiet(), 8u - 3u);
+}
+
+TEST_F(Nets, WhatPortNetsCannotDoIsAnErrorWithItsPosition) {
+  auto error_of = [&](const std::string& text) {
+    try {
+      vsd::Registry r;  // a refused load may leave its classes defined: a registry per case
+      vsd::Environment e(0, r);
+      vsd::soml::RunOptions o;
+      o.out = &out;
+      e.use<vsd::soml::Module>().load(e.main_state(), "net.soml", text, o);
+    } catch (const vsd::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string ports = "place a = 1;\nplace b;\ntransition move = Relay(a, b);\n";
+  // A property with the name of one of soml::Transition (the copy's node is one).
+  EXPECT_THAT(
+      error_of("net Relay(place in, place out) {\n  int firings = 0;\n  transition t;\n"
+               "  arrow in -> t;\n  arrow t -> out;\n}\n" +
+               ports),
+      HasSubstr("net.soml:2:7: error: duplicate definition of 'firings' (already a member of built-in "
+                "class 'soml::Transition')"));
+  // A port net nested in a class does not reach the class's instance (its depth varies per copy).
+  EXPECT_THAT(error_of("class C : Node {\n  int k = 0;\n  net Relay(place in, place out) {\n"
+                       "    transition t { do { k += 1; } }\n    arrow in -> t;\n    arrow t -> out;\n  }\n"
+                       "  place a = 1;\n  place b;\n  transition move = Relay(a, b);\n}\nobject o : C;\n"),
+              HasSubstr("net.soml:4:25: error: reaching the enclosing instance"));
+}
+
 // ---- invocation --------------------------------------------------------------------------------------
 
 constexpr const char* kDouble = R"(

@@ -231,15 +231,21 @@ TEST_F(Runtime, ScriptErrorsAndUnsupportedConstructsAreReportedWithPositions) {
   EXPECT_THAT(error_of([&] { load("int f() { return x; }\n"); }),
               HasSubstr("test.soml:1:18: error: undefined name 'x'"));
   const std::string e = error_of([&] {
-    load(R"(net Relay(place in, place out) {
-  int hops = 0;
-  transition pass;
-  arrow in -> pass;
-  arrow pass -> out;
+    load(R"(class C : Node {
+  int k = 0;
+  net Relay(place in, place out) {
+    transition t { do { k += 1; } }
+    arrow in -> t;
+    arrow t -> out;
+  }
+  place a = 1;
+  place b;
+  transition move = Relay(a, b);
 }
+object o : C;
 )");
   });
-  EXPECT_THAT(e, HasSubstr("test.soml:2:7"));
+  EXPECT_THAT(e, HasSubstr("test.soml:4:25"));
   EXPECT_THAT(e, HasSubstr("not supported"));
 }
 
