@@ -61,7 +61,7 @@ struct RawWriter {
 };
 
 std::vector<std::uint8_t> envelope(std::vector<std::uint8_t> body) {
-  body.insert(body.begin(), {'V', 'S', 'D', 'D', 1});
+  body.insert(body.begin(), {'V', 'S', 'D', 'D', 2});
   return body;
 }
 
@@ -89,11 +89,11 @@ TEST_F(FaultTest, ForeignAndMalformedSamplesAreLoggedAndNeverApplied) {
   raw.send(77, 1, 1, {'h', 'e', 'l', 'l', 'o'});                          // no envelope
   raw.send(77, 1, 1, {'V', 'S', 'D', 'D', 9, 0});                         // a future version
   raw.send(77, 1, 42, envelope({}));                                      // unknown kind
-  raw.send(77, 1, 1, envelope({'V', 'S', 'D', 'W', 1, 0, 1, 1, 1, 99}));  // bundle: bad name index
+  raw.send(77, 1, 1, envelope({'V', 'S', 'D', 'W', 2, 0, 1, 1, 1, 99}));  // bundle: bad name index
   raw.send(77, 2, 1, envelope({0xff, 0xff, 0xff}));                       // bundle: garbage
   raw.send(77, 0, 5, envelope({1, 2}));                                   // a truncated report
   // A well-formed bundle that creates an instance of a class nobody has: decodes, cannot apply.
-  std::vector<std::uint8_t> body{'V', 'S', 'D', 'W', 1, 1, 7,  'N', 'o', 'C',
+  std::vector<std::uint8_t> body{'V', 'S', 'D', 'W', 2, 1, 7,  'N', 'o', 'C',
                                  'l', 'a', 's', 's', 1, 1, 99, 0,   0};
   ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return pb.stats().foreign >= 3 && pb.stats().malformed >= 3; }));
   EXPECT_EQ(b.size(), before);

@@ -2,4 +2,5 @@
 # multi-process ones run alone (they spawn processes, use ports and may make network namespaces).
 set_tests_properties("DistProcesses.AReaderThatDiesAndARejoinerFollowAWriterProcess"
                      "DistProcesses.NetworkNamespacesWithLossDelayAndReordering"
-                     "DistProcesses.TenPercentPacketLossLosesNothingAndReordersNothing" PROPERTIES RUN_SERIAL TRUE)
+                     "DistProcesses.TenPercentPacketLossLosesNothingAndReordersNothing"
+                     "DistProcesses.ThreeProcessesEditingOneListEndWithTheSameList" PROPERTIES RUN_SERIAL TRUE)

@@ -106,14 +106,14 @@ TEST_F(WireTest, MalformedBytesAreErrorsWithTheirPosition) {
   EXPECT_THAT([&] { (void)vsd::dist::decode_bundle(trailing); },
               testing::ThrowsMessage<vsd::Error>(HasSubstr("1 unexpected bytes after the last operation")));
   // A name index past the table.
-  const std::vector<std::uint8_t> bad_name{'V', 'S', 'D', 'W', 1, 1, 4, 'D', 'A', 'r', 'm', 1, 1, 5, 3};
+  const std::vector<std::uint8_t> bad_name{'V', 'S', 'D', 'W', 2, 1, 4, 'D', 'A', 'r', 'm', 1, 1, 5, 3};
   EXPECT_THAT([&] { (void)vsd::dist::decode_bundle(bad_name); },
               testing::ThrowsMessage<vsd::Error>(
                   HasSubstr("byte 14: name index 3 is past the name table (1 names)")));
-  const std::vector<std::uint8_t> bad_code{'V', 'S', 'D', 'W', 1, 1, 4, 'D', 'A', 'r', 'm', 1, 9, 5, 0};
+  const std::vector<std::uint8_t> bad_code{'V', 'S', 'D', 'W', 2, 1, 4, 'D', 'A', 'r', 'm', 1, 9, 5, 0};
   EXPECT_THAT([&] { (void)vsd::dist::decode_bundle(bad_code); },
               testing::ThrowsMessage<vsd::Error>(HasSubstr("byte 12: unknown operation code 9")));
-  const std::vector<std::uint8_t> huge_count{'V', 'S', 'D', 'W', 1, 0, 0x7f};
+  const std::vector<std::uint8_t> huge_count{'V', 'S', 'D', 'W', 2, 0, 0x7f};
   EXPECT_THAT([&] { (void)vsd::dist::decode_bundle(huge_count); },
               testing::ThrowsMessage<vsd::Error>(HasSubstr("exceeds")));
 }

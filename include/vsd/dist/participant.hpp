@@ -90,8 +90,13 @@ enum class ConflictKind : std::uint8_t {
   /// won everywhere; the other one was rolled back.
   ClaimRace = 2,
   /// A change to an instance (a set or a list edit) was made while another participant deleted it: the
-  /// deletion won everywhere, the change was dropped; the deleter tells the writer (docs/dist.md).
+  /// deletion won everywhere, the change was dropped; the deleter tells the writer (docs/dist.md). Also a
+  /// reference set to, or a list entry of, an instance deleted concurrently (Conflict::target): the
+  /// reference ends null, the entry removed, everywhere.
   Deleted = 3,
+  /// Two participants moved the same node to different parents concurrently: the newer move (the larger
+  /// stamp) won everywhere, the other entry was removed from its children list (docs/dist.md).
+  ConcurrentMove = 4,
 };
 
 /// @brief A write or claim that lost: reported to the loser and the winner (and logged by receivers).
@@ -103,7 +108,10 @@ struct Conflict {
   std::uint64_t seq = 0;  ///< the loser's sequence number of its bundle or claim (0: never sent)
   Id instance = null_id;  ///< the instance touched
   std::string property;   ///< the property touched (empty: the instance itself, a deletion)
-  std::string text;       ///< one line for logs: who, what, whose
+  /// Deleted: the deleted instance a reference or list entry referred to (null_id: @p instance itself was
+  /// deleted); ConcurrentMove: the node moved (@p instance, @p property: the children list it lost)
+  Id target = null_id;
+  std::string text;  ///< one line for logs: who, what, whose
 };
 
 /// @brief Counters, for tests, tools and monitoring.
@@ -120,8 +128,9 @@ struct ParticipantStats {
   std::uint64_t resyncs = 0;           ///< snapshots installed after the first synchronisation
   std::uint64_t snapshots_served = 0;  ///< snapshot requests answered
   std::uint64_t dropped_unsynced = 0;  ///< local bundles dropped because they were made while unsynchronised
-  std::uint64_t lost_writes = 0;  ///< sets and list edits of others dropped here: a concurrent write with a
-                                  ///< later stamp or a concurrent deletion won
+  /// sets and list edits of others dropped here: a concurrent write with a later stamp, a concurrent
+  /// deletion or a newer move won
+  std::uint64_t lost_writes = 0;
   std::uint64_t claims_lost = 0;  ///< claims (anyone's) that lost a race here, this one's included
 };
 
