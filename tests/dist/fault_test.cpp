@@ -57,6 +57,7 @@ struct RawWriter {
     m.payload._length = static_cast<std::uint32_t>(payload.size());
     m.payload._maximum = m.payload._length;
     ASSERT_GE(dds_write(writer, &m), 0);
+    dds_write_flush(writer);  // the loopback configuration batches writes
   }
 };
 

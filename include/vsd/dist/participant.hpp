@@ -158,11 +158,16 @@ class Participant {
   /// @brief Sends the changes recorded since the last publish as one bundle, if any Distributed change is
   /// among them. A change to what another participant owns is undone here instead (the whole bundle) and
   /// reported (on_conflict, log, and to the owner). While unsynchronised, changes are dropped (counted).
+  /// With Cyclone's write batching (Internal/WriteBatch, on in the shipped loopback configuration) the
+  /// sample waits in the writer until the next poll(), poll_until() or flush() (docs/dist.md).
   /// @return true when a bundle was sent. @throws vsd::Error when the writer stays blocked past
   /// write_timeout.
   bool publish();
+  /// @brief Hands everything published so far to the network now (poll() and poll_until() do it too).
+  void flush();
   /// @brief publish(), then handles everything that arrived: applies bundles and claims in order, answers
-  /// snapshot requests, installs a snapshot. Never blocks. @return the number of bundles applied.
+  /// snapshot requests, installs a snapshot; then flush(). Never blocks. @return the number of bundles
+  /// applied.
   std::size_t poll();
   /// @brief Polls until @p done returns true or @p timeout passes, sleeping on DDS data in between.
   /// @return the last value of @p done.
