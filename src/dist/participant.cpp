@@ -208,6 +208,9 @@ struct Participant::Impl {
   // Instances deleted, with the stamp of the deletion: a change to one of them made concurrently with the
   // deletion is dropped by every replica (the deletion wins), whatever the arrival order.
   std::unordered_map<Id, Stamp> deleted;
+  // When each tombstone was made here, oldest first: pruned after ParticipantOptions::tombstone_horizon.
+  std::deque<std::pair<std::chrono::steady_clock::time_point, Id>> deletion_order;
+  std::chrono::steady_clock::time_point last_prune{};
   // Every reference list edited through vsd::dist since it was created or joined: a replicated sequence
   // whose visible entries are the list here (docs/dist.md, "Reference lists"). Lists nobody edited have
   // none; their value is the same everywhere.
@@ -381,7 +384,8 @@ struct Participant::Impl {
   }
   void forget_deleted(const std::vector<Id>& ids, const Stamp& stamp) {
     for (const Id gone : ids) {
-      deleted.emplace(gone, stamp);
+      if (deleted.emplace(gone, stamp).second)
+        deletion_order.emplace_back(std::chrono::steady_clock::now(), gone);
       written.erase(gone);
       top_child.erase(gone);
       for (auto it = lists.lower_bound(ListKey(gone, std::string()));
@@ -560,7 +564,7 @@ struct Participant::Impl {
         const std::size_t pos = seq_of_list.position(index);
         if (pos == internal::Sequence::npos || seq_of_list.elems[pos].target != target) throw out_of_sync();
         e.element = seq_of_list.elems[pos].id;
-        seq_of_list.elems[pos].removed = true;
+        seq_of_list.remove(pos);
       }
       return e;
     };
@@ -753,6 +757,7 @@ struct Participant::Impl {
         e.id.n = r.varint();
         e.target = r.varint();
         e.removed = r.u8() != 0;
+        if (e.removed) e.removed_at = std::chrono::steady_clock::now();
       }
     }
     if (seqs[id] < seq) {
@@ -801,6 +806,9 @@ struct Participant::Impl {
     written = std::move(registers);
     deleted = std::move(tombstones);
     lists = std::move(sequences);
+    deletion_order.clear();
+    for (const auto& [gone, st] : deleted)
+      deletion_order.emplace_back(std::chrono::steady_clock::now(), gone);
     top_child.clear();
     for (const auto& [key, sq] : lists)
       if (is_children(key.second))
@@ -947,7 +955,7 @@ struct Participant::Impl {
           if (sq.elems[pos].removed) return;  // erased already: twice, a lost move, or its target deleted
           detail::write_list(out, Transaction::Op::Erase, e.holder, e.property, sq.index_of(pos), e.target);
           ++ops;
-          sq.elems[pos].removed = true;
+          sq.remove(pos);
           return;
         }
         const ElementId elem{stamp.clock, stamp.who, e.element.n};
@@ -987,7 +995,7 @@ struct Participant::Impl {
             if (x.removed || x.target != dead) continue;
             detail::write_list(out, Transaction::Op::Erase, key.first, key.second, sq->index_of(pos), dead);
             ++ops;
-            x.removed = true;
+            sq->remove(pos);
             // Its inserter learns it from the deleter, which sees the insertion arrive after its deletion.
             if (x.id.who != id) dangling.push_back({key.first, key.second, stamp, dead, x.id.who});
           }
@@ -1016,7 +1024,7 @@ struct Participant::Impl {
           detail::write_list(out, Transaction::Op::Erase, old->second.holder,
                              Node::vsd_prop_children().name(), sq->index_of(pos), child);
           ++ops;
-          sq->elems[pos].removed = true;
+          sq->remove(pos);
           moved.push_back({old->second.holder, std::string(Node::vsd_prop_children().name()), stamp, child,
                            old->second.element.who});
         }
@@ -1341,6 +1349,24 @@ struct Participant::Impl {
     handle(std::move(m));
   }
 
+  // Tombstones (ids of deleted instances, removed list entries) are there to recognise changes made
+  // concurrently with the deletion or erasure. After the horizon no such change is expected any more: a
+  // participant cut off that long has been dropped (its lease) and resynchronises (docs/dist.md).
+  void prune_tombstones() {
+    if (opt.tombstone_horizon.count() <= 0) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_prune <
+        std::min<std::chrono::milliseconds>(opt.tombstone_horizon / 4, std::chrono::seconds(1)))
+      return;
+    last_prune = now;
+    const auto before = now - opt.tombstone_horizon;
+    while (!deletion_order.empty() && deletion_order.front().first < before) {
+      stats.tombstones_pruned += deleted.erase(deletion_order.front().second);
+      deletion_order.pop_front();
+    }
+    for (auto& [key, sq] : lists) stats.tombstones_pruned += sq.prune(before);
+  }
+
   std::size_t poll() {
     applied_now = 0;
     publish();
@@ -1367,6 +1393,7 @@ struct Participant::Impl {
         request_snapshot();
       }
     }
+    prune_tombstones();
     flush();
     return applied_now;
   }

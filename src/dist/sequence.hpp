@@ -11,6 +11,8 @@
 // whatever order they arrive in, and a participant's own insertion lands exactly where it made it.
 #pragma once
 
+#include <algorithm>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -24,6 +26,7 @@ struct Element {
   ElementId id;
   Id target = null_id;
   bool removed = false;
+  std::chrono::steady_clock::time_point removed_at{};  // here, for pruning (not sent)
 };
 
 class Sequence {
@@ -65,8 +68,23 @@ class Sequence {
       ++pos;
     }
     while (pos < elems.size() && id < elems[pos].id) ++pos;
-    elems.insert(elems.begin() + static_cast<std::ptrdiff_t>(pos), Element{id, target, removed});
+    elems.insert(
+        elems.begin() + static_cast<std::ptrdiff_t>(pos),
+        Element{id, target, removed,
+                removed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{}});
     return pos;
+  }
+  /// Marks the entry at @p pos removed (it stays, as a tombstone, for edits that name it).
+  void remove(std::size_t pos) {
+    elems[pos].removed = true;
+    elems[pos].removed_at = std::chrono::steady_clock::now();
+  }
+  /// Drops the tombstones removed before @p before (docs/dist.md, "Tombstones"): the visible entries and
+  /// their order do not change. @return how many went.
+  std::size_t prune(std::chrono::steady_clock::time_point before) {
+    const std::size_t n = elems.size();
+    std::erase_if(elems, [&](const Element& e) { return e.removed && e.removed_at < before; });
+    return n - elems.size();
   }
   [[nodiscard]] std::vector<Id> visible() const {
     std::vector<Id> v;

@@ -389,6 +389,56 @@ TEST_F(ArbitrationTest, ConcurrentMovesOfOneChildEndWithOneParentEverywhere) {
   EXPECT_EQ(robot->stats().resyncs + ui->stats().resyncs + other->stats().resyncs, 0u);
 }
 
+// Tombstones (deleted instances, erased list entries) go after the horizon; lists still merge afterwards, and
+// a participant that joins later synchronises from a pruned state.
+TEST(Tombstones, ArePrunedAfterTheHorizonAndListsStillMerge) {
+  const std::uint32_t domain = vsd_dist_test::fresh_domain();
+  vsd::Environment env_a{1}, env_b{2}, env_l{3};
+  vsd::SimState& a = env_a.main_state();
+  vsd::SimState& b = env_b.main_state();
+  auto& arm = a.create<DArm>();
+  a.database().add_child(arm);
+  auto o_a = options("a", domain, true);
+  auto o_b = options("b", domain);
+  o_a.tombstone_horizon = o_b.tombstone_horizon = 300ms;
+  vsd::dist::Participant pa(a, o_a), pb(b, o_b);
+  ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return pb.synced(); }));
+  std::vector<vsd::Node*> nodes;
+  for (int k = 0; k < 10; ++k) {
+    nodes.push_back(&a.create<vsd::Node>());
+    arm.edit_tools().push_back(*nodes.back());
+  }
+  ASSERT_TRUE(pa.publish());
+  ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return tools_of(b, arm.id()).size() == 10; }));
+  for (int k = 0; k < 10; k += 2) a.destroy(*nodes[static_cast<std::size_t>(k)]);  // 5 deletions, 5 erasures
+  ASSERT_TRUE(pa.publish());
+  ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return tools_of(b, arm.id()).size() == 5; }));
+  EXPECT_EQ(pa.stats().tombstones_pruned, 0u);
+  // Past the horizon (and the pruning interval), both have pruned the 5 deleted ids and the 5 erased entries.
+  poll_all(
+      {&pa, &pb}, [] { return false; }, 700ms);
+  EXPECT_EQ(pa.stats().tombstones_pruned, 10u);
+  EXPECT_EQ(pb.stats().tombstones_pruned, 10u);
+  for (int i = 0; i < 5; ++i) {  // concurrent edits next to where the pruned entries were
+    a.find<DArm>(arm.id())->edit_tools().insert(1, a.create<vsd::Node>());
+    b.find<DArm>(arm.id())->edit_tools().insert(1, b.create<vsd::Node>());
+    b.find<DArm>(arm.id())->edit_tools().erase(0);
+    ASSERT_TRUE(pa.publish());
+    ASSERT_TRUE(pb.publish());
+    ASSERT_TRUE(poll_all({&pa, &pb}, [&] {
+      return tools_of(a, arm.id()) == tools_of(b, arm.id()) &&
+             tools_of(a, arm.id()).size() == 6u + static_cast<std::size_t>(i);
+    }));
+  }
+  vsd::SimState& l = env_l.main_state();
+  vsd::dist::Participant pl(l, options("late", domain));
+  ASSERT_TRUE(poll_all({&pa, &pb, &pl}, [&] { return pl.synced(); }));
+  std::string diff;
+  EXPECT_TRUE(a.equals(l, &diff)) << diff;
+  EXPECT_TRUE(a.equals(b, &diff)) << diff;
+  EXPECT_EQ(pa.stats().resyncs + pb.stats().resyncs, 0u);
+}
+
 // Three processes edit one list at the same time (inserts at the front and in the middle, erasures): every
 // process ends with the same list, holding every insertion nobody erased, with no resynchronisation.
 TEST(DistProcesses, ThreeProcessesEditingOneListEndWithTheSameList) {

@@ -74,6 +74,11 @@ struct ParticipantOptions {
   /// @brief The participant's DDS lease: a participant that died without leaving is dropped by the others
   /// after this long (their writers wait for it until then). Keep write_timeout above it.
   std::chrono::milliseconds lease_duration{3000};
+  /// @brief How long a participant keeps the tombstones of deleted instances and erased list entries (to
+  /// recognise changes made concurrently with the deletion); then they are pruned. A change older than
+  /// this that arrives later (a participant cut off that long) does not apply, and its receiver
+  /// resynchronises. Keep it well above lease_duration. 0: keep them for the life of the domain.
+  std::chrono::milliseconds tombstone_horizon{60000};
   /// @brief Receives one line per noteworthy event (rejections, resynchronisation, conflicts). Default:
   /// standard error, prefixed "vsd::dist[name]: ".
   std::function<void(std::string_view line)> log;
@@ -131,7 +136,8 @@ struct ParticipantStats {
   /// sets and list edits of others dropped here: a concurrent write with a later stamp, a concurrent
   /// deletion or a newer move won
   std::uint64_t lost_writes = 0;
-  std::uint64_t claims_lost = 0;  ///< claims (anyone's) that lost a race here, this one's included
+  std::uint64_t claims_lost = 0;        ///< claims (anyone's) that lost a race here, this one's included
+  std::uint64_t tombstones_pruned = 0;  ///< tombstones dropped after ParticipantOptions::tombstone_horizon
 };
 
 /// @brief One SimState's membership in a distributed model (see the file comment).
