@@ -453,8 +453,11 @@ struct Participant::Impl {
       const MetaProperty* p = x != nullptr ? x->meta().find_property(op.name) : nullptr;
       return p != nullptr && p->type().is_ref_list();
     };
+    bool any = false;  // most bundles have none: look without keeping the parse
+    detail::TxParser parser(t);
+    for (detail::TxOp op; !any && parser.next(op);) any = is_list_set(op);
+    if (!any) return;
     std::vector<detail::TxOp> ops = detail::parse_tx(t);
-    if (std::none_of(ops.begin(), ops.end(), is_list_set)) return;
     std::vector<std::uint8_t> out;
     detail::write_tx_header(out);
     std::size_t count = 0;

@@ -189,6 +189,31 @@ TEST_F(ArbitrationTest, ConcurrentListEditsMergeEntryByEntryEverywhere) {
   EXPECT_EQ(robot->stats().lost_writes + ui->stats().lost_writes + other->stats().lost_writes, 0u);
 }
 
+// A whole-value set of a list travels as erasures and insertions, so it merges with a concurrent append.
+TEST_F(ArbitrationTest, AWholeListSetMergesWithAConcurrentAppend) {
+  const vsd::Id arm = keep->id();
+  for (int k = 0; k < 3; ++k) keep->edit_tools().push_back(r.create<vsd::Node>());
+  ASSERT_TRUE(robot->publish());
+  ASSERT_TRUE(settle([&] { return tools_of(u, arm).size() == 3 && tools_of(c, arm).size() == 3; }));
+  auto& x = u.create<vsd::Node>();
+  auto& y = u.create<vsd::Node>();
+  vsd::SharedRefList<vsd::Node> fresh;
+  fresh.push_back(&x);
+  fresh.push_back(&y);
+  u.find<DArm>(arm)->set_tools(fresh);  // the ui replaces the list ...
+  auto& z = r.create<vsd::Node>();
+  keep->edit_tools().push_back(z);  // ... while the robot appends to the old one
+  ASSERT_TRUE(ui->publish());
+  ASSERT_TRUE(robot->publish());
+  ASSERT_TRUE(settle([&] {
+    const auto a = tools_of(r, arm);
+    return a == tools_of(u, arm) && a == tools_of(c, arm) && sorted(a) == sorted({x.id(), y.id(), z.id()});
+  })) << testing::PrintToString(tools_of(r, arm))
+      << " " << testing::PrintToString(tools_of(u, arm));
+  expect_all_equal();
+  EXPECT_EQ(robot->stats().resyncs + ui->stats().resyncs + other->stats().resyncs, 0u);
+}
+
 // All three insert at the same position at once: the three entries end in one order everywhere, next to
 // each other, whatever order each participant received them in.
 TEST_F(ArbitrationTest, ThreeInsertionsAtOnePlaceLandInOneOrderEverywhere) {
