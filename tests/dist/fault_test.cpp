@@ -123,6 +123,38 @@ TEST_F(FaultTest, ForeignAndMalformedSamplesAreLoggedAndNeverApplied) {
       {&pa, &pb}, [&] { return b.find<DArm>(arm->id())->target() == 4.0; }, 15s));
 }
 
+// A list edit that names an entry nobody has (a third participant's insertion still on the way, or a
+// broken sender): the receivers resynchronise and say so; the state stays the shared one.
+TEST_F(FaultTest, AnEditOfAnUnknownListEntryResynchronises) {
+  vsd::dist::Participant pa(a, options("a", domain, true, &log_a));
+  vsd::dist::Participant pb(b, options("b", domain, false, &log_b));
+  ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return pb.synced(); }));
+  RawWriter raw(domain);
+  ASSERT_TRUE(raw.wait_matched(2));
+  std::vector<std::uint8_t> body{'V', 'S', 'D', 'W', 2};
+  vsd::ByteWriter w(body);
+  w.varint(1);
+  w.string("tools");
+  w.varint(1);  // one operation: erase entry (5, 0x77, 1) of arm.tools
+  w.u8(7);
+  w.varint(arm->id());
+  w.varint(0);
+  w.varint(5);
+  w.fixed(std::uint64_t{0x77});
+  w.varint(1);
+  w.varint(arm->id());
+  raw.send(80, 1, 1, envelope(body));
+  ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return contains(log_b, "it edits a list entry unknown here"); }))
+      << testing::PrintToString(log_b);
+  ASSERT_TRUE(poll_all(
+      {&pa, &pb}, [&] { return pb.synced() && pa.synced(); }, 15s));
+  arm->set_target(6.0);  // and the real stream goes on
+  ASSERT_TRUE(poll_all(
+      {&pa, &pb}, [&] { return b.find<DArm>(arm->id())->target() == 6.0; }, 15s));
+  std::string diff;
+  EXPECT_TRUE(a.equals(b, &diff)) << diff;
+}
+
 TEST_F(FaultTest, ADivergedParticipantResynchronisesFromASnapshot) {
   vsd::dist::Participant pa(a, options("a", domain, true, &log_a));
   vsd::dist::Participant pb(b, options("b", domain, false, &log_b));
