@@ -221,7 +221,13 @@ struct Participant::Impl {
   std::uint64_t prefer = 0;  // the participant a resynchronisation asks first (0: anyone)
   std::unordered_map<std::uint64_t, std::string> names;
   std::deque<Message> buffer;  // bundles and claims received while unsynchronised
-  std::uint64_t nonce = 0;     // of my pending snapshot request
+  // Bundles (and the ones after them, per sender) that edit a list entry made by a bundle of a third
+  // participant that has not arrived yet: they wait for it (bundles are not delivered in causal order).
+  std::map<std::uint64_t, std::deque<Message>> waiting;
+  std::chrono::steady_clock::time_point waiting_since{};
+  bool replaying = false;
+  std::unordered_map<std::uint64_t, std::uint64_t> last_clock;  // sender -> clock of its last bundle applied
+  std::uint64_t nonce = 0;                                      // of my pending snapshot request
   std::chrono::steady_clock::time_point last_request{};
   ParticipantStats stats;
   Signal<void(const Conflict&)> conflict_signal;
@@ -684,6 +690,12 @@ struct Participant::Impl {
     synced = false;
     buffer.clear();
     if (pending != nullptr) buffer.push_back(*pending);
+    for (auto& [sender, q] : waiting)  // after the snapshot, in their senders' order
+      for (Message& w : q)
+        if (pending == nullptr || w.sender != pending->sender || w.seq != pending->seq)
+          buffer.push_back(std::move(w));
+    waiting.clear();
+    waiting_since = {};
     nonce = random_id();
     resync_started = std::chrono::steady_clock::now();
     request_snapshot();
@@ -862,12 +874,50 @@ struct Participant::Impl {
   bool self_diverged = false;
   std::chrono::steady_clock::time_point resync_started{};
 
+  // True when entry @p e was made by a bundle of a participant other than @p sender that is not applied
+  // here yet: its clock is past that participant's last bundle applied here.
+  bool to_come(const ElementId& e, std::uint64_t sender) const {
+    if (e.who == 0 || e.who == sender || e.who == id) return false;
+    auto c = last_clock.find(e.who);
+    return c == last_clock.end() || c->second < e.clock;
+  }
+
+  // Retries the waiting bundles, each sender's in order, until none moves on.
+  void replay_waiting() {
+    replaying = true;
+    for (bool progress = true; progress && synced;) {
+      progress = false;
+      for (auto w = waiting.begin(); w != waiting.end() && synced;) {
+        while (!w->second.empty() && synced) {
+          const Message m = std::move(w->second.front());
+          w->second.pop_front();
+          const std::uint64_t before = applied[m.sender];
+          sequenced(m);
+          if (!synced) {  // it resynchronises: resync() moved the waiting bundles to the buffer
+            replaying = false;
+            return;
+          }
+          if (!w->second.empty() && w->second.front().seq == m.seq) break;  // waits again
+          progress = progress || applied[m.sender] != before;
+        }
+        w = w->second.empty() ? waiting.erase(w) : std::next(w);
+      }
+    }
+    if (waiting.empty()) waiting_since = {};
+    replaying = false;
+  }
+
   // A bundle or claim, in the sender's order.
   void sequenced(const Message& m) {
     if (!synced) {
       buffer.push_back(m);
       return;
     }
+    if (!replaying)
+      if (auto w = waiting.find(m.sender); w != waiting.end() && !w->second.empty()) {
+        w->second.push_back(m);  // behind its sender's waiting bundle
+        return;
+      }
     publish();  // my changes first: the recording must hold only what this participant did
     const Stamp stamp{m.clock, m.sender};
     Transaction t;
@@ -885,6 +935,7 @@ struct Participant::Impl {
     std::unordered_map<Id, Top> tops;
     std::unordered_map<Id, std::string_view> created;  // class names of the instances the bundle creates
     bool unknown_entry = false;  // an edit names a list entry this participant has not seen
+    bool entry_to_come = false;  // ... one that a bundle not applied yet of a third participant makes
     if (m.kind == Kind::Bundle) {
       auto existing = [&](const ListKey& key) -> internal::Sequence* {
         if (auto x = touched.find(key); x != touched.end()) return &x->second;
@@ -953,6 +1004,8 @@ struct Participant::Impl {
           const std::size_t pos = sq.find(e.element);
           if (pos == internal::Sequence::npos || sq.elems[pos].target != e.target) {
             unknown_entry = true;
+            entry_to_come =
+                entry_to_come || (pos == internal::Sequence::npos && to_come(e.element, m.sender));
             return;
           }
           if (sq.elems[pos].removed) return;  // erased already: twice, a lost move, or its target deleted
@@ -982,6 +1035,7 @@ struct Participant::Impl {
         const std::size_t pos = sq.integrate(elem, e.origin, e.target, hidden);
         if (pos == internal::Sequence::npos) {
           unknown_entry = true;
+          entry_to_come = entry_to_come || to_come(e.origin, m.sender);
           return;
         }
         if (hidden) return;
@@ -1076,6 +1130,16 @@ struct Participant::Impl {
       report(*c, c->owner == id);  // the owner tells the writer
       return;
     }
+    if (unknown_entry && entry_to_come &&
+        (waiting_since == std::chrono::steady_clock::time_point{} ||
+         std::chrono::steady_clock::now() - waiting_since < 10 * opt.request_interval)) {
+      // Wait for the bundle that makes the entry (its sender's stream is behind this one's here).
+      if (waiting_since == std::chrono::steady_clock::time_point{})
+        waiting_since = std::chrono::steady_clock::now();
+      waiting[m.sender].push_front(m);
+      if (!replaying) ++stats.bundles_waited;
+      return;
+    }
     try {
       if (unknown_entry) throw Error("it edits a list entry unknown here");
       state.apply(t);
@@ -1102,9 +1166,11 @@ struct Participant::Impl {
     for (const auto& [child, top] : tops) top_child[child] = top;
     forget_deleted(deletes, stamp);
     it->second = m.seq;
+    last_clock[m.sender] = m.clock;
     handled(m);
     ++stats.bundles_applied;
     ++applied_now;
+    if (!waiting.empty() && !replaying) replay_waiting();
     for (const Lost& l : lost) {
       // The later stamped write won here, as it does everywhere. Its writer tells the loser (who may see
       // nothing amiss: the winner's set simply overwrote its own).
@@ -1396,6 +1462,9 @@ struct Participant::Impl {
         request_snapshot();
       }
     }
+    if (!waiting.empty() && synced &&
+        std::chrono::steady_clock::now() - waiting_since >= 10 * opt.request_interval)
+      replay_waiting();  // waited long enough: what still does not apply makes this participant resynchronise
     prune_tombstones();
     flush();
     return applied_now;

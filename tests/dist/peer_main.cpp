@@ -146,8 +146,9 @@ int lister(std::uint32_t domain, int n, const std::string& config) {
   }
   std::string list;
   for (vsd::Node* x : arm->tools()) list += " " + std::to_string(x->id());
-  std::printf("lister: tools%s\nlister: resyncs %llu\n", list.c_str(),
-              static_cast<unsigned long long>(p.stats().resyncs));
+  std::printf("lister: tools%s\nlister: resyncs %llu, bundles that waited for another's %llu\n", list.c_str(),
+              static_cast<unsigned long long>(p.stats().resyncs),
+              static_cast<unsigned long long>(p.stats().bundles_waited));
   return 0;
 }
 

@@ -136,7 +136,9 @@ struct ParticipantStats {
   /// sets and list edits of others dropped here: a concurrent write with a later stamp, a concurrent
   /// deletion or a newer move won
   std::uint64_t lost_writes = 0;
-  std::uint64_t claims_lost = 0;        ///< claims (anyone's) that lost a race here, this one's included
+  std::uint64_t claims_lost = 0;  ///< claims (anyone's) that lost a race here, this one's included
+  /// bundles that waited for a bundle of a third participant that made a list entry they edit
+  std::uint64_t bundles_waited = 0;
   std::uint64_t tombstones_pruned = 0;  ///< tombstones dropped after ParticipantOptions::tombstone_horizon
 };
 
