@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -52,7 +53,7 @@ vsd::dist::ParticipantOptions options(const char* name, std::uint32_t domain, bo
 
 // Raw Cyclone DDS: the same message type and QoS as vsd::dist, on a topic of its own.
 struct Raw {
-  dds_entity_t participant = 0, writer = 0, reader = 0;
+  dds_entity_t participant = 0, writer = 0, reader = 0, waitset = 0;
   explicit Raw(std::uint32_t domain) {
     participant = dds_create_participant(domain, nullptr, nullptr);
     dds_qos_t* q = dds_create_qos();
@@ -64,6 +65,14 @@ struct Raw {
     writer = dds_create_writer(participant, topic, q, nullptr);
     reader = dds_create_reader(participant, topic, q, nullptr);
     dds_delete_qos(q);
+    // Waiting sleeps on the reader, as vsd::dist's poll_until() does on its own.
+    waitset = dds_create_waitset(participant);
+    dds_waitset_attach(waitset, dds_create_readcondition(reader, DDS_ANY_STATE), 0);
+  }
+  // Sleeps until data is there to take, or @p at_most passes.
+  void wait(std::chrono::milliseconds at_most) const {
+    dds_attach_t triggered = 0;
+    (void)dds_waitset_wait(waitset, &triggered, 1, DDS_MSECS(at_most.count()));
   }
   ~Raw() { dds_delete(participant); }
   void write(std::uint8_t kind, std::uint64_t seq, std::vector<std::uint8_t>& payload) const {
@@ -74,6 +83,8 @@ struct Raw {
     m.payload._length = m.payload._maximum = static_cast<std::uint32_t>(payload.size());
     dds_write(writer, &m);
   }
+  // With the configuration's write batching, samples leave here (vsd::dist: in poll() and poll_until()).
+  void flush() const { dds_write_flush(writer); }
   // Takes everything that arrived (in batches of 64, as vsd::dist does); calls f(kind, seq) for each.
   template <class F>
   void take(F&& f) const {
@@ -119,25 +130,38 @@ int peer(std::uint32_t domain) {
   for (auto* n : s.database().children())
     if (auto* a = n->as<BArm>()) arm = a;
   if (arm == nullptr) return 1;
+  // Nothing here spins: the raw echo sleeps on its reader in a thread of its own, the vsd::dist side in
+  // poll_until() on the participant's (on 2 loaded cores a spinning peer takes the CPU from Cyclone's own
+  // receive and delivery threads, which both sides need).
+  std::atomic<bool> stop{false};
+  std::thread echo([&] {
+    while (!stop) {
+      raw.take([&](std::uint8_t kind, std::uint64_t seq) {
+        if (kind == Ping) raw.write(Pong, seq, payload);
+        if (kind == Data && seq % ack_every == 0) raw.write(Ack, seq, payload);
+      });
+      raw.flush();
+      raw.wait(20ms);
+    }
+  });
   const auto end = std::chrono::steady_clock::now() + 300s;
-  while (std::chrono::steady_clock::now() < end && ::getppid() != 1) {
-    p.poll();
-    bool changed = false;
-    if (arm->pong() != arm->ping()) {
-      arm->set_pong(arm->ping());
-      changed = true;
-    }
-    if (arm->counter() % ack_every == 0 && arm->ack() != arm->counter()) {
-      arm->set_ack(arm->counter());
-      changed = true;
-    }
-    if (changed) p.publish();
-    raw.take([&](std::uint8_t kind, std::uint64_t seq) {
-      if (kind == Ping) raw.write(Pong, seq, payload);
-      if (kind == Data && seq % ack_every == 0) raw.write(Ack, seq, payload);
-    });
-    std::this_thread::yield();
-  }
+  p.poll_until(
+      [&] {
+        bool changed = false;
+        if (arm->pong() != arm->ping()) {
+          arm->set_pong(arm->ping());
+          changed = true;
+        }
+        if (arm->counter() % ack_every == 0 && arm->ack() != arm->counter()) {
+          arm->set_ack(arm->counter());
+          changed = true;
+        }
+        if (changed) p.publish();
+        return std::chrono::steady_clock::now() >= end || ::getppid() == 1;
+      },
+      300s);
+  stop = true;
+  echo.join();
   return 0;
 }
 
@@ -185,7 +209,23 @@ struct Session {
 
 Session* session = nullptr;
 
-// Spins on @p poll until @p done; false (and the benchmark skipped with an error) after 30 s.
+// Calls @p poll until @p done, sleeping in @p wait (on the reader's data) in between; false (and the
+// benchmark skipped with an error) after 30 s. Neither side spins (see peer()).
+template <class Poll, class Done, class Wait>
+bool wait_for(benchmark::State& st, Poll&& poll, Done&& done, Wait&& wait) {
+  const auto end = std::chrono::steady_clock::now() + 30s;
+  for (;;) {
+    poll();
+    if (done()) return true;
+    if (std::chrono::steady_clock::now() > end) {
+      st.SkipWithError("the peer did not answer within 30 s");
+      return false;
+    }
+    wait();
+  }
+}
+// Spins on @p poll until @p done (the in-process pairs: one thread serves both sides, so it cannot sleep
+// on one side's reader); false after 30 s.
 template <class Poll, class Done>
 bool spin(benchmark::State& st, Poll&& poll, Done&& done) {
   const auto end = std::chrono::steady_clock::now() + 30s;
@@ -198,6 +238,13 @@ bool spin(benchmark::State& st, Poll&& poll, Done&& done) {
   }
   return true;
 }
+// vsd::dist: poll_until() polls and sleeps on the participant's reader.
+template <class Done>
+bool wait_for(benchmark::State& st, vsd::dist::Participant& p, Done&& done) {
+  if (p.poll_until(done, 30s)) return true;
+  st.SkipWithError("the peer did not answer within 30 s");
+  return false;
+}
 
 void BM_DistRoundTrip(benchmark::State& st) {
   Session& x = *session;
@@ -205,9 +252,7 @@ void BM_DistRoundTrip(benchmark::State& st) {
     const double v = x.arm.ping() + 1;
     x.arm.set_ping(v);
     x.p->publish();
-    if (!spin(
-            st, [&] { x.p->poll(); }, [&] { return x.arm.pong() == v; }))
-      break;
+    if (!wait_for(st, *x.p, [&] { return x.arm.pong() == v; })) break;
   }
   st.counters["payload_bytes"] = static_cast<double>(x.payload.size());
 }
@@ -217,13 +262,14 @@ void BM_RawDdsRoundTrip(benchmark::State& st) {
   for (auto _ : st) {
     const std::uint64_t seq = ++x.raw_seq;
     x.raw->write(Ping, seq, x.payload);
+    x.raw->flush();
     bool back = false;
-    if (!spin(
+    if (!wait_for(
             st,
             [&] {
               x.raw->take([&](std::uint8_t kind, std::uint64_t s) { back |= kind == Pong && s == seq; });
             },
-            [&] { return back; }))
+            [&] { return back; }, [&] { x.raw->wait(20ms); }))
       break;
   }
   st.counters["payload_bytes"] = static_cast<double>(x.payload.size());
@@ -238,9 +284,7 @@ void BM_DistChangesPerSecond(benchmark::State& st) {
       x.p->publish();
     }
     const int want = x.arm.counter();
-    if (!spin(
-            st, [&] { x.p->poll(); }, [&] { return x.arm.ack() == want; }))
-      break;
+    if (!wait_for(st, *x.p, [&] { return x.arm.ack() == want; })) break;
   }
   st.SetItemsProcessed(static_cast<std::int64_t>(st.iterations()) * ack_every);
 }
@@ -250,12 +294,15 @@ void BM_RawDdsSamplesPerSecond(benchmark::State& st) {
   for (auto _ : st) {
     x.raw_seq = x.raw_seq / ack_every * ack_every;  // the batch ends on a multiple of ack_every
     for (int i = 0; i < ack_every; ++i) x.raw->write(Data, ++x.raw_seq, x.payload);
+    x.raw->flush();  // as vsd::dist's poll_until() does before it waits
     const std::uint64_t want = x.raw_seq;
     bool acked = false;
     auto take = [&] {
       x.raw->take([&](std::uint8_t kind, std::uint64_t s) { acked |= kind == Ack && s == want; });
     };
-    if (!spin(st, take, [&] { return acked; })) break;
+    if (!wait_for(
+            st, take, [&] { return acked; }, [&] { x.raw->wait(20ms); }))
+      break;
   }
   st.SetItemsProcessed(static_cast<std::int64_t>(st.iterations()) * ack_every);
 }
@@ -269,9 +316,7 @@ void BM_DistChangesPerSecondBatched(benchmark::State& st) {
       x.p->publish();
     }
     const int want = x.arm.counter();
-    if (!spin(
-            st, [&] { x.p->poll(); }, [&] { return x.arm.ack() == want; }))
-      break;
+    if (!wait_for(st, *x.p, [&] { return x.arm.ack() == want; })) break;
   }
   st.SetItemsProcessed(static_cast<std::int64_t>(st.iterations()) * ack_every);
 }
@@ -296,14 +341,14 @@ void BM_DistRoundTripInProcess(benchmark::State& st) {
     const double v = x.arm.ping() + 1;
     x.arm.set_ping(v);
     x.p->publish();
+    x.p->flush();
     if (!spin(
             st, [&] { pb.poll(); }, [&] { return b->ping() == v; }))
       break;
     b->set_pong(v);
     pb.publish();
-    if (!spin(
-            st, [&] { x.p->poll(); }, [&] { return x.arm.pong() == v; }))
-      break;
+    pb.flush();
+    if (!wait_for(st, *x.p, [&] { return x.arm.pong() == v; })) break;
   }
 }
 
@@ -317,12 +362,14 @@ void BM_RawDdsRoundTripInProcess(benchmark::State& st) {
   for (auto _ : st) {
     const std::uint64_t seq = ++x.raw_seq;
     x.raw->write(Data, seq, payload);  // Data: the peer process acks only multiples of 1000, never these
+    x.raw->flush();
     bool got = false;
     if (!spin(
             st, [&] { echo.take([&](std::uint8_t k, std::uint64_t s) { got |= k == Data && s == seq; }); },
             [&] { return got; }))
       break;
     echo.write(Pong, seq, payload);
+    echo.flush();
     bool back = false;
     if (!spin(
             st, [&] { x.raw->take([&](std::uint8_t k, std::uint64_t s) { back |= k == Pong && s == seq; }); },

@@ -18,11 +18,15 @@
 #include <utility>
 #include <vector>
 
+#include "sequence.hpp"
 #include "vsd/core/bytes.hpp"
 #include "vsd/core/detail/tx_codec.hpp"
 #include "vsd/core/environment.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/core/meta_instance.hpp"
+#include "vsd/core/node.hpp"
+#include "vsd/core/reference.hpp"
+#include "vsd/core/registry.hpp"
 #include "vsd/core/sim_state.hpp"
 #include "vsd/dist/wire.hpp"
 #include "vsd_dist.h"
@@ -35,7 +39,7 @@ namespace {
 
 enum class Kind : std::uint8_t { Bundle = 1, Claim = 2, Request = 3, Snapshot = 4, Report = 5 };
 constexpr std::uint8_t envelope_magic[4] = {'V', 'S', 'D', 'D'};
-constexpr std::uint8_t envelope_version = 1;
+constexpr std::uint8_t envelope_version = 2;  // 2: element-form list edits, list sequences in snapshots
 constexpr std::size_t envelope_size = 5;
 
 void write_envelope(std::vector<std::uint8_t>& out) {
@@ -102,6 +106,37 @@ struct Message {
 };
 
 using OwnerKey = std::pair<Id, std::string>;  // property "" is the instance itself
+using ListKey = std::pair<Id, std::string>;   // (holder, list property)
+
+// The newest entry of a node in a children list.
+struct Top {
+  ElementId element;
+  Id holder = null_id;
+};
+
+// A node's children list: a node has one parent, so concurrent moves of one child are arbitrated.
+bool is_children(std::string_view property) { return property == Node::vsd_prop_children().name(); }
+
+// The ids in the reference list @p prop of @p holder (empty when either does not exist here).
+std::vector<Id> list_ids(const SimState& state, Id holder, std::string_view prop) {
+  std::vector<Id> ids;
+  const SimStateInstance* x = state.find(holder);
+  if (x == nullptr) return ids;
+  const MetaProperty* p = x->meta().find_property(prop);
+  if (p == nullptr || !p->type().is_ref_list()) return ids;
+  const auto& list = *static_cast<const RefListBase*>(p->address(*x));
+  ids.reserve(list.size());
+  for (std::size_t i = 0; i < list.size(); ++i) ids.push_back(list.at(i)->id());
+  return ids;
+}
+
+// The ids of a reference list's binary form (varint count, varint ids).
+std::vector<Id> ids_of_list_value(std::span<const std::uint8_t> value) {
+  ByteReader r(value.data(), value.size());
+  std::vector<Id> ids(r.size_prefix(1));
+  for (Id& i : ids) i = r.varint();
+  return ids;
+}
 
 // The total order of bundles and claims: the sender's Lamport clock, then its id. Every replica compares
 // the same two numbers, so every replica decides a race alike.
@@ -111,6 +146,22 @@ struct Stamp {
   auto operator<=>(const Stamp&) const = default;
 };
 constexpr Stamp no_limit{~std::uint64_t{0}, ~std::uint64_t{0}};
+
+// A change of another participant that lost here: to a later write, a deletion, a newer move.
+struct Lost {
+  Id instance;
+  std::string property;
+  Stamp winner;
+  Id target;            // the instance a reference or list entry referred to (or null_id)
+  std::uint64_t loser;  // the participant whose change lost
+};
+
+// One operation of a bundle, for the ownership check.
+struct OpRef {
+  Transaction::Op op;
+  Id id;
+  std::string_view name;
+};
 
 // The stamp of the last set of one property that was applied (a last-writer-wins register's stamp).
 struct Written {
@@ -157,10 +208,26 @@ struct Participant::Impl {
   // Instances deleted, with the stamp of the deletion: a change to one of them made concurrently with the
   // deletion is dropped by every replica (the deletion wins), whatever the arrival order.
   std::unordered_map<Id, Stamp> deleted;
+  // When each tombstone was made here, oldest first: pruned after ParticipantOptions::tombstone_horizon.
+  std::deque<std::pair<std::chrono::steady_clock::time_point, Id>> deletion_order;
+  std::chrono::steady_clock::time_point last_prune{};
+  // Every reference list edited through vsd::dist since it was created or joined: a replicated sequence
+  // whose visible entries are the list here (docs/dist.md, "Reference lists"). Lists nobody edited have
+  // none; their value is the same everywhere.
+  std::map<ListKey, internal::Sequence> lists;
+  // Per node: the newest entry of it in any children list (holder, entry). A node has one parent: of two
+  // concurrent moves, the newer entry wins and the other is removed (docs/dist.md).
+  std::unordered_map<Id, Top> top_child;
   std::uint64_t prefer = 0;  // the participant a resynchronisation asks first (0: anyone)
   std::unordered_map<std::uint64_t, std::string> names;
   std::deque<Message> buffer;  // bundles and claims received while unsynchronised
-  std::uint64_t nonce = 0;     // of my pending snapshot request
+  // Bundles (and the ones after them, per sender) that edit a list entry made by a bundle of a third
+  // participant that has not arrived yet: they wait for it (bundles are not delivered in causal order).
+  std::map<std::uint64_t, std::deque<Message>> waiting;
+  std::chrono::steady_clock::time_point waiting_since{};
+  bool replaying = false;
+  std::unordered_map<std::uint64_t, std::uint64_t> last_clock;  // sender -> clock of its last bundle applied
+  std::uint64_t nonce = 0;                                      // of my pending snapshot request
   std::chrono::steady_clock::time_point last_request{};
   ParticipantStats stats;
   Signal<void(const Conflict&)> conflict_signal;
@@ -240,6 +307,12 @@ struct Participant::Impl {
     if (rc < 0) dds_fail("dds_write (is a participant stuck?)", rc);
   }
 
+  // Sends what the writer holds back: with Cyclone's write batching (Internal/WriteBatch) samples wait in
+  // the writer until a datagram is full or this is called; without it, this costs next to nothing.
+  void flush() const noexcept {
+    if (writer > 0) dds_write_flush(writer);
+  }
+
   std::size_t peers() const {
     dds_publication_matched_status_t st{};
     if (dds_get_publication_matched_status(writer, &st) < 0) return 0;
@@ -277,12 +350,18 @@ struct Participant::Impl {
     return key_owner(inst, {}, limit);
   }
   std::uint64_t owner_of(Id inst, std::string_view prop) const { return owner_at(inst, prop, no_limit); }
-  // The first operation of @p t that touches what someone other than @p writer owns as of @p stamp.
-  std::optional<Conflict> find_conflict(const Transaction& t, std::uint64_t writer,
+  // The operations of @p t, for find_conflict().
+  static std::vector<OpRef> ops_of(const Transaction& t) {
+    std::vector<OpRef> ops;
+    detail::TxParser parser(t);
+    for (detail::TxOp op; parser.next(op);) ops.push_back({op.op, op.id, op.name});
+    return ops;
+  }
+  // The first of @p ops that touches what someone other than @p writer owns as of @p stamp.
+  std::optional<Conflict> find_conflict(const std::vector<OpRef>& ops, std::uint64_t writer,
                                         const Stamp& stamp = no_limit) const {
     if (claims.empty()) return std::nullopt;
-    detail::TxParser parser(t);
-    for (detail::TxOp op; parser.next(op);) {
+    for (const OpRef& op : ops) {
       Conflict c;
       c.writer = writer;
       c.instance = op.id;
@@ -311,8 +390,13 @@ struct Participant::Impl {
   }
   void forget_deleted(const std::vector<Id>& ids, const Stamp& stamp) {
     for (const Id gone : ids) {
-      deleted.emplace(gone, stamp);
+      if (deleted.emplace(gone, stamp).second)
+        deletion_order.emplace_back(std::chrono::steady_clock::now(), gone);
       written.erase(gone);
+      top_child.erase(gone);
+      for (auto it = lists.lower_bound(ListKey(gone, std::string()));
+           it != lists.end() && it->first.first == gone;)
+        it = lists.erase(it);
       if (!claims.empty()) std::erase_if(claims, [&](const auto& e) { return e.first.first == gone; });
     }
   }
@@ -327,8 +411,16 @@ struct Participant::Impl {
                std::to_string(c.seq) + ") lost to the earlier stamped one of " + who(c.owner) +
                "; rolled back";
       case ConflictKind::Deleted:
+        if (c.target != null_id)
+          return "reference by " + who(c.writer) + " from " + what + " to #" + std::to_string(c.target) +
+                 (c.seq != 0 ? " (bundle " + std::to_string(c.seq) + ")" : std::string()) +
+                 " dropped: " + who(c.owner) + " deleted #" + std::to_string(c.target) + " concurrently";
         return "write by " + who(c.writer) + " to " + what + " (bundle " + std::to_string(c.seq) +
                ") dropped: " + who(c.owner) + " deleted #" + std::to_string(c.instance) + " concurrently";
+      case ConflictKind::ConcurrentMove:
+        return "concurrent moves of #" + std::to_string(c.target) + ": the move of " + who(c.writer) +
+               " to " + what + (c.seq != 0 ? " (bundle " + std::to_string(c.seq) + ")" : std::string()) +
+               " lost to the newer one of " + who(c.owner);
       case ConflictKind::Owned:
         break;
     }
@@ -350,52 +442,80 @@ struct Participant::Impl {
       w.string(c.property);
       w.string(opt.name);
       w.u8(static_cast<std::uint8_t>(c.kind));
+      w.varint(c.target);
       send(Kind::Report, 0, 0, p);
     }
     conflict_signal.emit(c);
   }
 
   // ---- sending ----
-  // Replaces the reference-list edits (insert, erase) of @p t by one set per edited list, of its value as
-  // @p t leaves it, after the other operations. Index-based edits of one list made concurrently by two
-  // participants do not commute; whole values do under last-writer-wins (docs/dist.md). The sets carry the
-  // new value as old value too: the wire form drops old values anyway.
-  void lists_as_sets(Transaction& t) const {
+  // Replaces the whole-value sets of reference lists in @p t by erasures of the old entries and insertions
+  // of the new ones: lists merge per entry (docs/dist.md, "Reference lists").
+  void list_sets_as_edits(Transaction& t) const {
     const std::vector<std::uint8_t>& bytes = t.bytes();
-    std::vector<std::pair<Id, std::string_view>> lists;
-    std::vector<std::pair<std::size_t, std::size_t>> keep;  // byte ranges of the other operations
-    detail::TxParser parser(t);
-    std::size_t start = 0;
-    bool other = false;
-    auto close = [&](std::size_t end) {
-      if (other && end > start) keep.emplace_back(start, end);
+    auto is_list_set = [&](const detail::TxOp& op) {
+      if (op.op != Transaction::Op::Set) return false;
+      const SimStateInstance* x = state.find(op.id);
+      const MetaProperty* p = x != nullptr ? x->meta().find_property(op.name) : nullptr;
+      return p != nullptr && p->type().is_ref_list();
     };
-    for (detail::TxOp op; parser.next(op);) {
-      close(op.offset);
-      start = op.offset;
-      other = op.op != Transaction::Op::Insert && op.op != Transaction::Op::Erase;
-      if (!other && std::find(lists.begin(), lists.end(), std::pair(op.id, op.name)) == lists.end())
-        lists.emplace_back(op.id, op.name);
-    }
-    if (lists.empty()) return;
-    close(bytes.size());
+    bool any = false;  // most bundles have none: look without keeping the parse
+    detail::TxParser parser(t);
+    for (detail::TxOp op; !any && parser.next(op);) any = is_list_set(op);
+    if (!any) return;
+    std::vector<detail::TxOp> ops = detail::parse_tx(t);
     std::vector<std::uint8_t> out;
     detail::write_tx_header(out);
-    std::size_t ops = 0;
-    for (const auto& [b, e] : keep) {
-      out.insert(out.end(), bytes.begin() + static_cast<std::ptrdiff_t>(b),
-                 bytes.begin() + static_cast<std::ptrdiff_t>(e));
-      ++ops;
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < ops.size(); ++i) {
+      const detail::TxOp& op = ops[i];
+      if (!is_list_set(op)) {
+        const std::size_t end = i + 1 < ops.size() ? ops[i + 1].offset : bytes.size();
+        out.insert(out.end(), bytes.begin() + static_cast<std::ptrdiff_t>(op.offset),
+                   bytes.begin() + static_cast<std::ptrdiff_t>(end));
+        ++count;
+        continue;
+      }
+      const std::vector<Id> before = ids_of_list_value(op.old_value);
+      const std::vector<Id> after = ids_of_list_value(op.new_value);
+      for (std::size_t k = before.size(); k-- > 0; ++count)
+        detail::write_list(out, Transaction::Op::Erase, op.id, op.name, k, before[k]);
+      for (std::size_t k = 0; k < after.size(); ++k, ++count)
+        detail::write_list(out, Transaction::Op::Insert, op.id, op.name, k, after[k]);
     }
-    for (const auto& [holder, prop] : lists) {
-      const SimStateInstance* x = state.find(holder);
-      if (x == nullptr) continue;  // deleted by the bundle itself
-      const MetaProperty* p = x->meta().find_property(prop);
-      if (p == nullptr) continue;
-      detail::write_set(out, *x, *p, p->address(*x), p->address(*x));
-      ++ops;
+    t = detail::make_transaction(std::move(out), count);
+  }
+
+  // The value each list edited by @p t (and without a sequence yet) had before @p t: the state holds the
+  // value after it, so the edits are undone backwards.
+  std::map<ListKey, std::vector<Id>> lists_before(const Transaction& t) const {
+    struct Edit {
+      bool insert;
+      std::size_t index;
+      Id target;
+    };
+    std::map<ListKey, std::vector<Edit>> edits;
+    detail::TxParser parser(t);
+    for (detail::TxOp op; parser.next(op);) {
+      if (op.op != Transaction::Op::Insert && op.op != Transaction::Op::Erase) continue;
+      ListKey key(op.id, std::string(op.name));
+      if (lists.contains(key)) continue;
+      edits[key].push_back({op.op == Transaction::Op::Insert, op.index, op.target});
     }
-    t = detail::make_transaction(std::move(out), ops);
+    std::map<ListKey, std::vector<Id>> out;
+    for (const auto& [key, es] : edits) {
+      std::vector<Id> v = list_ids(state, key.first, key.second);  // empty when the bundle deleted it
+      for (auto e = es.rbegin(); e != es.rend(); ++e) {
+        const auto at = v.begin() + static_cast<std::ptrdiff_t>(std::min(e->index, v.size()));
+        if (e->insert) {
+          if (at != v.end()) v.erase(at);
+        } else {
+          v.insert(at, e->target);
+        }
+      }
+      out.emplace(key, std::move(v));
+    }
+    return out;
   }
 
   bool publish() {
@@ -407,19 +527,57 @@ struct Participant::Impl {
       log("dropped " + std::to_string(t.size()) + " local changes made while not synchronised");
       return false;
     }
-    if (auto c = find_conflict(t, id)) {
+    if (std::optional<Conflict> c; !claims.empty() && (c = find_conflict(ops_of(t), id))) {
       // Undo the whole bundle here: a write to what another participant owns is never half-applied.
       state.apply(t.inverted());
       (void)state.take_recording();
       report(*c, true);
       return false;
     }
-    WireBundle wb = encode_bundle(t, state);
-    if (wb.list_edits) {
-      // List edits travel as the edited list's new value: a list is one register, like any property.
-      lists_as_sets(t);
-      wb = encode_bundle(t, state);
-    }
+    list_sets_as_edits(t);
+    // List edits travel in element form: each recorded index is turned into the entry it names here, and
+    // the mirror sequences take the edits (the state holds them already).
+    const Stamp next{clock + 1, id};
+    std::uint64_t inserted = 0;
+    std::optional<std::map<ListKey, std::vector<Id>>> before;
+    const ListEncoder to_elements = [&](Transaction::Op op, Id holder, std::string_view prop,
+                                        std::size_t index, Id target) {
+      ListKey key(holder, std::string(prop));
+      auto it = lists.find(key);
+      if (it == lists.end()) {
+        if (!before) before = lists_before(t);
+        auto b = before->find(key);
+        it = lists.emplace(key, internal::Sequence::base(b != before->end() ? b->second : std::vector<Id>{}))
+                 .first;
+      }
+      internal::Sequence& seq_of_list = it->second;
+      ElementEdit e;
+      e.op = op;
+      e.holder = holder;
+      e.property = prop;
+      e.target = target;
+      auto out_of_sync = [&]() {
+        return Error("dist: the entries of #" + std::to_string(holder) + "." + std::string(prop) +
+                     " are out of step with the list (an edit at index " + std::to_string(index) + ")");
+      };
+      if (op == Transaction::Op::Insert) {
+        if (index > 0) {
+          const std::size_t pos = seq_of_list.position(index - 1);
+          if (pos == internal::Sequence::npos) throw out_of_sync();
+          e.origin = seq_of_list.elems[pos].id;
+        }
+        e.element = ElementId{next.clock, next.who, ++inserted};
+        (void)seq_of_list.integrate(e.element, e.origin, target, false);
+        if (is_children(prop)) top_child[target] = Top{e.element, holder};
+      } else {
+        const std::size_t pos = seq_of_list.position(index);
+        if (pos == internal::Sequence::npos || seq_of_list.elems[pos].target != target) throw out_of_sync();
+        e.element = seq_of_list.elems[pos].id;
+        seq_of_list.remove(pos);
+      }
+      return e;
+    };
+    WireBundle wb = encode_bundle(t, state, to_elements);
     if (wb.ops == 0) {
       forget_deleted(wb.deleted, Stamp{clock, id});
       return false;
@@ -503,6 +661,19 @@ struct Participant::Impl {
       w.varint(stamp.clock);
       w.fixed(stamp.who);
     }
+    w.varint(lists.size());
+    for (const auto& [key, sq] : lists) {
+      w.varint(key.first);
+      w.string(key.second);
+      w.varint(sq.elems.size());
+      for (const internal::Element& e : sq.elems) {
+        w.varint(e.id.clock);
+        w.fixed(e.id.who);
+        w.varint(e.id.n);
+        w.varint(e.target);
+        w.u8(e.removed ? 1 : 0);
+      }
+    }
     p.insert(p.end(), wb.bytes.begin(), wb.bytes.end());
     send(Kind::Snapshot, 0, m.sender, p);
     ++stats.snapshots_served;
@@ -519,6 +690,12 @@ struct Participant::Impl {
     synced = false;
     buffer.clear();
     if (pending != nullptr) buffer.push_back(*pending);
+    for (auto& [sender, q] : waiting)  // after the snapshot, in their senders' order
+      for (Message& w : q)
+        if (pending == nullptr || w.sender != pending->sender || w.seq != pending->seq)
+          buffer.push_back(std::move(w));
+    waiting.clear();
+    waiting_since = {};
     nonce = random_id();
     resync_started = std::chrono::steady_clock::now();
     request_snapshot();
@@ -584,6 +761,20 @@ struct Participant::Impl {
       st.clock = r.varint();
       st.who = r.fixed<std::uint64_t>();
     }
+    std::map<ListKey, internal::Sequence> sequences;
+    for (std::size_t n = r.size_prefix(3); n > 0; --n) {
+      const Id holder = r.varint();
+      internal::Sequence& sq = sequences[ListKey(holder, r.string())];
+      sq.elems.resize(r.size_prefix(12));
+      for (internal::Element& e : sq.elems) {
+        e.id.clock = r.varint();
+        e.id.who = r.fixed<std::uint64_t>();
+        e.id.n = r.varint();
+        e.target = r.varint();
+        e.removed = r.u8() != 0;
+        if (e.removed) e.removed_at = std::chrono::steady_clock::now();
+      }
+    }
     if (seqs[id] < seq) {
       // The answering participant has not applied all my bundles yet: installing its state would lose
       // them here. Ask again later.
@@ -629,6 +820,17 @@ struct Participant::Impl {
     claims = std::move(table);
     written = std::move(registers);
     deleted = std::move(tombstones);
+    lists = std::move(sequences);
+    deletion_order.clear();
+    for (const auto& [gone, st] : deleted)
+      deletion_order.emplace_back(std::chrono::steady_clock::now(), gone);
+    top_child.clear();
+    for (const auto& [key, sq] : lists)
+      if (is_children(key.second))
+        for (const internal::Element& e : sq.elems)
+          if (auto [at, fresh] = top_child.try_emplace(e.target, Top{e.id, key.first});
+              !fresh && at->second.element < e.id)
+            at->second = Top{e.id, key.first};
     clock = std::max(clock, their_clock);
     prefer = 0;
     synced = true;
@@ -672,47 +874,221 @@ struct Participant::Impl {
   bool self_diverged = false;
   std::chrono::steady_clock::time_point resync_started{};
 
+  // True when entry @p e was made by a bundle of a participant other than @p sender that is not applied
+  // here yet: its clock is past that participant's last bundle applied here.
+  bool to_come(const ElementId& e, std::uint64_t sender) const {
+    if (e.who == 0 || e.who == sender || e.who == id) return false;
+    auto c = last_clock.find(e.who);
+    return c == last_clock.end() || c->second < e.clock;
+  }
+
+  // Retries the waiting bundles, each sender's in order, until none moves on.
+  void replay_waiting() {
+    replaying = true;
+    for (bool progress = true; progress && synced;) {
+      progress = false;
+      for (auto w = waiting.begin(); w != waiting.end() && synced;) {
+        while (!w->second.empty() && synced) {
+          const Message m = std::move(w->second.front());
+          w->second.pop_front();
+          const std::uint64_t before = applied[m.sender];
+          sequenced(m);
+          if (!synced) {  // it resynchronises: resync() moved the waiting bundles to the buffer
+            replaying = false;
+            return;
+          }
+          if (!w->second.empty() && w->second.front().seq == m.seq) break;  // waits again
+          progress = progress || applied[m.sender] != before;
+        }
+        w = w->second.empty() ? waiting.erase(w) : std::next(w);
+      }
+    }
+    if (waiting.empty()) waiting_since = {};
+    replaying = false;
+  }
+
   // A bundle or claim, in the sender's order.
   void sequenced(const Message& m) {
     if (!synced) {
       buffer.push_back(m);
       return;
     }
+    if (!replaying)
+      if (auto w = waiting.find(m.sender); w != waiting.end() && !w->second.empty()) {
+        w->second.push_back(m);  // behind its sender's waiting bundle
+        return;
+      }
     publish();  // my changes first: the recording must hold only what this participant did
     const Stamp stamp{m.clock, m.sender};
     Transaction t;
     // The sets of this bundle that lost to a later stamped write applied here (last writer wins), and the
     // ones that take the register.
-    struct Lost {
-      Id instance;
-      std::string_view property;
-      Stamp winner;
-    };
     std::vector<Lost> lost;
-    std::vector<Lost> gone;  // changes to instances deleted concurrently (winner: the deletion's stamp)
+    std::vector<Lost> gone;      // changes to instances deleted concurrently (winner: the deletion's stamp)
+    std::vector<Lost> dangling;  // references to, and list entries of, instances deleted concurrently
+    std::vector<Lost> moved;     // children-list entries that lost a race of moves
     std::vector<std::pair<Id, std::string_view>> kept;
     std::vector<Id> deletes;
+    std::vector<OpRef> own;  // the bundle's own kept operations (not those added here): for ownership
+    // The list sequences and newest children entries as the bundle leaves them: committed once it applied.
+    std::map<ListKey, internal::Sequence> touched;
+    std::unordered_map<Id, Top> tops;
+    std::unordered_map<Id, std::string_view> created;  // class names of the instances the bundle creates
+    bool unknown_entry = false;  // an edit names a list entry this participant has not seen
+    bool entry_to_come = false;  // ... one that a bundle not applied yet of a third participant makes
     if (m.kind == Kind::Bundle) {
-      // Decoded before its sequence number counts: a broken message must not make anyone resynchronise.
-      try {
-        t = decode_bundle(m.payload, [&](Transaction::Op op, Id inst, std::string_view prop) {
-          if (auto d = deleted.find(inst); d != deleted.end()) {
-            // The deletion wins, whatever the stamps: every replica ends without the instance. A second
-            // deletion of it is no conflict.
-            if (op != Transaction::Op::Delete &&
-                std::none_of(gone.begin(), gone.end(), [&](const Lost& g) { return g.instance == inst; }))
-              gone.push_back({inst, prop, d->second});
-            return false;
-          }
-          if (op == Transaction::Op::Delete) deletes.push_back(inst);
-          if (op != Transaction::Op::Set) return true;
+      auto existing = [&](const ListKey& key) -> internal::Sequence* {
+        if (auto x = touched.find(key); x != touched.end()) return &x->second;
+        if (auto l = lists.find(key); l != lists.end()) return &touched.emplace(key, l->second).first->second;
+        return nullptr;
+      };
+      auto sequence = [&](Id holder, std::string_view prop) -> internal::Sequence& {
+        ListKey key(holder, std::string(prop));
+        if (internal::Sequence* x = existing(key)) return *x;
+        // Nobody edited this list before: it holds the same value everywhere (docs/dist.md).
+        return touched.emplace(key, internal::Sequence::base(list_ids(state, holder, prop))).first->second;
+      };
+      auto top_of = [&](Id child) -> std::optional<Top> {
+        if (auto x = tops.find(child); x != tops.end()) return x->second;
+        if (auto x = top_child.find(child); x != top_child.end()) return x->second;
+        return std::nullopt;
+      };
+      auto property_here = [&](Id inst, std::string_view prop) -> const MetaProperty* {
+        const MetaInstance* cls = nullptr;
+        if (const SimStateInstance* x = state.find(inst)) {
+          cls = &x->meta();
+        } else if (auto c = created.find(inst); c != created.end()) {
+          cls = state.environment().registry().find_class_exact(c->second);
+        }
+        return cls != nullptr ? cls->find_property(prop) : nullptr;
+      };
+      DecodeHooks hooks;
+      hooks.keep = [&](Transaction::Op op, Id inst, std::string_view prop) {
+        if (auto d = deleted.find(inst); d != deleted.end()) {
+          // The deletion wins, whatever the stamps: every replica ends without the instance. A second
+          // deletion of it is no conflict.
+          if (op != Transaction::Op::Delete &&
+              std::none_of(gone.begin(), gone.end(), [&](const Lost& g) { return g.instance == inst; }))
+            gone.push_back({inst, std::string(prop), d->second, null_id, m.sender});
+          return false;
+        }
+        if (op == Transaction::Op::Delete) deletes.push_back(inst);
+        if (op == Transaction::Op::Set) {
           if (const Stamp* s = written_stamp(inst, prop); s != nullptr && stamp < *s) {
-            lost.push_back({inst, prop, *s});
+            lost.push_back({inst, std::string(prop), *s, null_id, m.sender});
             return false;
           }
           kept.emplace_back(inst, prop);
-          return true;
-        });
+        }
+        if (!claims.empty()) own.push_back({op, inst, prop});
+        return true;
+      };
+      hooks.created = [&](Id inst, std::string_view cls) { created.emplace(inst, cls); };
+      // A reference set to an instance deleted concurrently becomes null: in stamp order the deletion
+      // comes before or after the set, and either way the reference ends null (docs/dist.md).
+      hooks.set_value = [&](Id inst, std::string_view prop,
+                            std::span<const std::uint8_t> v) -> std::span<const std::uint8_t> {
+        static constexpr std::uint8_t null_ref[1] = {0};
+        const MetaProperty* p = property_here(inst, prop);
+        if (p == nullptr || !p->type().is_reference() || p->type().is_ref_list()) return v;
+        ByteReader r(v.data(), v.size());
+        const Id target = r.varint();
+        auto d = deleted.find(target);
+        if (d == deleted.end()) return v;
+        dangling.push_back({inst, std::string(prop), d->second, target, m.sender});
+        return {null_ref, 1};
+      };
+      hooks.list = [&](const ElementEdit& e, std::vector<std::uint8_t>& out, std::size_t& ops) {
+        internal::Sequence& sq = sequence(e.holder, e.property);
+        if (e.op == Transaction::Op::Erase) {
+          const std::size_t pos = sq.find(e.element);
+          if (pos == internal::Sequence::npos || sq.elems[pos].target != e.target) {
+            unknown_entry = true;
+            entry_to_come =
+                entry_to_come || (pos == internal::Sequence::npos && to_come(e.element, m.sender));
+            return;
+          }
+          if (sq.elems[pos].removed) return;  // erased already: twice, a lost move, or its target deleted
+          detail::write_list(out, Transaction::Op::Erase, e.holder, e.property, sq.index_of(pos), e.target);
+          ++ops;
+          sq.remove(pos);
+          return;
+        }
+        const ElementId elem{stamp.clock, stamp.who, e.element.n};
+        if (sq.find(elem) != internal::Sequence::npos) {
+          unknown_entry = true;
+          return;
+        }
+        bool hidden = false;
+        if (auto d = deleted.find(e.target); d != deleted.end()) {
+          hidden = true;  // the deletion wins: the entry is there, removed
+          dangling.push_back({e.holder, std::string(e.property), d->second, e.target, m.sender});
+        } else if (is_children(e.property)) {
+          if (const auto top = top_of(e.target); top && elem < top->element) {
+            hidden = true;  // a newer move of this child won
+            moved.push_back({e.holder, std::string(e.property), Stamp{top->element.clock, top->element.who},
+                             e.target, m.sender});
+          } else {
+            tops[e.target] = Top{elem, e.holder};
+          }
+        }
+        const std::size_t pos = sq.integrate(elem, e.origin, e.target, hidden);
+        if (pos == internal::Sequence::npos) {
+          unknown_entry = true;
+          entry_to_come = entry_to_come || to_come(e.origin, m.sender);
+          return;
+        }
+        if (hidden) return;
+        detail::write_list(out, Transaction::Op::Insert, e.holder, e.property, sq.index_of(pos), e.target);
+        ++ops;
+      };
+      // Entries of a deleted instance that its deleter did not know of (inserted concurrently) go first.
+      hooks.before_delete = [&](Id dead, std::vector<std::uint8_t>& out, std::size_t& ops) {
+        auto sweep = [&](const ListKey& key) {
+          if (key.first == dead) return;  // the instance's own lists go with it
+          internal::Sequence* sq = existing(key);
+          for (std::size_t pos = 0; sq != nullptr && pos < sq->elems.size(); ++pos) {
+            internal::Element& x = sq->elems[pos];
+            if (x.removed || x.target != dead) continue;
+            detail::write_list(out, Transaction::Op::Erase, key.first, key.second, sq->index_of(pos), dead);
+            ++ops;
+            sq->remove(pos);
+            // Its inserter learns it from the deleter, which sees the insertion arrive after its deletion.
+            if (x.id.who != id) dangling.push_back({key.first, key.second, stamp, dead, x.id.who});
+          }
+        };
+        auto holds = [&](const internal::Sequence& sq) {
+          return std::any_of(sq.elems.begin(), sq.elems.end(),
+                             [&](const internal::Element& x) { return !x.removed && x.target == dead; });
+        };
+        std::vector<ListKey> keys;
+        for (const auto& [key, sq] : touched)
+          if (holds(sq)) keys.push_back(key);
+        for (const auto& [key, sq] : lists)
+          if (!touched.contains(key) && holds(sq)) keys.push_back(key);
+        for (const ListKey& key : keys) sweep(key);
+      };
+      // A child moved here whose entry elsewhere is older and still there: that entry lost a race of moves
+      // (its mover had not seen this one) and goes, after the insertion, so the child never has no parent.
+      hooks.finish = [&](std::vector<std::uint8_t>& out, std::size_t& ops) {
+        for (const auto& [child, top] : tops) {
+          auto old = top_child.find(child);
+          if (old == top_child.end() || !(old->second.element < top.element)) continue;
+          internal::Sequence* sq =
+              existing(ListKey(old->second.holder, std::string(Node::vsd_prop_children().name())));
+          const std::size_t pos = sq != nullptr ? sq->find(old->second.element) : internal::Sequence::npos;
+          if (pos == internal::Sequence::npos || sq->elems[pos].removed) continue;
+          detail::write_list(out, Transaction::Op::Erase, old->second.holder,
+                             Node::vsd_prop_children().name(), sq->index_of(pos), child);
+          ++ops;
+          sq->remove(pos);
+          moved.push_back({old->second.holder, std::string(Node::vsd_prop_children().name()), stamp, child,
+                           old->second.element.who});
+        }
+      };
+      // Decoded before its sequence number counts: a broken message must not make anyone resynchronise.
+      try {
+        t = decode_bundle(m.payload, hooks);
       } catch (const Error& e) {
         ++stats.malformed;
         log("rejected bundle " + std::to_string(m.seq) + " of " + who(m.sender) + ": " + e.what());
@@ -747,14 +1123,25 @@ struct Participant::Impl {
       apply_claim(m);
       return;
     }
-    if (auto c = find_conflict(t, m.sender, stamp)) {
+    if (auto c = find_conflict(own, m.sender, stamp)) {
       it->second = m.seq;
       handled(m);
       c->seq = m.seq;
       report(*c, c->owner == id);  // the owner tells the writer
       return;
     }
+    if (unknown_entry && entry_to_come &&
+        (waiting_since == std::chrono::steady_clock::time_point{} ||
+         std::chrono::steady_clock::now() - waiting_since < 10 * opt.request_interval)) {
+      // Wait for the bundle that makes the entry (its sender's stream is behind this one's here).
+      if (waiting_since == std::chrono::steady_clock::time_point{})
+        waiting_since = std::chrono::steady_clock::now();
+      waiting[m.sender].push_front(m);
+      if (!replaying) ++stats.bundles_waited;
+      return;
+    }
     try {
+      if (unknown_entry) throw Error("it edits a list entry unknown here");
       state.apply(t);
     } catch (const Error& e) {
       discard_recording();
@@ -775,11 +1162,15 @@ struct Participant::Impl {
     }
     discard_recording();
     for (const auto& [inst, prop] : kept) note_write(inst, prop, stamp);
+    for (auto& [key, sq] : touched) lists[key] = std::move(sq);
+    for (const auto& [child, top] : tops) top_child[child] = top;
     forget_deleted(deletes, stamp);
     it->second = m.seq;
+    last_clock[m.sender] = m.clock;
     handled(m);
     ++stats.bundles_applied;
     ++applied_now;
+    if (!waiting.empty() && !replaying) replay_waiting();
     for (const Lost& l : lost) {
       // The later stamped write won here, as it does everywhere. Its writer tells the loser (who may see
       // nothing amiss: the winner's set simply overwrote its own).
@@ -804,6 +1195,33 @@ struct Participant::Impl {
       c.instance = g.instance;
       c.property = std::string(g.property);
       report(std::move(c), g.winner.who == id);
+    }
+    for (const Lost& g : dangling) {
+      // A reference set to, or a list entry of, an instance deleted concurrently: null, or removed. The
+      // deleter tells the writer.
+      ++stats.lost_writes;
+      Conflict c;
+      c.kind = ConflictKind::Deleted;
+      c.writer = g.loser;
+      c.owner = g.winner.who;
+      c.seq = g.loser == m.sender ? m.seq : 0;
+      c.instance = g.instance;
+      c.property = g.property;
+      c.target = g.target;
+      report(std::move(c), g.winner.who == id && g.loser == m.sender);
+    }
+    for (const Lost& g : moved) {
+      // Both movers and every other participant see both moves and decide alike: no report sample.
+      ++stats.lost_writes;
+      Conflict c;
+      c.kind = ConflictKind::ConcurrentMove;
+      c.writer = g.loser;
+      c.owner = g.winner.who;
+      c.seq = g.loser == m.sender ? m.seq : 0;
+      c.instance = g.instance;
+      c.property = g.property;
+      c.target = g.target;
+      report(std::move(c), false);
     }
   }
 
@@ -927,10 +1345,11 @@ struct Participant::Impl {
     c.instance = r.varint();
     c.property = r.string();
     names[m.sender] = r.string();
-    if (const std::uint8_t k = r.u8(); k <= static_cast<std::uint8_t>(ConflictKind::Deleted))
+    if (const std::uint8_t k = r.u8(); k <= static_cast<std::uint8_t>(ConflictKind::ConcurrentMove))
       c.kind = static_cast<ConflictKind>(k);
     else
       r.fail("unknown conflict kind " + std::to_string(k));
+    c.target = r.varint();
     if (c.writer == id) {
       report(c, false);
       // My bundle was rejected by the others but applied here: this state has diverged. (A set that lost
@@ -999,6 +1418,24 @@ struct Participant::Impl {
     handle(std::move(m));
   }
 
+  // Tombstones (ids of deleted instances, removed list entries) are there to recognise changes made
+  // concurrently with the deletion or erasure. After the horizon no such change is expected any more: a
+  // participant cut off that long has been dropped (its lease) and resynchronises (docs/dist.md).
+  void prune_tombstones() {
+    if (opt.tombstone_horizon.count() <= 0) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_prune <
+        std::min<std::chrono::milliseconds>(opt.tombstone_horizon / 4, std::chrono::seconds(1)))
+      return;
+    last_prune = now;
+    const auto before = now - opt.tombstone_horizon;
+    while (!deletion_order.empty() && deletion_order.front().first < before) {
+      stats.tombstones_pruned += deleted.erase(deletion_order.front().second);
+      deletion_order.pop_front();
+    }
+    for (auto& [key, sq] : lists) stats.tombstones_pruned += sq.prune(before);
+  }
+
   std::size_t poll() {
     applied_now = 0;
     publish();
@@ -1025,6 +1462,11 @@ struct Participant::Impl {
         request_snapshot();
       }
     }
+    if (!waiting.empty() && synced &&
+        std::chrono::steady_clock::now() - waiting_since >= 10 * opt.request_interval)
+      replay_waiting();  // waited long enough: what still does not apply makes this participant resynchronise
+    prune_tombstones();
+    flush();
     return applied_now;
   }
 
@@ -1064,6 +1506,7 @@ Participant::Participant(SimState& state, ParticipantOptions options)
 }
 
 Participant::~Participant() {
+  impl_->flush();
   if (impl_->state.recording()) (void)impl_->state.stop_recording();
   impl_->close();
 }
@@ -1074,6 +1517,7 @@ SimState& Participant::state() const noexcept { return impl_->state; }
 bool Participant::synced() const noexcept { return impl_->synced; }
 std::size_t Participant::peers() const { return impl_->peers(); }
 bool Participant::publish() { return impl_->publish(); }
+void Participant::flush() { impl_->flush(); }
 std::size_t Participant::poll() { return impl_->poll(); }
 
 bool Participant::poll_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
@@ -1083,7 +1527,9 @@ bool Participant::poll_until(const std::function<bool()>& done, std::chrono::mil
     if (done()) return true;
     const auto now = std::chrono::steady_clock::now();
     if (now >= end) return false;
-    // Wake for data, and at least every 20 ms for snapshot requests and conditions on other threads.
+    // Wake for data, and at least every 20 ms for snapshot requests and conditions on other threads. What
+    // done() published leaves first.
+    impl_->flush();
     impl_->wait_data(std::min(std::chrono::duration_cast<std::chrono::milliseconds>(end - now),
                               std::chrono::milliseconds(20)));
   }

@@ -19,7 +19,23 @@ namespace vsd::dist {
 namespace {
 
 constexpr std::uint8_t wire_magic[4] = {'V', 'S', 'D', 'W'};
-constexpr std::uint8_t wire_version = 1;
+constexpr std::uint8_t wire_version = 2;
+// Wire-only operation codes next to Transaction::Op's: reference-list edits in element form.
+constexpr std::uint8_t element_insert = 6;
+constexpr std::uint8_t element_erase = 7;
+
+void write_element(ByteWriter& w, const ElementId& e) {
+  w.varint(e.clock);
+  w.fixed(e.who);
+  w.varint(e.n);
+}
+ElementId read_element(ByteReader& r) {
+  ElementId e;
+  e.clock = r.varint();
+  e.who = r.fixed<std::uint64_t>();
+  e.n = r.varint();
+  return e;
+}
 
 // Names in order of first use; an operation refers to a name by its index.
 class NameTable {
@@ -39,6 +55,10 @@ class NameTable {
 }  // namespace
 
 WireBundle encode_bundle(const Transaction& t, const SimState& state) {
+  return encode_bundle(t, state, ListEncoder{});
+}
+
+WireBundle encode_bundle(const Transaction& t, const SimState& state, const ListEncoder& lists) {
   const Registry& registry = state.environment().registry();
   const auto ops = detail::parse_tx(t);
   // The class of every instance the bundle creates or deletes: it may be gone from the state by now
@@ -109,12 +129,27 @@ WireBundle encode_bundle(const Transaction& t, const SimState& state) {
           ++out.dropped;
           continue;
         }
+        out.list_edits = true;
+        if (lists) {
+          const ElementEdit e = lists(op.op, op.id, op.name, op.index, op.target);
+          const bool insert = op.op == Transaction::Op::Insert;
+          w.u8(insert ? element_insert : element_erase);
+          w.varint(op.id);
+          w.varint(names.index(op.name));
+          if (insert) {
+            w.varint(e.element.n);  // the element's clock and who are the bundle's stamp
+            write_element(w, e.origin);
+          } else {
+            write_element(w, e.element);
+          }
+          w.varint(op.target);
+          break;
+        }
         w.u8(static_cast<std::uint8_t>(op.op));
         w.varint(op.id);
         w.varint(names.index(op.name));
         w.varint(op.index);
         w.varint(op.target);
-        out.list_edits = true;
         break;
     }
     ++out.ops;
@@ -133,6 +168,13 @@ WireBundle encode_bundle(const Transaction& t, const SimState& state) {
 Transaction decode_bundle(std::span<const std::uint8_t> bytes) { return decode_bundle(bytes, OpFilter{}); }
 
 Transaction decode_bundle(std::span<const std::uint8_t> bytes, const OpFilter& keep) {
+  DecodeHooks hooks;
+  hooks.keep = keep;
+  return decode_bundle(bytes, hooks);
+}
+
+Transaction decode_bundle(std::span<const std::uint8_t> bytes, const DecodeHooks& hooks) {
+  const OpFilter& keep = hooks.keep;
   ByteReader r(bytes.data(), bytes.size());
   try {
     if (bytes.size() < 5 || std::memcmp(bytes.data(), wire_magic, 4) != 0)
@@ -168,22 +210,24 @@ Transaction decode_bundle(std::span<const std::uint8_t> bytes, const OpFilter& k
       const std::uint8_t code = r.u8();
       const Id id = r.varint();
       const std::string_view n = name();
-      switch (static_cast<Transaction::Op>(code)) {
-        case Transaction::Op::Create: {
+      switch (code) {
+        case static_cast<std::uint8_t>(Transaction::Op::Create): {
           const std::size_t count = r.size_prefix(2);
           values.clear();
           for (std::size_t k = 0; k < count; ++k) {
             const std::string_view prop = name();
             values.emplace_back(prop, value());
           }
+          if (hooks.created) hooks.created(id, n);
           detail::write_create(out, id, n, values);
           break;
         }
-        case Transaction::Op::Delete: {
+        case static_cast<std::uint8_t>(Transaction::Op::Delete): {
           if (keep && !keep(Transaction::Op::Delete, id, {})) {
             --kept;
             break;
           }
+          if (hooks.before_delete) hooks.before_delete(id, out, kept);
           ByteWriter w(out);  // the VSDT layout of a deletion (transaction.hpp), without last values
           w.u8(static_cast<std::uint8_t>(Transaction::Op::Delete));
           w.varint(id);
@@ -191,17 +235,18 @@ Transaction decode_bundle(std::span<const std::uint8_t> bytes, const OpFilter& k
           w.varint(0);
           break;
         }
-        case Transaction::Op::Set: {
-          const auto v = value();
+        case static_cast<std::uint8_t>(Transaction::Op::Set): {
+          auto v = value();
           if (keep && !keep(Transaction::Op::Set, id, n)) {
             --kept;
             break;
           }
+          if (hooks.set_value) v = hooks.set_value(id, n, v);
           detail::write_set(out, id, n, v, v);
           break;
         }
-        case Transaction::Op::Insert:
-        case Transaction::Op::Erase: {
+        case static_cast<std::uint8_t>(Transaction::Op::Insert):
+        case static_cast<std::uint8_t>(Transaction::Op::Erase): {
           const std::uint64_t index = r.varint();
           const Id target = r.varint();
           if (keep && !keep(static_cast<Transaction::Op>(code), id, n)) {
@@ -212,11 +257,32 @@ Transaction decode_bundle(std::span<const std::uint8_t> bytes, const OpFilter& k
                              target);
           break;
         }
+        case element_insert:
+        case element_erase: {
+          ElementEdit e;
+          e.holder = id;
+          e.property = n;
+          if (code == element_insert) {
+            e.op = Transaction::Op::Insert;
+            e.element.n = r.varint();
+            e.origin = read_element(r);
+          } else {
+            e.op = Transaction::Op::Erase;
+            e.element = read_element(r);
+          }
+          e.target = r.varint();
+          --kept;  // the hook counts what it writes
+          if (keep && !keep(e.op, id, n)) break;
+          if (!hooks.list) r.fail_at(at, "an element-form list edit needs a list decoder");
+          hooks.list(e, out, kept);
+          break;
+        }
         default:
           r.fail_at(at, "unknown operation code " + std::to_string(code));
       }
     }
     if (!r.at_end()) r.fail(std::to_string(r.remaining()) + " unexpected bytes after the last operation");
+    if (hooks.finish) hooks.finish(out, kept);
     return detail::make_transaction(std::move(out), kept);
   } catch (const Error& e) {
     throw Error(std::string("wire bundle ") + e.what());

@@ -48,20 +48,23 @@ struct RawWriter {
     }
     return false;
   }
-  void send(std::uint64_t sender, std::uint64_t seq, std::uint8_t kind, std::vector<std::uint8_t> payload) {
+  void send(std::uint64_t sender, std::uint64_t seq, std::uint8_t kind, std::vector<std::uint8_t> payload,
+            std::uint64_t clock = 0) {
     vsd_dist_Message m{};
     m.sender = sender;
     m.seq = seq;
+    m.clock = clock;
     m.kind = kind;
     m.payload._buffer = payload.data();
     m.payload._length = static_cast<std::uint32_t>(payload.size());
     m.payload._maximum = m.payload._length;
     ASSERT_GE(dds_write(writer, &m), 0);
+    dds_write_flush(writer);  // the loopback configuration batches writes
   }
 };
 
 std::vector<std::uint8_t> envelope(std::vector<std::uint8_t> body) {
-  body.insert(body.begin(), {'V', 'S', 'D', 'D', 1});
+  body.insert(body.begin(), {'V', 'S', 'D', 'D', 2});
   return body;
 }
 
@@ -89,11 +92,11 @@ TEST_F(FaultTest, ForeignAndMalformedSamplesAreLoggedAndNeverApplied) {
   raw.send(77, 1, 1, {'h', 'e', 'l', 'l', 'o'});                          // no envelope
   raw.send(77, 1, 1, {'V', 'S', 'D', 'D', 9, 0});                         // a future version
   raw.send(77, 1, 42, envelope({}));                                      // unknown kind
-  raw.send(77, 1, 1, envelope({'V', 'S', 'D', 'W', 1, 0, 1, 1, 1, 99}));  // bundle: bad name index
+  raw.send(77, 1, 1, envelope({'V', 'S', 'D', 'W', 2, 0, 1, 1, 1, 99}));  // bundle: bad name index
   raw.send(77, 2, 1, envelope({0xff, 0xff, 0xff}));                       // bundle: garbage
   raw.send(77, 0, 5, envelope({1, 2}));                                   // a truncated report
   // A well-formed bundle that creates an instance of a class nobody has: decodes, cannot apply.
-  std::vector<std::uint8_t> body{'V', 'S', 'D', 'W', 1, 1, 7,  'N', 'o', 'C',
+  std::vector<std::uint8_t> body{'V', 'S', 'D', 'W', 2, 1, 7,  'N', 'o', 'C',
                                  'l', 'a', 's', 's', 1, 1, 99, 0,   0};
   ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return pb.stats().foreign >= 3 && pb.stats().malformed >= 3; }));
   EXPECT_EQ(b.size(), before);
@@ -120,6 +123,83 @@ TEST_F(FaultTest, ForeignAndMalformedSamplesAreLoggedAndNeverApplied) {
   arm->set_target(4.0);  // and the real stream goes on
   ASSERT_TRUE(poll_all(
       {&pa, &pb}, [&] { return b.find<DArm>(arm->id())->target() == 4.0; }, 15s));
+}
+
+// A list edit that names an entry nobody has (a third participant's insertion still on the way, or a
+// broken sender): the receivers resynchronise and say so; the state stays the shared one.
+TEST_F(FaultTest, AnEditOfAnUnknownListEntryResynchronises) {
+  vsd::dist::Participant pa(a, options("a", domain, true, &log_a));
+  vsd::dist::Participant pb(b, options("b", domain, false, &log_b));
+  ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return pb.synced(); }));
+  RawWriter raw(domain);
+  ASSERT_TRUE(raw.wait_matched(2));
+  std::vector<std::uint8_t> body{'V', 'S', 'D', 'W', 2};
+  vsd::ByteWriter w(body);
+  w.varint(1);
+  w.string("tools");
+  w.varint(1);  // one operation: erase entry (5, 0x77, 1) of arm.tools
+  w.u8(7);
+  w.varint(arm->id());
+  w.varint(0);
+  w.varint(5);
+  w.fixed(std::uint64_t{0x77});
+  w.varint(1);
+  w.varint(arm->id());
+  raw.send(80, 1, 1, envelope(body));
+  ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return contains(log_b, "it edits a list entry unknown here"); }))
+      << testing::PrintToString(log_b);
+  ASSERT_TRUE(poll_all(
+      {&pa, &pb}, [&] { return pb.synced() && pa.synced(); }, 15s));
+  arm->set_target(6.0);  // and the real stream goes on
+  ASSERT_TRUE(poll_all(
+      {&pa, &pb}, [&] { return b.find<DArm>(arm->id())->target() == 6.0; }, 15s));
+  std::string diff;
+  EXPECT_TRUE(a.equals(b, &diff)) << diff;
+}
+
+// Bundles are not delivered in causal order: a bundle that inserts after an entry made by a third
+// participant's bundle that has not arrived yet waits for it, and both apply, in order, without a resync.
+TEST_F(FaultTest, AnEditOfAnEntryStillOnTheWayWaitsForIt) {
+  auto& n1 = a.create<vsd::Node>();
+  auto& n2 = a.create<vsd::Node>();
+  a.database().add_child(n1);
+  a.database().add_child(n2);
+  vsd::dist::Participant pa(a, options("a", domain, true, &log_a));
+  vsd::dist::Participant pb(b, options("b", domain, false, &log_b));
+  ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return pb.synced(); }));
+  RawWriter raw(domain);
+  ASSERT_TRUE(raw.wait_matched(2));
+  auto insert = [&](std::uint64_t origin_clock, std::uint64_t origin_who, std::uint64_t origin_n,
+                    vsd::Id target) {
+    std::vector<std::uint8_t> body{'V', 'S', 'D', 'W', 2};
+    vsd::ByteWriter w(body);
+    w.varint(1);
+    w.string("tools");
+    w.varint(1);
+    w.u8(6);  // entry insert: entry number 1 of the bundle, after the origin
+    w.varint(arm->id());
+    w.varint(0);
+    w.varint(1);
+    w.varint(origin_clock);
+    w.fixed(origin_who);
+    w.varint(origin_n);
+    w.varint(target);
+    return envelope(body);
+  };
+  // Participant 0x90 saw 0x91's entry (clock 5) and inserted after it (clock 10); 0x91's bundle comes later.
+  raw.send(0x90, 1, 1, insert(5, 0x91, 1, n2.id()), 10);
+  raw.send(0x91, 1, 1, insert(0, 0, 0, n1.id()), 5);
+  const std::vector<vsd::Id> want{n1.id(), n2.id()};
+  auto tools = [&](vsd::SimState& s) {
+    std::vector<vsd::Id> v;
+    for (vsd::Node* n : s.find<DArm>(arm->id())->tools()) v.push_back(n->id());
+    return v;
+  };
+  ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return tools(a) == want && tools(b) == want; }))
+      << testing::PrintToString(tools(a)) << " " << testing::PrintToString(log_b);
+  EXPECT_GE(pa.stats().bundles_waited, 1u);
+  EXPECT_GE(pb.stats().bundles_waited, 1u);
+  EXPECT_EQ(pa.stats().resyncs + pb.stats().resyncs, 0u);
 }
 
 TEST_F(FaultTest, ADivergedParticipantResynchronisesFromASnapshot) {

@@ -6,8 +6,13 @@
 //                                                   joins, checks that every counter value after its
 //                                                   snapshot arrives once and in order up to N, says "done";
 //                                                   with --die-after it exits abruptly after K values
+//   vsd_dist_peer lister DOMAIN N [--config URI]    joins, inserts N nodes of its own into arm.tools (and
+//                                                   erases entries) while the others do the same, adds a
+//                                                   "finished-<pid>" node, then waits for the seed's "done"
+//                                                   and for two "finished-" nodes, and prints the list
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -97,11 +102,62 @@ int reader(std::uint32_t domain, int n, const std::string& config, int die_after
   return in_order && received == n - at_sync ? 0 : 1;
 }
 
+// One of two processes that edit the same list as the seed at the same time (DistProcesses).
+int lister(std::uint32_t domain, int n, const std::string& config) {
+  const int pid = static_cast<int>(::getpid());
+  vsd::Environment env{static_cast<std::uint16_t>(100 + pid % 1000)};
+  vsd::SimState& s = env.main_state();
+  auto o = vsd_dist_test::options("lister-" + std::to_string(pid), domain);
+  o.config = config;
+  o.log = [](std::string_view l) { std::printf("lister: %.*s\n", static_cast<int>(l.size()), l.data()); };
+  vsd::dist::Participant p(s, o);
+  if (!p.wait_synced(30s)) {
+    std::printf("lister: no snapshot\n");
+    return 1;
+  }
+  DArm* arm = nullptr;
+  for (auto* x : s.database().children())
+    if (auto* a = x->as<DArm>()) arm = a;
+  if (arm == nullptr) {
+    std::printf("lister: no arm in the snapshot\n");
+    return 1;
+  }
+  for (int i = 1; i <= n; ++i) {
+    auto& node = s.create<vsd::Node>();
+    node.set_name(std::to_string(pid) + "-" + std::to_string(i));
+    arm->edit_tools().insert(std::min<std::size_t>(static_cast<std::size_t>(i % 3), arm->tools().size()),
+                             node);
+    if (i % 4 == 0) arm->edit_tools().erase(0);
+    p.poll();
+    std::this_thread::sleep_for(std::chrono::microseconds(200 + (pid % 7) * 100));
+  }
+  auto& marker = s.create<vsd::Node>();
+  marker.set_name("finished-" + std::to_string(pid));
+  s.database().add_child(marker);
+  p.poll();
+  auto finished = [&] {
+    int k = 0;
+    for (auto* x : s.database().children()) k += x->name().rfind("finished-", 0) == 0 ? 1 : 0;
+    return k;
+  };
+  if (!p.poll_until([&] { return s.database().name() == "done" && finished() == 2; }, 60s)) {
+    std::printf("lister: no 'done' from the seed (finished: %d)\n", finished());
+    return 1;
+  }
+  std::string list;
+  for (vsd::Node* x : arm->tools()) list += " " + std::to_string(x->id());
+  std::printf("lister: tools%s\nlister: resyncs %llu, bundles that waited for another's %llu\n", list.c_str(),
+              static_cast<unsigned long long>(p.stats().resyncs),
+              static_cast<unsigned long long>(p.stats().bundles_waited));
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr, "usage: vsd_dist_peer writer|reader DOMAIN N [--config URI] [--die-after K]\n");
+    std::fprintf(stderr,
+                 "usage: vsd_dist_peer writer|reader|lister DOMAIN N [--config URI] [--die-after K]\n");
     return 2;
   }
   const std::string mode = argv[1];
@@ -117,6 +173,7 @@ int main(int argc, char** argv) {
   try {
     if (mode == "writer") return writer(domain, n, config);
     if (mode == "reader") return reader(domain, n, config, die_after);
+    if (mode == "lister") return lister(domain, n, config);
   } catch (const std::exception& e) {
     std::printf("%s: error: %s\n", mode.c_str(), e.what());
     return 1;

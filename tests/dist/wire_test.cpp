@@ -106,14 +106,14 @@ TEST_F(WireTest, MalformedBytesAreErrorsWithTheirPosition) {
   EXPECT_THAT([&] { (void)vsd::dist::decode_bundle(trailing); },
               testing::ThrowsMessage<vsd::Error>(HasSubstr("1 unexpected bytes after the last operation")));
   // A name index past the table.
-  const std::vector<std::uint8_t> bad_name{'V', 'S', 'D', 'W', 1, 1, 4, 'D', 'A', 'r', 'm', 1, 1, 5, 3};
+  const std::vector<std::uint8_t> bad_name{'V', 'S', 'D', 'W', 2, 1, 4, 'D', 'A', 'r', 'm', 1, 1, 5, 3};
   EXPECT_THAT([&] { (void)vsd::dist::decode_bundle(bad_name); },
               testing::ThrowsMessage<vsd::Error>(
                   HasSubstr("byte 14: name index 3 is past the name table (1 names)")));
-  const std::vector<std::uint8_t> bad_code{'V', 'S', 'D', 'W', 1, 1, 4, 'D', 'A', 'r', 'm', 1, 9, 5, 0};
+  const std::vector<std::uint8_t> bad_code{'V', 'S', 'D', 'W', 2, 1, 4, 'D', 'A', 'r', 'm', 1, 9, 5, 0};
   EXPECT_THAT([&] { (void)vsd::dist::decode_bundle(bad_code); },
               testing::ThrowsMessage<vsd::Error>(HasSubstr("byte 12: unknown operation code 9")));
-  const std::vector<std::uint8_t> huge_count{'V', 'S', 'D', 'W', 1, 0, 0x7f};
+  const std::vector<std::uint8_t> huge_count{'V', 'S', 'D', 'W', 2, 0, 0x7f};
   EXPECT_THAT([&] { (void)vsd::dist::decode_bundle(huge_count); },
               testing::ThrowsMessage<vsd::Error>(HasSubstr("exceeds")));
 }
@@ -132,6 +132,55 @@ TEST_F(WireTest, ABundleThatDoesNotFitChangesNothing) {
   EXPECT_THAT([&] { replica.apply(vsd::dist::decode_bundle(wire)); },
               testing::ThrowsMessage<vsd::Error>(HasSubstr("no instance #" + std::to_string(id))));
   EXPECT_EQ(replica.size(), before);
+}
+
+// List edits in element form: the encoder names entries, the decoder's hook turns them back into indices;
+// without a hook, and when cut anywhere, decoding is an error, never a crash.
+TEST_F(WireTest, ElementFormListEditsRoundTripThroughTheHooks) {
+  auto& a = source.create<DArm>();
+  auto& n1 = source.create<vsd::Node>();
+  auto& n2 = source.create<vsd::Node>();
+  source.database().add_child(a);
+  replica.apply(source.snapshot());
+  source.start_recording();
+  a.edit_tools().push_back(n1);
+  a.edit_tools().insert(0, n2);
+  a.edit_tools().erase(1);
+  std::vector<vsd::dist::ElementEdit> seen;
+  const auto wire = vsd::dist::encode_bundle(
+      source.stop_recording(), source,
+      [&](vsd::Transaction::Op op, vsd::Id holder, std::string_view prop, std::size_t index, vsd::Id target) {
+        vsd::dist::ElementEdit e;
+        e.op = op;
+        e.holder = holder;
+        e.property = prop;
+        e.target = target;
+        e.element = vsd::dist::ElementId{7, 9, index + 1};
+        e.origin = vsd::dist::ElementId{0, 0, index};
+        return e;
+      });
+  EXPECT_TRUE(wire.list_edits);
+  EXPECT_THAT(
+      [&] { (void)vsd::dist::decode_bundle(wire.bytes); },
+      testing::ThrowsMessage<vsd::Error>(HasSubstr("an element-form list edit needs a list decoder")));
+  vsd::dist::DecodeHooks hooks;
+  hooks.list = [&](const vsd::dist::ElementEdit& e, std::vector<std::uint8_t>&, std::size_t&) {
+    seen.push_back(e);
+  };
+  (void)vsd::dist::decode_bundle(wire.bytes, hooks);
+  ASSERT_EQ(seen.size(), 3u);
+  EXPECT_EQ(seen[0].op, vsd::Transaction::Op::Insert);
+  EXPECT_EQ(seen[0].target, n1.id());
+  EXPECT_EQ(seen[0].element.n, 1u);  // an insertion's clock and who are the stamp's
+  EXPECT_EQ(seen[0].element.clock, 0u);
+  EXPECT_EQ(seen[1].origin, (vsd::dist::ElementId{0, 0, 0}));  // inserted at the front
+  EXPECT_EQ(seen[2].op, vsd::Transaction::Op::Erase);
+  EXPECT_EQ(seen[2].element, (vsd::dist::ElementId{7, 9, 2}));  // erasures name the whole entry
+  EXPECT_EQ(seen[2].target, n1.id());
+  for (std::size_t cut = 5; cut < wire.bytes.size(); ++cut) {
+    std::vector<std::uint8_t> part(wire.bytes.begin(), wire.bytes.begin() + static_cast<std::ptrdiff_t>(cut));
+    EXPECT_THROW((void)vsd::dist::decode_bundle(part, hooks), vsd::Error) << "cut at " << cut;
+  }
 }
 
 }  // namespace

@@ -74,6 +74,11 @@ struct ParticipantOptions {
   /// @brief The participant's DDS lease: a participant that died without leaving is dropped by the others
   /// after this long (their writers wait for it until then). Keep write_timeout above it.
   std::chrono::milliseconds lease_duration{3000};
+  /// @brief How long a participant keeps the tombstones of deleted instances and erased list entries (to
+  /// recognise changes made concurrently with the deletion); then they are pruned. A change older than
+  /// this that arrives later (a participant cut off that long) does not apply, and its receiver
+  /// resynchronises. Keep it well above lease_duration. 0: keep them for the life of the domain.
+  std::chrono::milliseconds tombstone_horizon{60000};
   /// @brief Receives one line per noteworthy event (rejections, resynchronisation, conflicts). Default:
   /// standard error, prefixed "vsd::dist[name]: ".
   std::function<void(std::string_view line)> log;
@@ -90,8 +95,13 @@ enum class ConflictKind : std::uint8_t {
   /// won everywhere; the other one was rolled back.
   ClaimRace = 2,
   /// A change to an instance (a set or a list edit) was made while another participant deleted it: the
-  /// deletion won everywhere, the change was dropped; the deleter tells the writer (docs/dist.md).
+  /// deletion won everywhere, the change was dropped; the deleter tells the writer (docs/dist.md). Also a
+  /// reference set to, or a list entry of, an instance deleted concurrently (Conflict::target): the
+  /// reference ends null, the entry removed, everywhere.
   Deleted = 3,
+  /// Two participants moved the same node to different parents concurrently: the newer move (the larger
+  /// stamp) won everywhere, the other entry was removed from its children list (docs/dist.md).
+  ConcurrentMove = 4,
 };
 
 /// @brief A write or claim that lost: reported to the loser and the winner (and logged by receivers).
@@ -103,7 +113,10 @@ struct Conflict {
   std::uint64_t seq = 0;  ///< the loser's sequence number of its bundle or claim (0: never sent)
   Id instance = null_id;  ///< the instance touched
   std::string property;   ///< the property touched (empty: the instance itself, a deletion)
-  std::string text;       ///< one line for logs: who, what, whose
+  /// Deleted: the deleted instance a reference or list entry referred to (null_id: @p instance itself was
+  /// deleted); ConcurrentMove: the node moved (@p instance, @p property: the children list it lost)
+  Id target = null_id;
+  std::string text;  ///< one line for logs: who, what, whose
 };
 
 /// @brief Counters, for tests, tools and monitoring.
@@ -120,9 +133,13 @@ struct ParticipantStats {
   std::uint64_t resyncs = 0;           ///< snapshots installed after the first synchronisation
   std::uint64_t snapshots_served = 0;  ///< snapshot requests answered
   std::uint64_t dropped_unsynced = 0;  ///< local bundles dropped because they were made while unsynchronised
-  std::uint64_t lost_writes = 0;  ///< sets and list edits of others dropped here: a concurrent write with a
-                                  ///< later stamp or a concurrent deletion won
+  /// sets and list edits of others dropped here: a concurrent write with a later stamp, a concurrent
+  /// deletion or a newer move won
+  std::uint64_t lost_writes = 0;
   std::uint64_t claims_lost = 0;  ///< claims (anyone's) that lost a race here, this one's included
+  /// bundles that waited for a bundle of a third participant that made a list entry they edit
+  std::uint64_t bundles_waited = 0;
+  std::uint64_t tombstones_pruned = 0;  ///< tombstones dropped after ParticipantOptions::tombstone_horizon
 };
 
 /// @brief One SimState's membership in a distributed model (see the file comment).
@@ -149,11 +166,16 @@ class Participant {
   /// @brief Sends the changes recorded since the last publish as one bundle, if any Distributed change is
   /// among them. A change to what another participant owns is undone here instead (the whole bundle) and
   /// reported (on_conflict, log, and to the owner). While unsynchronised, changes are dropped (counted).
+  /// With Cyclone's write batching (Internal/WriteBatch, on in the shipped loopback configuration) the
+  /// sample waits in the writer until the next poll(), poll_until() or flush() (docs/dist.md).
   /// @return true when a bundle was sent. @throws vsd::Error when the writer stays blocked past
   /// write_timeout.
   bool publish();
+  /// @brief Hands everything published so far to the network now (poll() and poll_until() do it too).
+  void flush();
   /// @brief publish(), then handles everything that arrived: applies bundles and claims in order, answers
-  /// snapshot requests, installs a snapshot. Never blocks. @return the number of bundles applied.
+  /// snapshot requests, installs a snapshot; then flush(). Never blocks. @return the number of bundles
+  /// applied.
   std::size_t poll();
   /// @brief Polls until @p done returns true or @p timeout passes, sleeping on DDS data in between.
   /// @return the last value of @p done.
