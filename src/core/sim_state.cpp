@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 
+#include "vsd/core/detail/state_builder.hpp"
 #include "vsd/core/detail/tx_codec.hpp"
 #include "vsd/core/environment.hpp"
 #include "vsd/core/error.hpp"
@@ -126,6 +127,47 @@ SimStateInstance& SimState::create(const MetaInstance& cls) {
   }
   return inst;
 }
+
+// ---- StateBuilder (loaders) -------------------------------------------------------------------------------
+
+namespace detail {
+
+StateBuilder::StateBuilder(SimState& state) noexcept : state_(state) {
+  ++state_.applying_;
+  ++state_.dispatching_;  // one dispatch for the whole build: see the header
+}
+
+StateBuilder::~StateBuilder() {
+  --state_.applying_;
+  if (--state_.dispatching_ == 0 && !state_.graveyard_.empty()) state_.free_graveyard();
+}
+
+void StateBuilder::check_class(SimState& state, const MetaInstance& cls) { state.check_class(cls); }
+
+void StateBuilder::reserve(const MetaInstance& cls, std::size_t count) {
+  state_.reserve_instances(cls, count);
+}
+
+void StateBuilder::reserve_ids(std::size_t count) { state_.by_id_.reserve(state_.by_id_.size() + count); }
+
+SimStateInstance& StateBuilder::make(const MetaInstance& cls, Id id) { return state_.make(cls, id); }
+
+void StateBuilder::finish_create(SimStateInstance& x) { state_.finish_create(x); }
+
+namespace {
+struct ListAppend : RefListBase {  // the builder's access to a list's editing operation
+  using RefListBase::insert_at;
+};
+}  // namespace
+
+void StateBuilder::append(SimStateInstance& holder, const MetaProperty& p, SimStateInstance& target) {
+  auto& list = *static_cast<RefListBase*>(const_cast<void*>(p.address(holder)));
+  const std::size_t index = list.size();
+  static_cast<ListAppend&>(list).insert_at(index, &target);
+  state_.list_changed(holder, p, index, target, true);
+}
+
+}  // namespace detail
 
 SimStateInstance& SimState::create(std::string_view cls) { return create(env_->registry().get_class(cls)); }
 

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "vsd/core/bytes.hpp"
+#include "vsd/core/detail/state_builder.hpp"
 #include "vsd/core/detail/tx_codec.hpp"
 
 namespace vsd::io::detail {
@@ -306,136 +307,147 @@ LoadReport LoadModel::summary() const {
   return report;
 }
 
-// An upper bound of the size of the bundle that apply() writes (every varint counted at its widest).
-// Reserved at once, a bundle of a million instances is written without the copies and the fresh pages of
-// a vector grown by doubling: the reservation beyond what is written is never touched, so costs nothing.
-std::size_t LoadModel::bundle_bound(bool whole) const {
-  constexpr std::size_t varint_max = 10;
-  constexpr std::size_t frame = 4;
-  std::size_t n = 64;  // the header
-  for (const SavedInstance& x : instances_) {
-    n += 1 + 3 * varint_max + x.entry->cls->name().size();  // create: op, id, class, count
-    for (const SavedValue& v : values_of(x)) {
-      if (v.slot->prop == nullptr) continue;
-      const std::size_t name = varint_max + v.slot->prop->name().size();
-      if (v.slot->prop->type().is_reference()) {  // list inserts, or a set with two small frames
-        n += (std::max<std::size_t>(v.ids_count, 1)) * (1 + 4 * varint_max + name + 2 * frame);
-      } else {
-        n += name + frame + v.size;
-        // The Database's own values are sets, the old value being the state's (a guess: it may grow).
-        if (whole && &x == file_root_) n += 1 + varint_max + name + 2 * frame + 2 * v.size;
-      }
-    }
-  }
-  n += roots_.size() * (1 + 4 * varint_max + varint_max + Node::vsd_prop_children().name().size());
-  return n;
-}
-
-// Builds the bundle that creates the file's instances in @p state, under @p parent (nullptr: the state
-// must be empty and a whole-state file restores its Database's values and children too).
+// Fills @p state with the model: under @p parent, or (nullptr) as the whole of an empty state.
+//
+// What a bundle's dry run used to check is checked here, before the first change: the model itself has
+// been checked by finish() (unique ids, references that name instances of the file of the right class,
+// no null in a list, no composite cycle, the top-level nodes), and what depends on the target state is
+// checked below (each class may live in it, kept ids are free). The build then cannot fail on the
+// file's account; it does what applying the bundle did, in the same order (creates with their values,
+// the Database's own values, references, the top-level nodes attached), so the same signals fire and a
+// recording state records the same changes.
 LoadReport LoadModel::apply(SimState& state, Node* parent) {
-  LoadReport report;
   const bool whole = parent == nullptr;
   if (whole && (state.size() != 1 || !state.database().children().empty()))
     throw Error(std::string(origin_) + ": loading a file as a whole state needs an empty SimState, but '" +
                 state.name() + "' holds " + std::to_string(state.size()) + " instances");
   Environment& env = state.environment();
-  // Ids: kept in an empty state, fresh under a node; the Database of a state file maps to the target's.
-  // A whole-state load keeps every id but the Database's: no map needed.
-  vsd::detail::FlatIdMap<Id> map;
   const SavedInstance* saved_root = file_root_;
-  Id highest = null_id;  // reserved once: each reservation makes the SimStates drop their blocks of ids
+
+  // ---- checks against the state; nothing changes before they pass ----
+  std::vector<std::pair<const MetaInstance*, std::size_t>> per_class;  // instances to make, by class
+  Id highest = null_id;
   for (const SavedInstance& x : instances_) {
+    if (&x == saved_root) continue;  // stands for the target's Database, or for the node loaded under
+    const MetaInstance& cls = *x.entry->cls;
+    if (per_class.empty() || per_class.back().first != &cls) {
+      auto it =
+          std::find_if(per_class.begin(), per_class.end(), [&](const auto& e) { return e.first == &cls; });
+      if (it == per_class.end()) {
+        try {
+          vsd::detail::StateBuilder::check_class(state, cls);
+        } catch (const Error& e) {
+          fail_at(x.offset, "instance #" + std::to_string(x.id) + ": " + e.what());
+        }
+        per_class.emplace_back(&cls, 0);
+      } else {
+        std::rotate(it, it + 1, per_class.end());  // the current class last: files group instances by class
+      }
+    }
+    ++per_class.back().second;
+    if (whole) {
+      // The state is empty but for its Database: a kept id can only clash with the Database's.
+      if (x.id == state.database().id())
+        fail_at(x.offset, "instance #" + std::to_string(x.id) + " already exists in SimState '" +
+                              state.name() + "' (its Database)");
+      if ((x.id >> 48) == env.site())
+        highest = std::max(highest, x.id);  // ids of other sites never meet ours
+    }
+  }
+  // Ids: kept in an empty state (the counter moves past them: reserved once, since each reservation makes
+  // the SimStates drop their blocks of ids), fresh under a node.
+  if (highest != null_id) env.reserve_ids_through(highest);
+
+  // ---- the build ----
+  vsd::detail::StateBuilder build(state);
+  std::size_t creates = 0;
+  for (const auto& [cls, n] : per_class) creates += n;
+  if (creates >= 64) {  // one reservation instead of growing step by step (small loads: not worth it)
+    build.reserve_ids(creates);
+    for (const auto& [cls, n] : per_class) build.reserve(*cls, n);
+  }
+  // made[i]: what instances_[i] became. The file's Database is the target's Database, or the node loaded
+  // under (its children become the node's and references to it point at the node).
+  std::vector<SimStateInstance*> made(instances_.size(), nullptr);
+  for (std::size_t i = 0; i < instances_.size(); ++i) {
+    const SavedInstance& x = instances_[i];
     if (&x == saved_root) {
-      // Loaded under a node, the file's Database *is* that node: its children become the node's, and
-      // references to it point at the node.
-      if (!whole) map.insert(x.id, parent->id());
+      made[i] = whole ? static_cast<SimStateInstance*>(&state.database()) : parent;
       continue;
     }
-    if (whole) {
-      if (state.find(x.id) != nullptr)
-        fail_at(x.offset, "instance #" + std::to_string(x.id) + " already exists");
-      // (Ids of other sites never meet ours.)
-      if ((x.id >> 48) == env.site()) highest = std::max(highest, x.id);
-    } else {
-      map.insert(x.id, env.next_id());
+    SimStateInstance& obj = build.make(*x.entry->cls, whole ? x.id : env.next_id());
+    for (const SavedValue& v : values_of(x)) {
+      if (v.slot->prop == nullptr || !vsd::detail::carried_in_payload(*v.slot->prop)) continue;
+      // Initial values, not changes; checked by the reader, so they read back without fail.
+      ByteReader r(v.data, v.size);
+      v.slot->prop->type().read_bytes(const_cast<void*>(v.slot->prop->address(obj)), r, nullptr);
     }
+    made[i] = &obj;
+    build.finish_create(obj);
   }
-  if (highest != null_id) env.reserve_ids_through(highest);
-  const Id file_database = saved_root != nullptr ? saved_root->id : null_id;
-  auto mapped = [&](Id id) {
-    if (id == null_id) return null_id;
-    if (whole) return id == file_database ? state.database().id() : id;
-    return map.find(id);
+  // A listener may delete what the load made; that is reported (the load stops there), not dereferenced.
+  // (One dispatch spans the build: a deleted instance stays allocated until the builder is done.)
+  auto live = [&](std::size_t i) -> SimStateInstance& {
+    SimStateInstance* x = made[i];
+    if (VSD_UNLIKELY(x->is_being_deleted()))
+      throw Error(std::string(origin_) + ": instance #" + std::to_string(x->id()) +
+                  " was deleted by a listener while the file was loaded into SimState '" + state.name() +
+                  "'; what came before was loaded");
+    return *x;
   };
-
-  std::vector<std::uint8_t> bundle;
-  bundle.reserve(bundle_bound(whole));
-  vsd::detail::write_tx_header(bundle);
-  std::size_t ops = 0;
-  std::vector<vsd::detail::TxValue> values;
-  for (const SavedInstance& x : instances_) {
-    if (&x == saved_root) continue;
-    values.clear();
-    for (const SavedValue& v : values_of(x))
-      if (v.slot->prop != nullptr && vsd::detail::carried_in_payload(*v.slot->prop))
-        values.emplace_back(v.slot->prop->name(), v.bytes());
-    vsd::detail::write_create(bundle, mapped(x.id), x.entry->cls->name(), values);
-    ++ops;
-  }
-  if (saved_root != nullptr && whole) {  // the Database's own values
+  auto index_of = [&](Id id) { return by_id_.find(id) - 1; };  // present: finish() checked
+  if (saved_root != nullptr && whole) {                        // the Database's own values
+    Database& db = state.database();
     for (const SavedValue& v : values_of(*saved_root)) {
       if (v.slot->prop == nullptr || !vsd::detail::carried_in_payload(*v.slot->prop)) continue;
-      std::vector<std::uint8_t> now;
-      ByteWriter w(now);
-      v.slot->prop->type().write_bytes(v.slot->prop->address(state.database()), w);
-      vsd::detail::write_set(bundle, state.database().id(), v.slot->prop->name(), now, v.bytes());
-      ++ops;
+      const MetaProperty& p = *v.slot->prop;
+      Value now(p.type());
+      ByteReader r(v.data, v.size);
+      p.type().read_bytes(now.data(), r, nullptr);
+      p.assign_raw(db, now.data());
     }
   }
-  for (const SavedInstance& x : instances_) {
+  struct One final : RefResolver {  // resolves the one id a single reference's bytes hold
+    SimStateInstance* target = nullptr;
+    SimStateInstance* resolve(Id) const override { return target; }
+  };
+  for (std::size_t i = 0; i < instances_.size(); ++i) {
+    const SavedInstance& x = instances_[i];
     if (&x == saved_root && !whole) continue;  // under a node: the Database's children are roots_
     for (const SavedValue& v : values_of(x)) {
-      if (v.slot->prop == nullptr || !v.slot->prop->type().is_reference() || v.slot->prop->has(Transient))
-        continue;
+      if (v.slot->prop == nullptr || !v.slot->prop->type().is_reference()) continue;
       const MetaProperty& p = *v.slot->prop;
       if (p.type().is_ref_list()) {
-        const auto ids = ids_of(v);
-        for (std::size_t i = 0; i < ids.size(); ++i) {
-          vsd::detail::write_list(bundle, Transaction::Op::Insert, mapped(x.id), p.name(), i, mapped(ids[i]));
-          ++ops;
-        }
+        for (Id id : ids_of(v)) build.append(live(i), p, live(index_of(id)));
       } else if (v.ids_count != 0 && ids_of(v).front() != null_id) {
-        std::vector<std::uint8_t> null_bytes, target;
-        ByteWriter(null_bytes).varint(null_id);
-        ByteWriter(target).varint(mapped(ids_of(v).front()));
-        vsd::detail::write_set(bundle, mapped(x.id), p.name(), null_bytes, target);
-        ++ops;
+        One one;
+        one.target = &live(index_of(ids_of(v).front()));
+        std::vector<std::uint8_t> bytes;
+        ByteWriter(bytes).varint(one.target->id());
+        Value now(p.type());
+        ByteReader r(bytes.data(), bytes.size());
+        p.type().read_bytes(now.data(), r, &one);
+        p.assign_raw(live(i), now.data());
       }
     }
   }
-  // The top-level nodes are attached, except in a whole-state load of a file with a Database: that restores
+  // The top-level nodes are attached, except in a whole-state load of a file with a Database: that restored
   // the Database's own children list above.
   if (!whole || saved_root == nullptr) {
     Node& into = whole ? state.database() : *parent;
-    std::size_t at = into.children().size();
-    for (Id id : roots_) {
-      vsd::detail::write_list(bundle, Transaction::Op::Insert, into.id(), Node::vsd_prop_children().name(),
-                              at++, mapped(id));
-      ++ops;
-    }
-  }
-  try {
-    vsd::detail::apply_checked_values(state, vsd::detail::make_transaction(std::move(bundle), ops));
-  } catch (const Error& e) {
-    throw Error(std::string(origin_) + ": the file does not fit SimState '" + state.name() +
-                "': " + e.what());
+    if (into.is_being_deleted())
+      throw Error(
+          std::string(origin_) + ": node #" + std::to_string(into.id()) +
+          " was deleted by a listener while the file was loaded into it; what came before was loaded");
+    for (Id id : roots_) build.append(into, Node::vsd_prop_children(), live(index_of(id)));
   }
   committed_ = true;
+  LoadReport report;
   report.subtree = kind_ == kind_subtree;
   report.instances = instances_.size() - (saved_root != nullptr ? 1 : 0);
   for (Id id : roots_)
-    if (Node* n = state.find<Node>(mapped(id))) report.roots.push_back(n);
+    if (SimStateInstance* n = made[index_of(id)]; !n->is_being_deleted())
+      report.roots.push_back(n->as<Node>());
   for (const MetaInstance* c : defined_) report.defined_classes.push_back(c->name());
   for (const MetaType* t : defined_types_) report.defined_types.push_back(t->name());
   report.version = version_;

@@ -177,7 +177,6 @@ class LoadModel {
 
  private:
   void check_composite_cycles() const;
-  [[nodiscard]] std::size_t bundle_bound(bool whole) const;
 
   std::deque<std::vector<std::uint8_t>> arena_;  // chunks that are filled, never grown
   [[nodiscard]] const SavedInstance* find(Id id) const {

@@ -37,6 +37,7 @@ namespace vsd {
 class Environment;
 namespace detail {
 class Applier;
+class StateBuilder;
 }  // namespace detail
 
 class SimState : public Instance {
@@ -146,6 +147,7 @@ class SimState : public Instance {
   friend class Database;
   friend struct detail::RefAccess;
   friend class detail::Applier;
+  friend class detail::StateBuilder;
 
   SimStateInstance& make(const MetaInstance& cls, Id id);
   void check_class(const MetaInstance& cls);  // may cls live here? (throws when not)
