@@ -12,13 +12,10 @@
 
 using testing::HasSubstr;
 using vsd_test::build_model;
+using vsd_test::bytes_of;
+using vsd_test::diff_of;
 
 namespace {
-
-std::string diff_of(const vsd::SimState& a, const vsd::SimState& b) {
-  std::string d;
-  return a.equals(b, &d) ? std::string() : d;
-}
 
 std::size_t child_links(const vsd::SimState& s) {
   std::size_t n = 0;
@@ -26,8 +23,6 @@ std::size_t child_links(const vsd::SimState& s) {
     if (const auto* node = x->as<vsd::Node>()) n += node->children().size();
   return n;
 }
-
-std::vector<std::uint8_t> bytes_of(const std::string& text) { return {text.begin(), text.end()}; }
 
 class LoadApply : public testing::TestWithParam<vsd::io::Format> {
  protected:
