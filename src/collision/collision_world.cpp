@@ -47,6 +47,8 @@ struct ShapeEntry {
   Shape shape;
   std::string problem;  // non-empty: degenerate, shape is null
   bool plane = false;
+  // A mesh without vertices (e.g. a URDF loaded without its mesh files): nothing to collide, not an error.
+  bool empty = false;
 };
 
 bool finite(double v) { return std::isfinite(v); }
@@ -89,7 +91,11 @@ ShapeEntry build_shape(const Geometry& g) {
     case GeometryKind::Mesh: {
       const auto& v = g.vertices();
       const auto& f = g.facets();
-      if (v.empty() || f.empty()) return fail("a mesh needs vertices and triangles");
+      if (v.empty()) {
+        e.empty = true;
+        return e;
+      }
+      if (f.empty()) return fail("a mesh needs triangles (its facet list is empty)");
       if (f.size() % 3 != 0) return fail("the facet list is not a multiple of 3 indices");
       if (!g.scale().allFinite() || g.scale().cwiseAbs().minCoeff() <= 0)
         return fail("the mesh scale must be finite and non-zero");
@@ -134,6 +140,7 @@ struct Entry {
   bool plane = false;
   std::uint64_t stamp = 0;  // last sync that updated this entry's pose
   std::string problem;      // non-empty: left out of the broadphase
+  bool empty = false;       // its geometry is a mesh without vertices: skipped, with a warning
 };
 
 struct PairKey {
@@ -153,6 +160,8 @@ struct CollisionWorld::Impl {
   std::vector<Entry*> planes;                 // half-spaces: queried against the tree, not in it
   std::unordered_map<Id, ShapeEntry> shapes;  // by Geometry id, shared by the hulls using it
   std::unordered_set<const Entry*> troubled;  // entries with a problem (left out)
+  std::vector<std::string> warnings;          // each once
+  std::unordered_set<std::string> warned;
 
   // Pending work, by id (an instance may be deleted before the next sync).
   std::vector<Id> moved;               // Node3Ds whose frame changed: hulls at or below move
@@ -232,9 +241,17 @@ struct CollisionWorld::Impl {
     troubled.erase(e);
     e->object.reset();
     e->geometry = 0;
+    e->empty = false;
     Geometry* g = h.geometry().get();
     if (g == nullptr) return;  // no geometry: tracked, but nothing to collide
     const ShapeEntry& s = shape_of(*g);
+    if (s.empty) {
+      // As vsd::physics does: skipped with one warning (the URDF loader warned about the files already).
+      e->empty = true;
+      warn(describe_hull(h) + ": its mesh has no vertices (" + describe_geometry(*g) +
+           "); it does not collide");
+      return;
+    }
     if (s.shape == nullptr) {
       troubled.insert(e);
       e->problem = describe_hull(h) + ": " + s.problem + " (at " + describe_pose(h.world_frame()) + ")";
@@ -252,6 +269,10 @@ struct CollisionWorld::Impl {
       manager.registerObject(e->object.get());
       e->in_manager = true;
     }
+  }
+
+  void warn(std::string text) {
+    if (warned.insert(text).second) warnings.push_back(std::move(text));
   }
 
   void remove(Hull& h) {
@@ -520,6 +541,7 @@ struct CollisionWorld::Impl {
                   " is not in the collision world (role, scope or deleted)");
     Entry& e = *it->second;
     if (!e.problem.empty()) throw Error("collision: " + e.problem);
+    if (e.empty) throw Error("collision: " + describe_hull(h) + ": its mesh has no vertices");
     if (e.object == nullptr) throw Error("collision: " + describe_hull(h) + " has no geometry");
     return e;
   }
@@ -663,5 +685,7 @@ std::size_t CollisionWorld::shape_count() const noexcept {
 }
 std::size_t CollisionWorld::last_moved() const noexcept { return impl_->last_moved; }
 std::vector<std::string> CollisionWorld::problems() const { return impl_->problem_lines(); }
+
+const std::vector<std::string>& CollisionWorld::warnings() const noexcept { return impl_->warnings; }
 
 }  // namespace vsd::collision

@@ -127,6 +127,8 @@ int run_tool(std::span<const std::string_view> args, std::ostream& out, std::ost
     for (const auto& p : world.problems()) err << "warning: left out: " << p << '\n';
     if (world.problems().empty()) err << "warning: " << e.what() << '\n';
   }
+  // Hulls whose mesh has no vertices (not loaded): skipped, not an error.
+  for (const auto& w : world.warnings()) err << "warning: left out: " << w << '\n';
 
   std::vector<scene::Hull*> hulls;
   state.index().for_each(scene::Hull::static_meta(), true, [&](SimStateInstance& i) {
@@ -135,8 +137,8 @@ int run_tool(std::span<const std::string_view> args, std::ostream& out, std::ost
   });
   std::sort(hulls.begin(), hulls.end(),
             [](const scene::Hull* a, const scene::Hull* b) { return a->id() < b->id(); });
-  out << hulls.size() << " hulls, " << world.shape_count() << " shapes, " << world.problems().size()
-      << " left out\n";
+  out << hulls.size() << " hulls, " << world.shape_count() << " shapes, "
+      << world.problems().size() + world.warnings().size() << " left out\n";
   const auto pairs = world.contact_pairs();
   out << pairs.size() << " pairs in contact\n";
   for (const auto& [a, b] : pairs) {

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "vsd/core/error.hpp"
+#include "vsd/core/meta_property.hpp"
 #include "vsd/robotics/hardware_binding.hpp"
 
 namespace vsd::robotics {
@@ -13,6 +14,27 @@ namespace vsd::robotics {
 KinematicTree* JointController::tree() const noexcept {
   NamedModelInstance* o = owner();
   return o != nullptr ? o->find_extension<KinematicTree>() : nullptr;
+}
+
+namespace {
+
+// True when clamping changed any value of @p q (compared with @p before).
+bool clamped(const Model& m, std::vector<double>& q) {
+  const std::vector<double> before = q;
+  m.clamp(q.data());
+  return q != before;
+}
+
+}  // namespace
+
+// Connected by the SimState's robotics tracker (kinematic_tree.cpp), so every way of setting a target
+// clears `done` at once, not only this class's setters.
+void on_controller_changed(SimStateInstance& inst, const MetaProperty& p) {
+  auto& c = static_cast<JointController&>(inst);
+  const std::string_view name = p.name();
+  if (name == "target" || name == "target_pose" || name == "tip" ||
+      (name == "mode" && (c.mode() == ControlMode::Position || c.mode() == ControlMode::Cartesian)))
+    c.set_done(false);
 }
 
 void JointController::stop(std::string why) {
@@ -65,7 +87,7 @@ void JointController::step(double dt) {
                     std::to_string(n));
       if (!trajectory_ || planned_for_ != target() || trajectory_->size() != n) {
         std::vector<double> goal = target();
-        m.clamp(goal.data());
+        set_limited(clamped(m, goal));
         trajectory_ = JointTrajectory::plan(interpolation(), q, goal, vmax, amax);
         planned_for_ = target();
         elapsed_ = 0.0;
@@ -82,7 +104,7 @@ void JointController::step(double dt) {
                     " values; the tree has " + std::to_string(n));
       std::vector<double> before = q;
       for (std::size_t i = 0; i < n; ++i) q[i] += std::clamp(target_velocity()[i], -vmax[i], vmax[i]) * dt;
-      m.clamp(q.data());
+      set_limited(clamped(m, q));
       for (std::size_t i = 0; i < n; ++i) qd[i] = (q[i] - before[i]) / dt;
       break;
     }
@@ -98,6 +120,7 @@ void JointController::step(double dt) {
       e.tail<3>() = aa.angle() * aa.axis();
       if (e.head<3>().norm() <= cartesian_tolerance() && e.tail<3>().norm() <= cartesian_tolerance()) {
         set_done(true);
+        set_limited(false);
         break;
       }
       set_done(false);
@@ -112,7 +135,7 @@ void JointController::step(double dt) {
         scale = std::min(scale, vmax[i] / std::max(std::abs(v[static_cast<Eigen::Index>(i)]), 1e-300));
       std::vector<double> before = q;
       for (std::size_t i = 0; i < n; ++i) q[i] += scale * v[static_cast<Eigen::Index>(i)] * dt;
-      m.clamp(q.data());
+      set_limited(clamped(m, q));
       for (std::size_t i = 0; i < n; ++i) qd[i] = (q[i] - before[i]) / dt;
       break;
     }

@@ -6,11 +6,15 @@
 
 #include "vsd/core/error.hpp"
 #include "vsd/core/sim_state.hpp"
+#include "vsd/robotics/controller.hpp"
 #include "vsd/scene/joint.hpp"
 #include "vsd/scene/link.hpp"
 #include "vsd/scene/scene.hpp"
 
 namespace vsd::robotics {
+
+// Clears a JointController's `done` when it gets a new target (defined in controller.cpp).
+void on_controller_changed(SimStateInstance& inst, const MetaProperty& p);
 
 namespace {
 
@@ -126,6 +130,8 @@ Tracker& tracker(SimState& state) {
           .connect([raw](SimStateInstance& i, const MetaProperty& p) { on_node_changed(*raw, i, p); }));
   t->connections.push_back(
       state.on_property_changed(scene::Joint::static_meta(), true).connect(&on_scene_joint_changed));
+  t->connections.push_back(
+      state.on_property_changed(JointController::static_meta(), true).connect(&on_controller_changed));
   t->connections.push_back(state.on_child_added().connect([raw](vsd::Node&, vsd::Node&) { ++raw->version; }));
   t->connections.push_back(
       state.on_child_removed().connect([raw](vsd::Node&, vsd::Node&) { ++raw->version; }));

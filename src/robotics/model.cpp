@@ -347,15 +347,19 @@ void Model::forward(const double* q, Data& data) const noexcept {
     values[i] = v;
   }
   detail::sincos_batch(values, sines, cosines, n);
-  // The previous fast segment's product (before its perm): rows of columns 0 and 1, column 2, translation.
-  V2 m01[3] = {};
-  double m2[3] = {}, mt[3] = {};
+  // The previous fast segment's product M (before its perm), kept in registers by columns: topC holds
+  // rows 0 and 1 of column C, bot01 row 2 of columns 0 and 1, bot2 = M(2, 2); the translation likewise
+  // (t01, t2). By columns, the step from one segment to the next needs only broadcasts of the new
+  // A = C * Rz(v) (known from the sines and cosines, off the chain) and of the bottom row; arrays
+  // indexed in loops would live in memory instead.
+  V2 top0 = {}, top1 = {}, top2 = {}, bot01 = {}, t01 = {};
+  double bot2 = 0.0, t2 = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     const Segment& s = segments_[i];
     if (s.fast) {
-      // R = P * B * Rz(v) (P: the parent's rotation, identity at the base), column i to column perm[i];
+      // M = P * C * Rz(v) (P: the parent's M, identity at the base), column i to frame column perm[i];
       // t = parent t + P * pre.p over the nonzero components of pre.p. The same products and sums in
-      // the same order as the general form below, so the same results; two columns per SSE2 operation.
+      // the same order as the general form below, so the same results; two rows per SSE2 operation.
       double* r = out[i].rotation.data();  // r[c * 3 + row]
       double* t = out[i].translation.data();
       const V2 cs2 = v2(cosines[i], cosines[i]), sn2 = v2(sines[i], sines[i]);
@@ -364,50 +368,67 @@ void Model::forward(const double* q, Data& data) const noexcept {
       const double* col2 = s.chained ? s.c_col2 : s.b_col2;
       const double* lt = s.chained ? s.c_translation : s.pre.translation.data();
       const unsigned mask = s.chained ? s.c_mask : s.pre_translation_mask;
-      V2 a[3];  // rows of B * Rz(v)'s first two columns; its third column is col2
-      for (int j = 0; j < 3; ++j) a[j] = cs2 * v2(row[j][0], row[j][1]) + sn2 * v2(swp[j][0], swp[j][1]);
-      const std::size_t c0 = s.perm[0] * 3U, c1 = s.perm[1] * 3U, c2 = s.perm[2] * 3U;
+      // Rows of A's first two columns; its third column is col2.
+      const V2 a0 = cs2 * v2(row[0][0], row[0][1]) + sn2 * v2(swp[0][0], swp[0][1]);
+      const V2 a1 = cs2 * v2(row[1][0], row[1][1]) + sn2 * v2(swp[1][0], swp[1][1]);
+      const V2 a2 = cs2 * v2(row[2][0], row[2][1]) + sn2 * v2(swp[2][0], swp[2][1]);
       if (s.parent < 0) {
-        for (int k = 0; k < 3; ++k) {
-          m01[k] = a[k];
-          m2[k] = col2[k];
-          mt[k] = lt[k];
-        }
+        top0 = v2(a0[0], a1[0]);
+        top1 = v2(a0[1], a1[1]);
+        top2 = v2(col2[0], col2[1]);
+        bot01 = a2;
+        bot2 = col2[2];
+        t01 = v2(lt[0], lt[1]);
+        t2 = lt[2];
       } else {
-        double p[9];  // the parent's rotation (column-major), in the chained case in its product's order
-        double tt[3];
-        if (s.chained) {
-          for (int k = 0; k < 3; ++k) {
-            p[k] = m01[k][0];
-            p[3 + k] = m01[k][1];
-            p[6 + k] = m2[k];
-            tt[k] = mt[k];
-          }
-        } else {
-          // Into locals first: r and t could alias the parent's frame as far as the compiler knows.
-          const Frame& pf = out[s.parent];
-          for (int k = 0; k < 9; ++k) p[k] = pf.rotation.data()[k];
-          for (int k = 0; k < 3; ++k) tt[k] = pf.translation[k];
+        if (!s.chained) {
+          // From memory: the parent is not the previous segment, or not in the fast form.
+          const double* p = out[s.parent].rotation.data();
+          const double* pt = out[s.parent].translation.data();
+          top0 = v2(p[0], p[1]);
+          top1 = v2(p[3], p[4]);
+          top2 = v2(p[6], p[7]);
+          bot01 = v2(p[2], p[5]);
+          bot2 = p[8];
+          t01 = v2(pt[0], pt[1]);
+          t2 = pt[2];
         }
+        const double b0 = bot01[0], b1 = bot01[1];
         // The mask is fixed per segment: these branches predict perfectly.
-        for (int c = 0; c < 3; ++c)
-          if ((mask >> c) & 1U)
-            for (int k = 0; k < 3; ++k) tt[k] += p[c * 3 + k] * lt[c];
-        for (int k = 0; k < 3; ++k)
-          m01[k] = v2(p[k], p[k]) * a[0] + v2(p[3 + k], p[3 + k]) * a[1] + v2(p[6 + k], p[6 + k]) * a[2];
-        const V2 top = v2(p[0], p[1]) * v2(col2[0], col2[0]) + v2(p[3], p[4]) * v2(col2[1], col2[1]) +
-                       v2(p[6], p[7]) * v2(col2[2], col2[2]);
-        m2[0] = top[0];
-        m2[1] = top[1];
-        m2[2] = p[2] * col2[0] + p[5] * col2[1] + p[8] * col2[2];
-        for (int k = 0; k < 3; ++k) mt[k] = tt[k];
+        if (mask & 1U) {
+          t01 = t01 + top0 * v2(lt[0], lt[0]);
+          t2 = t2 + b0 * lt[0];
+        }
+        if (mask & 2U) {
+          t01 = t01 + top1 * v2(lt[1], lt[1]);
+          t2 = t2 + b1 * lt[1];
+        }
+        if (mask & 4U) {
+          t01 = t01 + top2 * v2(lt[2], lt[2]);
+          t2 = t2 + bot2 * lt[2];
+        }
+        const V2 n0 = top0 * v2(a0[0], a0[0]) + top1 * v2(a1[0], a1[0]) + top2 * v2(a2[0], a2[0]);
+        const V2 n1 = top0 * v2(a0[1], a0[1]) + top1 * v2(a1[1], a1[1]) + top2 * v2(a2[1], a2[1]);
+        const V2 n2 = top0 * v2(col2[0], col2[0]) + top1 * v2(col2[1], col2[1]) + top2 * v2(col2[2], col2[2]);
+        bot01 = v2(b0, b0) * a0 + v2(b1, b1) * a1 + v2(bot2, bot2) * a2;
+        bot2 = b0 * col2[0] + b1 * col2[1] + bot2 * col2[2];
+        top0 = n0;
+        top1 = n1;
+        top2 = n2;
       }
-      for (int k = 0; k < 3; ++k) {
-        r[c0 + k] = m01[k][0];
-        r[c1 + k] = m01[k][1];
-        r[c2 + k] = m2[k];
-        t[k] = mt[k];
-      }
+      const std::size_t c0 = s.perm[0] * 3U, c1 = s.perm[1] * 3U, c2 = s.perm[2] * 3U;
+      r[c0] = top0[0];
+      r[c0 + 1] = top0[1];
+      r[c0 + 2] = bot01[0];
+      r[c1] = top1[0];
+      r[c1 + 1] = top1[1];
+      r[c1 + 2] = bot01[1];
+      r[c2] = top2[0];
+      r[c2 + 1] = top2[1];
+      r[c2 + 2] = bot2;
+      t[0] = t01[0];
+      t[1] = t01[1];
+      t[2] = t2;
       continue;
     }
     double* r = out[i].rotation.data();  // r[c * 3 + row]

@@ -606,25 +606,80 @@ TEST_F(CollisionTest, ZeroSizeBoxIsReportedWithHullShapeAndPose) {
   EXPECT_NEAR(w.distance(a, bad).distance, std::sqrt(1.5 * 1.5 + 2.5 * 2.5) - 1, 1e-6);
 }
 
-TEST_F(CollisionTest, EmptyAndBrokenMeshesAreReported) {
-  auto& empty = s.create<Geometry>();
-  empty.set_kind(GeometryKind::Mesh);
-  empty.set_source("missing.stl");
-  keep(empty);
-  hull(empty, at(0), "empty");
+TEST_F(CollisionTest, BrokenMeshesAreReported) {
   auto& broken = cube_mesh();
   auto facets = broken.facets();
   facets[4] = 99;
   broken.set_facets(facets);
   hull(broken, at(3), "broken");
+  // Vertices without triangles are degenerate too (unlike a mesh without any vertex: see below).
+  auto& flat = s.create<Geometry>();
+  flat.set_kind(GeometryKind::Mesh);
+  flat.set_vertices({Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0)});
+  keep(flat);
+  hull(flat, at(6), "flat");
   CollisionWorld w(s);
   const std::string msg = update_error(w);
-  EXPECT_NE(msg.find("hull 'empty'"), std::string::npos) << msg;
-  EXPECT_NE(msg.find("mesh missing.stl (not loaded)"), std::string::npos) << msg;
-  EXPECT_NE(msg.find("a mesh needs vertices and triangles"), std::string::npos) << msg;
   EXPECT_NE(msg.find("hull 'broken'"), std::string::npos) << msg;
   EXPECT_NE(msg.find("facet 1 has vertex index 99 out of range (8 vertices)"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("hull 'flat'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("a mesh needs triangles (its facet list is empty)"), std::string::npos) << msg;
   EXPECT_EQ(w.problems().size(), 2u);
+  EXPECT_TRUE(w.warnings().empty());
+}
+
+// Regression: a URDF loaded without its meshes has mesh geometries without vertices. vsd::physics skips
+// them with a warning; the collision world threw on every update(), even when the pair filter excluded
+// them. Now they are skipped with one warning each, consistently with physics.
+TEST_F(CollisionTest, EmptyMeshesAreSkippedWithOneWarning) {
+  auto& empty = s.create<Geometry>();
+  empty.set_kind(GeometryKind::Mesh);
+  empty.set_source("missing.stl");
+  keep(empty);
+  Hull& e = hull(empty, at(0), "empty");
+  Hull& a = hull(box(1, 1, 1), at(0.2), "a");  // overlaps the empty hull's place
+  Hull& b = hull(sphere(0.5), at(0.9), "b");
+  for (const bool filtered : {false, true}) {
+    Options o;
+    if (filtered)  // the filter excludes every pair with the empty hull: still no error
+      o.pair_filter = [&e](const Hull& x, const Hull& y) { return &x != &e && &y != &e; };
+    CollisionWorld w(s, o);
+    for (int i = 0; i < 3; ++i) {
+      ASSERT_NO_THROW(w.update());
+      a.set_frame(at(0.2 + 0.01 * i));  // the world moves: still no error, no new warning
+    }
+    EXPECT_TRUE(w.problems().empty());
+    ASSERT_EQ(w.warnings().size(), 1u);
+    const std::string& warning = w.warnings().front();
+    EXPECT_NE(warning.find("hull 'empty'"), std::string::npos) << warning;
+    EXPECT_NE(warning.find("mesh missing.stl (not loaded)"), std::string::npos) << warning;
+    EXPECT_NE(warning.find("its mesh has no vertices"), std::string::npos) << warning;
+    EXPECT_TRUE(w.contains(e));
+    EXPECT_TRUE(w.in_contact(a, b));  // the others collide as before
+    EXPECT_FALSE(w.in_contact(a, e));
+    EXPECT_EQ(w.contact_pairs().size(), 1u);
+    // A query naming it is a clear error; a ray passes through it.
+    try {
+      (void)w.distance(a, e);
+      ADD_FAILURE() << "distance to an empty mesh did not throw";
+    } catch (const vsd::Error& ex) {
+      EXPECT_NE(std::string(ex.what()).find("hull 'empty'"), std::string::npos) << ex.what();
+      EXPECT_NE(std::string(ex.what()).find("its mesh has no vertices"), std::string::npos) << ex.what();
+    }
+    auto hit = w.ray_cast(Eigen::Vector3d(-5, 0, 0), Eigen::Vector3d::UnitX());
+    ASSERT_TRUE(hit);
+    EXPECT_EQ(hit->hull, &a);
+  }
+  // The mesh arrives (loaded later): the hull collides from the next update on.
+  CollisionWorld w(s);
+  w.update();
+  EXPECT_FALSE(w.in_contact(a, e));
+  const Geometry& cube = cube_mesh();
+  empty.set_vertices(cube.vertices());
+  empty.set_facets(cube.facets());
+  ASSERT_NO_THROW(w.update());
+  EXPECT_TRUE(w.in_contact(a, e));
+  EXPECT_NO_THROW((void)w.distance(a, e));
 }
 
 TEST_F(CollisionTest, NanPosesAreReportedAndRecoverable) {

@@ -151,5 +151,118 @@ TEST(JointController, BadTargetsStopWithAFault) {
   EXPECT_FALSE(lone.fault().empty());
 }
 
+// Regression: `done` used to be cleared only in the controller's next step after a new target, so a
+// supervisor testing it right after commanding saw the previous motion's done.
+TEST(JointController, DoneTurnsFalseAsSoonAsANewTargetIsSet) {
+  Cell c;
+  const std::vector<double> goal{0.2, -0.1, 0.1, -0.5, 0.0, 0.3, 0.0};
+  c.ctrl->set_target(goal);
+  EXPECT_FALSE(c.ctrl->done());  // no step yet
+  c.ctrl->set_mode(ControlMode::Position);
+  c.env.run_for(0.2);
+  EXPECT_FALSE(c.ctrl->done());
+  c.env.run_for(c.ctrl->trajectory_duration());
+  ASSERT_TRUE(c.ctrl->done());
+  // The same target again is no change: still done.
+  c.ctrl->set_target(goal);
+  EXPECT_TRUE(c.ctrl->done());
+  // A new target, set in C++ or through the generic property interface (as SOML++ and replicas do).
+  std::vector<double> next = goal;
+  next[0] = 0.4;
+  c.ctrl->set_target(next);
+  EXPECT_FALSE(c.ctrl->done());
+  c.env.run_for(c.ctrl->trajectory_duration() + 0.1);
+  ASSERT_TRUE(c.ctrl->done());
+  next[1] = 0.1;
+  static_cast<SimStateInstance&>(*c.ctrl).set("target", Value(next));
+  EXPECT_FALSE(c.ctrl->done());
+  c.env.run_for(1.0);
+  ASSERT_TRUE(c.ctrl->done());
+  // Cartesian: a new pose, a new tip, or switching into the mode clears it too.
+  const Model& m = c.tree->model();
+  Model::Data d = m.make_data();
+  m.forward(c.tree->positions(), d);
+  Eigen::Isometry3d pose = m.pose(d, m.find_body("iiwa_link_ee")).isometry();
+  c.ctrl->set_tip("iiwa_link_ee");
+  c.ctrl->set_target_pose(pose);
+  c.ctrl->set_mode(ControlMode::Cartesian);
+  EXPECT_FALSE(c.ctrl->done());
+  c.env.step();
+  ASSERT_TRUE(c.ctrl->done());  // already there
+  pose.translation().z() -= 0.02;
+  c.ctrl->set_target_pose(pose);
+  EXPECT_FALSE(c.ctrl->done());
+  c.env.run_for(1.0);
+  ASSERT_TRUE(c.ctrl->done());
+  c.ctrl->set_tip("iiwa_link_7");
+  EXPECT_FALSE(c.ctrl->done());
+  c.ctrl->set_mode(ControlMode::Idle);
+  c.ctrl->set_done(true);
+  c.ctrl->set_mode(ControlMode::Velocity);  // no target to reach: left alone
+  EXPECT_TRUE(c.ctrl->done());
+  c.ctrl->set_mode(ControlMode::Position);
+  EXPECT_FALSE(c.ctrl->done());
+}
+
+// Regression: Cartesian control clamped at the joint limits silently; `limited` reports it.
+TEST(JointController, LimitedReportsClampingAtTheJointLimits) {
+  Cell c;
+  // Joint 4 (the elbow) sets the shoulder-wrist distance of the iiwa: a pose that needs it beyond its
+  // limit (-2.094 rad) cannot be reached by the other joints.
+  const std::vector<double> start{0.0, 0.5, 0.0, -2.0, 0.0, 0.6, 0.0};
+  std::vector<double> beyond = start;
+  beyond[3] = -2.4;
+  c.tree->set_positions(start);
+  const Model& m = c.tree->model();
+  Model::Data d = m.make_data();
+  const int tip = m.find_body("iiwa_link_ee");
+  m.forward(beyond, d);
+  c.ctrl->set_tip("iiwa_link_ee");
+  c.ctrl->set_target_pose(m.pose(d, tip).isometry());
+  c.ctrl->set_mode(ControlMode::Cartesian);
+  EXPECT_FALSE(c.ctrl->limited());
+  int first_limited = -1;
+  for (int i = 0; i < 2000; ++i) {
+    c.env.step();
+    if (first_limited < 0 && c.ctrl->limited()) first_limited = i;
+  }
+  EXPECT_GT(first_limited, 0);  // not at once: the elbow reaches its limit on the way
+  EXPECT_TRUE(c.ctrl->limited());
+  EXPECT_FALSE(c.ctrl->done());
+  EXPECT_NEAR(c.tree->positions()[3], -2.09439510239, 1e-9);  // held at the limit
+  // A reachable pose: no longer limited, and done.
+  std::vector<double> inside = start;
+  inside[3] = -1.8;
+  m.forward(inside, d);
+  c.ctrl->set_target_pose(m.pose(d, tip).isometry());
+  c.env.run_for(2.0);
+  EXPECT_FALSE(c.ctrl->limited());
+  EXPECT_TRUE(c.ctrl->done());
+
+  // Position: a target outside the limits is planned to the nearest position inside, and reported.
+  std::vector<double> target = inside;
+  target[1] = 3.0;
+  c.ctrl->set_target(target);
+  c.ctrl->set_mode(ControlMode::Position);
+  c.env.step();
+  EXPECT_TRUE(c.ctrl->limited());
+  c.env.run_for(c.ctrl->trajectory_duration());
+  EXPECT_TRUE(c.ctrl->done());
+  EXPECT_NEAR(c.tree->positions()[1], 2.09439510239, 1e-9);
+  target[1] = 1.0;
+  c.ctrl->set_target(target);
+  c.env.step();
+  EXPECT_FALSE(c.ctrl->limited());
+
+  // Velocity: limited while a joint is held at a limit against the command.
+  c.ctrl->set_target_velocity(std::vector<double>{0.0, 5.0, 0.0, 0.0, 0.0, 0.0, 0.0});
+  c.ctrl->set_mode(ControlMode::Velocity);
+  c.env.run_for(0.5);
+  EXPECT_TRUE(c.ctrl->limited());
+  c.ctrl->set_target_velocity(std::vector<double>{0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0});
+  c.env.step();
+  EXPECT_FALSE(c.ctrl->limited());
+}
+
 }  // namespace
 }  // namespace vsd::robotics

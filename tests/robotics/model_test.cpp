@@ -7,6 +7,7 @@
 #include <cmath>
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -407,32 +408,81 @@ TEST(DhChain, BadTablesAreErrors) {
 
 TEST(SinCos, MatchesTheLibrary) {
   std::mt19937_64 rng(5);
-  for (int i = 0; i < 100000; ++i) {
-    const double x = std::uniform_real_distribution<double>(-50, 50)(rng);
+  auto check = [](double x) {
     double s, c;
     robotics::detail::sincos(x, s, c);
-    ASSERT_NEAR(s, std::sin(x), 4e-16) << x;
-    ASSERT_NEAR(c, std::cos(x), 4e-16) << x;
+    ASSERT_NEAR(s, std::sin(x), 3e-16) << x;
+    ASSERT_NEAR(c, std::cos(x), 3e-16) << x;
+  };
+  for (int i = 0; i < 100000; ++i) check(std::uniform_real_distribution<double>(-50, 50)(rng));
+  // The table points k pi/64, the midpoints between them (where the reduction switches) and their
+  // neighbours, and large arguments still below the library fallback.
+  for (int k = -300; k <= 300; ++k) {
+    for (const double x : {k * std::numbers::pi / 64, (k + 0.5) * std::numbers::pi / 64}) {
+      check(x);
+      check(std::nextafter(x, 1e9));
+      check(std::nextafter(x, -1e9));
+    }
   }
-  // The batch form gives the same values, and falls back to the library for large arguments.
-  std::vector<double> xs, ss(1000), cs(1000);
-  for (int i = 0; i < 1000; ++i) xs.push_back(std::uniform_real_distribution<double>(-20, 20)(rng));
-  robotics::detail::sincos_batch(xs.data(), ss.data(), cs.data(), xs.size());
-  for (std::size_t i = 0; i < xs.size(); ++i) {
-    double s1, c1;
-    robotics::detail::sincos(xs[i], s1, c1);
-    ASSERT_EQ(ss[i], s1) << xs[i];
-    ASSERT_EQ(cs[i], c1) << xs[i];
-  }
-  xs[7] = 2e5;
-  robotics::detail::sincos_batch(xs.data(), ss.data(), cs.data(), xs.size());
-  EXPECT_EQ(ss[7], std::sin(2e5));
+  for (const double x : {99999.9, -99999.9, 12345.678, 1e-300, -1e-300}) check(x);
   double s, c;
-  robotics::detail::sincos(1e6, s, c);
-  EXPECT_EQ(s, std::sin(1e6));
   robotics::detail::sincos(0.0, s, c);
   EXPECT_EQ(s, 0.0);
   EXPECT_EQ(c, 1.0);
+  // Exactly at the table's points of symmetry where it matters for fixed joints and zero configurations.
+  robotics::detail::sincos(-0.0, s, c);
+  EXPECT_EQ(s, 0.0);
+  EXPECT_EQ(c, 1.0);
+  // Beyond the range, NaN and infinity: the library's results.
+  robotics::detail::sincos(1e6, s, c);
+  EXPECT_EQ(s, std::sin(1e6));
+  EXPECT_EQ(c, std::cos(1e6));
+  robotics::detail::sincos(std::numeric_limits<double>::quiet_NaN(), s, c);
+  EXPECT_TRUE(std::isnan(s));
+  EXPECT_TRUE(std::isnan(c));
+  robotics::detail::sincos(std::numeric_limits<double>::infinity(), s, c);
+  EXPECT_TRUE(std::isnan(s));
+}
+
+TEST(SinCos, BatchGivesTheScalarResults) {
+  std::mt19937_64 rng(6);
+  // Odd and even lengths (the batch works on pairs and finishes with the scalar form).
+  for (const std::size_t n : {0U, 1U, 7U, 8U, 1000U}) {
+    std::vector<double> xs, ss(n), cs(n);
+    for (std::size_t i = 0; i < n; ++i) xs.push_back(std::uniform_real_distribution<double>(-20, 20)(rng));
+    robotics::detail::sincos_batch(xs.data(), ss.data(), cs.data(), n);
+    for (std::size_t i = 0; i < n; ++i) {
+      double s1, c1;
+      robotics::detail::sincos(xs[i], s1, c1);
+      ASSERT_EQ(ss[i], s1) << xs[i];
+      ASSERT_EQ(cs[i], c1) << xs[i];
+    }
+  }
+  // One value out of range (or NaN) anywhere: the library for it, the same values for the others.
+  std::vector<double> xs, ss(9), cs(9);
+  for (int i = 0; i < 9; ++i) xs.push_back(0.3 * i - 1.0);
+  for (const double bad : {2e5, -2e5, std::numeric_limits<double>::quiet_NaN()}) {
+    for (const std::size_t at : {0U, 3U, 8U}) {
+      std::vector<double> v = xs;
+      v[at] = bad;
+      robotics::detail::sincos_batch(v.data(), ss.data(), cs.data(), v.size());
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        if (i == at) {
+          if (std::isnan(bad)) {
+            EXPECT_TRUE(std::isnan(ss[i]));
+          } else {
+            EXPECT_EQ(ss[i], std::sin(bad));
+            EXPECT_EQ(cs[i], std::cos(bad));
+          }
+          continue;
+        }
+        double s1, c1;
+        robotics::detail::sincos(v[i], s1, c1);
+        EXPECT_EQ(ss[i], s1);
+        EXPECT_EQ(cs[i], c1);
+      }
+    }
+  }
 }
 
 }  // namespace

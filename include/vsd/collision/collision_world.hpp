@@ -16,10 +16,13 @@
  *  afterwards there would be no hull to name.
  *
  *  Degenerate input never reaches FCL or libccd: a hull whose world pose is not finite, or whose
- *  geometry is degenerate (a dimension that is zero, negative or not finite, a mesh without triangles or
- *  with indices out of range), is kept out of the world and listed in problems(); update() then throws
- *  vsd::Error naming those hulls, their shapes and poses, after it has brought every other hull up to
- *  date. Exceptions thrown by FCL itself are caught and reported the same way, with both hulls.
+ *  geometry is degenerate (a dimension that is zero, negative or not finite, a mesh with vertices but
+ *  without triangles or with indices out of range), is kept out of the world and listed in problems();
+ *  update() then throws vsd::Error naming those hulls, their shapes and poses, after it has brought every
+ *  other hull up to date. Exceptions thrown by FCL itself are caught and reported the same way, with both
+ *  hulls. A mesh without any vertex is not degenerate but empty (a URDF loaded without its meshes): its
+ *  hulls are skipped with one warning each in warnings(), as vsd::physics does, and never make update()
+ *  throw; distance() on such a hull throws.
  *
  *  Which hulls: by default the Collision-role hulls (Hull::role) of the whole SimState; Options select
  *  visual hulls too, restrict the world to the subtree below a node, and filter pairs. A Geometry of kind
@@ -148,6 +151,10 @@ class CollisionWorld {
   [[nodiscard]] std::size_t last_moved() const noexcept;
   /// @brief One line per degenerate hull, naming it, its shape and its pose (empty when all are fine).
   [[nodiscard]] std::vector<std::string> problems() const;
+  /// @brief Warnings, each once, in the order they arose: hulls skipped because their mesh has no
+  /// vertices (a URDF loaded without its meshes, or a mesh file that was missing). They do not collide,
+  /// are not problems and do not make update() throw.
+  [[nodiscard]] const std::vector<std::string>& warnings() const noexcept;
 
  private:
   struct Impl;

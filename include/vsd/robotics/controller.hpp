@@ -6,7 +6,8 @@
  *  Targets are properties, so a supervisory control (a SOML++ net, a user interface in another process)
  *  commands the robot by setting them; a changed target replans from where the joints are. Limits: each
  *  joint's velocity and acceleration limits, or the controller's defaults where a joint has none; positions
- *  stay within the joint limits. A target of the wrong size stops the controller with `fault` set.
+ *  stay within the joint limits, and `limited` says when that cut a command or a target short. A target of
+ *  the wrong size stops the controller with `fault` set.
  *
  *  With an active HardwareBinding on the same node the step's result goes to the binding as the command
  *  (the binding writes the measured state into the joints); while the binding holds, the controller does
@@ -54,9 +55,16 @@ class JointController : public vsd::Extension {
   VSD_PROPERTY(double, cartesian_gain, 10.0)
   /// Cartesian mode: done within this position (m) and orientation (rad) error.
   VSD_PROPERTY(double, cartesian_tolerance, 1e-4)
-  /// True once the target is reached (Position, Cartesian). A new target clears it in the next step(),
-  /// not when it is set: a loop "step until done" steps once before testing.
+  /// True once the target is reached (Position, Cartesian). Cleared as soon as a new target is set —
+  /// `target`, `target_pose` or `tip` changes, or `mode` becomes Position or Cartesian — by whatever sets
+  /// it (C++, a SOML++ net, a replica, a file): "wait until done" never sees the previous target's done.
+  /// Setting the same value again is no change and leaves it as it is.
   VSD_PROPERTY(bool, done, true)
+  /// True while the joint limits cut the command short: in Cartesian and Velocity mode the last step
+  /// clamped a joint at its limit (the tip then leaves the straight path and may never reach
+  /// `target_pose`, so `done` may stay false), in Position mode the target lies outside the limits and the
+  /// plan goes to the nearest position within them. False otherwise; a property, so listeners see it.
+  VSD_PROPERTY(bool, limited, false)
   /// Why the controller stopped (empty while fine).
   VSD_PROPERTY(std::string, fault, "")
 

@@ -1,7 +1,12 @@
 /** @file
- *  @brief detail::sincos: sine and cosine of one angle at once, with one range reduction (Cephes'
- *  polynomials, accurate to about 1e-16 for |x| < 1e5; std::sin/std::cos beyond). Forward kinematics
- *  spends most of its time here with the library functions.
+ *  @brief detail::sincos: sine and cosine of one angle at once, with one range reduction to a table of
+ *  128 points (accurate to about 3e-16 for |x| < 1e5; std::sin/std::cos beyond, and for NaN and
+ *  infinities). Forward kinematics spends a large part of its time here with the library functions.
+ *
+ *  x = k * pi/64 + z with |z| <= pi/128; sin(k pi/64) and cos(k pi/64) come from the table (correctly
+ *  rounded, generated with mpmath at 60 digits), sin z and cos z - 1 from short Taylor polynomials (three
+ *  terms each: the next ones are below 1e-20), and the angle-addition formulas put them together. No
+ *  quadrant logic: k modulo 128 indexes the whole circle.
  */
 #pragma once
 
@@ -9,111 +14,203 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 namespace vsd::robotics::detail {
 
+/// sin and cos of k * pi / 64, k = 0..127, correctly rounded.
+inline constexpr double sincos_table[128][2] = {
+    {0.0, 0x1.0000000000000p+0},
+    {0x1.91f65f10dd814p-5, 0x1.ff621e3796d7ep-1},
+    {0x1.917a6bc29b42cp-4, 0x1.fd88da3d12526p-1},
+    {0x1.2c8106e8e613ap-3, 0x1.fa7557f08a517p-1},
+    {0x1.8f8b83c69a60bp-3, 0x1.f6297cff75cb0p-1},
+    {0x1.f19f97b215f1bp-3, 0x1.f0a7efb9230d7p-1},
+    {0x1.294062ed59f06p-2, 0x1.e9f4156c62ddap-1},
+    {0x1.58f9a75ab1fddp-2, 0x1.e212104f686e5p-1},
+    {0x1.87de2a6aea963p-2, 0x1.d906bcf328d46p-1},
+    {0x1.b5d1009e15cc0p-2, 0x1.ced7af43cc773p-1},
+    {0x1.e2b5d3806f63bp-2, 0x1.c38b2f180bdb1p-1},
+    {0x1.073879922ffeep-1, 0x1.b728345196e3ep-1},
+    {0x1.1c73b39ae68c8p-1, 0x1.a9b66290ea1a3p-1},
+    {0x1.30ff7fce17035p-1, 0x1.9b3e047f38741p-1},
+    {0x1.44cf325091dd6p-1, 0x1.8bc806b151741p-1},
+    {0x1.57d69348ceca0p-1, 0x1.7b5df226aafafp-1},
+    {0x1.6a09e667f3bcdp-1, 0x1.6a09e667f3bcdp-1},
+    {0x1.7b5df226aafafp-1, 0x1.57d69348ceca0p-1},
+    {0x1.8bc806b151741p-1, 0x1.44cf325091dd6p-1},
+    {0x1.9b3e047f38741p-1, 0x1.30ff7fce17035p-1},
+    {0x1.a9b66290ea1a3p-1, 0x1.1c73b39ae68c8p-1},
+    {0x1.b728345196e3ep-1, 0x1.073879922ffeep-1},
+    {0x1.c38b2f180bdb1p-1, 0x1.e2b5d3806f63bp-2},
+    {0x1.ced7af43cc773p-1, 0x1.b5d1009e15cc0p-2},
+    {0x1.d906bcf328d46p-1, 0x1.87de2a6aea963p-2},
+    {0x1.e212104f686e5p-1, 0x1.58f9a75ab1fddp-2},
+    {0x1.e9f4156c62ddap-1, 0x1.294062ed59f06p-2},
+    {0x1.f0a7efb9230d7p-1, 0x1.f19f97b215f1bp-3},
+    {0x1.f6297cff75cb0p-1, 0x1.8f8b83c69a60bp-3},
+    {0x1.fa7557f08a517p-1, 0x1.2c8106e8e613ap-3},
+    {0x1.fd88da3d12526p-1, 0x1.917a6bc29b42cp-4},
+    {0x1.ff621e3796d7ep-1, 0x1.91f65f10dd814p-5},
+    {0x1.0000000000000p+0, 0.0},
+    {0x1.ff621e3796d7ep-1, -0x1.91f65f10dd814p-5},
+    {0x1.fd88da3d12526p-1, -0x1.917a6bc29b42cp-4},
+    {0x1.fa7557f08a517p-1, -0x1.2c8106e8e613ap-3},
+    {0x1.f6297cff75cb0p-1, -0x1.8f8b83c69a60bp-3},
+    {0x1.f0a7efb9230d7p-1, -0x1.f19f97b215f1bp-3},
+    {0x1.e9f4156c62ddap-1, -0x1.294062ed59f06p-2},
+    {0x1.e212104f686e5p-1, -0x1.58f9a75ab1fddp-2},
+    {0x1.d906bcf328d46p-1, -0x1.87de2a6aea963p-2},
+    {0x1.ced7af43cc773p-1, -0x1.b5d1009e15cc0p-2},
+    {0x1.c38b2f180bdb1p-1, -0x1.e2b5d3806f63bp-2},
+    {0x1.b728345196e3ep-1, -0x1.073879922ffeep-1},
+    {0x1.a9b66290ea1a3p-1, -0x1.1c73b39ae68c8p-1},
+    {0x1.9b3e047f38741p-1, -0x1.30ff7fce17035p-1},
+    {0x1.8bc806b151741p-1, -0x1.44cf325091dd6p-1},
+    {0x1.7b5df226aafafp-1, -0x1.57d69348ceca0p-1},
+    {0x1.6a09e667f3bcdp-1, -0x1.6a09e667f3bcdp-1},
+    {0x1.57d69348ceca0p-1, -0x1.7b5df226aafafp-1},
+    {0x1.44cf325091dd6p-1, -0x1.8bc806b151741p-1},
+    {0x1.30ff7fce17035p-1, -0x1.9b3e047f38741p-1},
+    {0x1.1c73b39ae68c8p-1, -0x1.a9b66290ea1a3p-1},
+    {0x1.073879922ffeep-1, -0x1.b728345196e3ep-1},
+    {0x1.e2b5d3806f63bp-2, -0x1.c38b2f180bdb1p-1},
+    {0x1.b5d1009e15cc0p-2, -0x1.ced7af43cc773p-1},
+    {0x1.87de2a6aea963p-2, -0x1.d906bcf328d46p-1},
+    {0x1.58f9a75ab1fddp-2, -0x1.e212104f686e5p-1},
+    {0x1.294062ed59f06p-2, -0x1.e9f4156c62ddap-1},
+    {0x1.f19f97b215f1bp-3, -0x1.f0a7efb9230d7p-1},
+    {0x1.8f8b83c69a60bp-3, -0x1.f6297cff75cb0p-1},
+    {0x1.2c8106e8e613ap-3, -0x1.fa7557f08a517p-1},
+    {0x1.917a6bc29b42cp-4, -0x1.fd88da3d12526p-1},
+    {0x1.91f65f10dd814p-5, -0x1.ff621e3796d7ep-1},
+    {0.0, -0x1.0000000000000p+0},
+    {-0x1.91f65f10dd814p-5, -0x1.ff621e3796d7ep-1},
+    {-0x1.917a6bc29b42cp-4, -0x1.fd88da3d12526p-1},
+    {-0x1.2c8106e8e613ap-3, -0x1.fa7557f08a517p-1},
+    {-0x1.8f8b83c69a60bp-3, -0x1.f6297cff75cb0p-1},
+    {-0x1.f19f97b215f1bp-3, -0x1.f0a7efb9230d7p-1},
+    {-0x1.294062ed59f06p-2, -0x1.e9f4156c62ddap-1},
+    {-0x1.58f9a75ab1fddp-2, -0x1.e212104f686e5p-1},
+    {-0x1.87de2a6aea963p-2, -0x1.d906bcf328d46p-1},
+    {-0x1.b5d1009e15cc0p-2, -0x1.ced7af43cc773p-1},
+    {-0x1.e2b5d3806f63bp-2, -0x1.c38b2f180bdb1p-1},
+    {-0x1.073879922ffeep-1, -0x1.b728345196e3ep-1},
+    {-0x1.1c73b39ae68c8p-1, -0x1.a9b66290ea1a3p-1},
+    {-0x1.30ff7fce17035p-1, -0x1.9b3e047f38741p-1},
+    {-0x1.44cf325091dd6p-1, -0x1.8bc806b151741p-1},
+    {-0x1.57d69348ceca0p-1, -0x1.7b5df226aafafp-1},
+    {-0x1.6a09e667f3bcdp-1, -0x1.6a09e667f3bcdp-1},
+    {-0x1.7b5df226aafafp-1, -0x1.57d69348ceca0p-1},
+    {-0x1.8bc806b151741p-1, -0x1.44cf325091dd6p-1},
+    {-0x1.9b3e047f38741p-1, -0x1.30ff7fce17035p-1},
+    {-0x1.a9b66290ea1a3p-1, -0x1.1c73b39ae68c8p-1},
+    {-0x1.b728345196e3ep-1, -0x1.073879922ffeep-1},
+    {-0x1.c38b2f180bdb1p-1, -0x1.e2b5d3806f63bp-2},
+    {-0x1.ced7af43cc773p-1, -0x1.b5d1009e15cc0p-2},
+    {-0x1.d906bcf328d46p-1, -0x1.87de2a6aea963p-2},
+    {-0x1.e212104f686e5p-1, -0x1.58f9a75ab1fddp-2},
+    {-0x1.e9f4156c62ddap-1, -0x1.294062ed59f06p-2},
+    {-0x1.f0a7efb9230d7p-1, -0x1.f19f97b215f1bp-3},
+    {-0x1.f6297cff75cb0p-1, -0x1.8f8b83c69a60bp-3},
+    {-0x1.fa7557f08a517p-1, -0x1.2c8106e8e613ap-3},
+    {-0x1.fd88da3d12526p-1, -0x1.917a6bc29b42cp-4},
+    {-0x1.ff621e3796d7ep-1, -0x1.91f65f10dd814p-5},
+    {-0x1.0000000000000p+0, 0.0},
+    {-0x1.ff621e3796d7ep-1, 0x1.91f65f10dd814p-5},
+    {-0x1.fd88da3d12526p-1, 0x1.917a6bc29b42cp-4},
+    {-0x1.fa7557f08a517p-1, 0x1.2c8106e8e613ap-3},
+    {-0x1.f6297cff75cb0p-1, 0x1.8f8b83c69a60bp-3},
+    {-0x1.f0a7efb9230d7p-1, 0x1.f19f97b215f1bp-3},
+    {-0x1.e9f4156c62ddap-1, 0x1.294062ed59f06p-2},
+    {-0x1.e212104f686e5p-1, 0x1.58f9a75ab1fddp-2},
+    {-0x1.d906bcf328d46p-1, 0x1.87de2a6aea963p-2},
+    {-0x1.ced7af43cc773p-1, 0x1.b5d1009e15cc0p-2},
+    {-0x1.c38b2f180bdb1p-1, 0x1.e2b5d3806f63bp-2},
+    {-0x1.b728345196e3ep-1, 0x1.073879922ffeep-1},
+    {-0x1.a9b66290ea1a3p-1, 0x1.1c73b39ae68c8p-1},
+    {-0x1.9b3e047f38741p-1, 0x1.30ff7fce17035p-1},
+    {-0x1.8bc806b151741p-1, 0x1.44cf325091dd6p-1},
+    {-0x1.7b5df226aafafp-1, 0x1.57d69348ceca0p-1},
+    {-0x1.6a09e667f3bcdp-1, 0x1.6a09e667f3bcdp-1},
+    {-0x1.57d69348ceca0p-1, 0x1.7b5df226aafafp-1},
+    {-0x1.44cf325091dd6p-1, 0x1.8bc806b151741p-1},
+    {-0x1.30ff7fce17035p-1, 0x1.9b3e047f38741p-1},
+    {-0x1.1c73b39ae68c8p-1, 0x1.a9b66290ea1a3p-1},
+    {-0x1.073879922ffeep-1, 0x1.b728345196e3ep-1},
+    {-0x1.e2b5d3806f63bp-2, 0x1.c38b2f180bdb1p-1},
+    {-0x1.b5d1009e15cc0p-2, 0x1.ced7af43cc773p-1},
+    {-0x1.87de2a6aea963p-2, 0x1.d906bcf328d46p-1},
+    {-0x1.58f9a75ab1fddp-2, 0x1.e212104f686e5p-1},
+    {-0x1.294062ed59f06p-2, 0x1.e9f4156c62ddap-1},
+    {-0x1.f19f97b215f1bp-3, 0x1.f0a7efb9230d7p-1},
+    {-0x1.8f8b83c69a60bp-3, 0x1.f6297cff75cb0p-1},
+    {-0x1.2c8106e8e613ap-3, 0x1.fa7557f08a517p-1},
+    {-0x1.917a6bc29b42cp-4, 0x1.fd88da3d12526p-1},
+    {-0x1.91f65f10dd814p-5, 0x1.ff621e3796d7ep-1},
+};
+
+inline constexpr double sincos_64_over_pi = 0x1.45f306dc9c883p+4;
+// pi/64 in two parts: the first has 30 significant bits, so y * hi is exact for |y| < 2^22 (|x| < 1e5).
+inline constexpr double sincos_pi_64_hi = 0x1.921fb54000000p-5;
+inline constexpr double sincos_pi_64_lo = 0x1.10b4611a62633p-35;
+// Adding 1.5 * 2^52 rounds to an integer, which is then in the low bits of the mantissa.
+inline constexpr double sincos_shifter = 0x1.8p52;
+inline constexpr double sincos_limit = 1e5;
+// Taylor coefficients: sin z = z + z^3 (s1 + z^2 (s2 + z^2 s3)), cos z - 1 = z^2 (c1 + z^2 (c2 + z^2 c3)).
+inline constexpr double sincos_s1 = -1.0 / 6.0, sincos_s2 = 1.0 / 120.0, sincos_s3 = -1.0 / 5040.0;
+inline constexpr double sincos_c1 = -0.5, sincos_c2 = 1.0 / 24.0, sincos_c3 = -1.0 / 720.0;
+
 /// @brief Sets @p s = sin(@p x) and @p c = cos(@p x).
 [[gnu::always_inline]] inline void sincos(double x, double& s, double& c) noexcept {
-  double ax = x < 0 ? -x : x;
-  if (!(ax < 1e5)) {  // also NaN
+  if (!(x < sincos_limit && x > -sincos_limit)) {  // also NaN
     s = std::sin(x);
     c = std::cos(x);
     return;
   }
-  // x = z + k * pi/2 with |z| <= pi/4 (pi/4 split in three parts, Cody–Waite).
-  constexpr double four_over_pi = 1.27323954473516268615;
-  constexpr double dp1 = 7.85398125648498535156e-1, dp2 = 3.77489470793079817668e-8,
-                   dp3 = 2.69515142907905952645e-15;
-  // Truncation is floor for 0 <= ax < 1e5, and a plain conversion (std::floor is a library call without
-  // SSE4.1).
-  auto j = static_cast<std::int64_t>(ax * four_over_pi);
-  j += j & 1;  // round up to even: |z| <= pi/4 (no branch)
-  const double y = static_cast<double>(j);
-  const double z = ((ax - y * dp1) - y * dp2) - y * dp3;
+  const double r = x * sincos_64_over_pi + sincos_shifter;
+  const double y = r - sincos_shifter;
+  const auto k = static_cast<std::size_t>(std::bit_cast<std::uint64_t>(r) & 127U);
+  const double z = (x - y * sincos_pi_64_hi) - y * sincos_pi_64_lo;
   const double zz = z * z;
-  const double sp = z + z * zz *
-                            ((((((1.58962301576546568060e-10 * zz - 2.50507477628578072866e-8) * zz +
-                                 2.75573136213857245213e-6) *
-                                    zz -
-                                1.98412698295895385996e-4) *
-                                   zz +
-                               8.33333333332211858878e-3) *
-                                  zz -
-                              1.66666666666666307295e-1));
-  const double cp = 1.0 - 0.5 * zz +
-                    zz * zz *
-                        (((((-1.13585365213876817300e-11 * zz + 2.08757008419747316778e-9) * zz -
-                            2.75573141792967388112e-7) *
-                               zz +
-                           2.48015872888517045348e-5) *
-                              zz -
-                          1.38888888888730564116e-3) *
-                             zz +
-                         4.16666666666665929218e-2);
-  // Quadrant selection without branches (random joint values would mispredict them): swap sine and
-  // cosine in odd quadrants, then fix the signs. Bit masks keep the selected values exact.
-  const auto q = static_cast<std::uint64_t>(j >> 1);
-  const std::uint64_t swap = 0 - (q & 1);  // all ones in quadrants 1 and 3
-  const auto bs = std::bit_cast<std::uint64_t>(sp), bc = std::bit_cast<std::uint64_t>(cp);
-  const double sv = std::bit_cast<double>((bs & ~swap) | (bc & swap));
-  const double cv = std::bit_cast<double>((bc & ~swap) | (bs & swap));
-  const std::uint64_t sign_bit = std::uint64_t{1} << 63;
-  // sin is negative in quadrants 2 and 3 (and for negative x), cos in quadrants 1 and 2.
-  const std::uint64_t s_neg = (((q >> 1) & 1) ^ (x < 0 ? 1u : 0u)) << 63;
-  const std::uint64_t c_neg = (((q + 1) >> 1) & 1) << 63;
-  s = std::bit_cast<double>(std::bit_cast<std::uint64_t>(sv) ^ (s_neg & sign_bit));
-  c = std::bit_cast<double>(std::bit_cast<std::uint64_t>(cv) ^ (c_neg & sign_bit));
+  const double sz = z + (z * zz) * ((sincos_s3 * zz + sincos_s2) * zz + sincos_s1);
+  const double cm1 = zz * ((sincos_c3 * zz + sincos_c2) * zz + sincos_c1);
+  const double st = sincos_table[k][0], ct = sincos_table[k][1];
+  // The table value last: the small corrections are rounded on their own scale.
+  s = st + (st * cm1 + ct * sz);
+  c = ct + (ct * cm1 - st * sz);
 }
 
-}  // namespace vsd::robotics::detail
-
-namespace vsd::robotics::detail {
-
-/// @brief sincos() of @p n values at once: the same results, in a loop without branches that the compiler
-/// vectorises (two angles per SSE2 instruction) when every |x| < 1e5.
+/// @brief sincos() of @p n values: the same results, two angles per SSE2 instruction (GCC and Clang vector
+/// extensions) when every |x| < 1e5; the scalar form otherwise.
 inline void sincos_batch(const double* x, double* s, double* c, std::size_t n) noexcept {
-  bool small = true;
-  for (std::size_t i = 0; i < n; ++i) small &= (x[i] < 1e5) & (x[i] > -1e5);  // false for NaN too
-  if (!small) {
-    for (std::size_t i = 0; i < n; ++i) sincos(x[i], s[i], c[i]);
-    return;
+  std::size_t i = 0;
+#if defined(__GNUC__)
+  using V2 = double __attribute__((vector_size(16)));
+  const V2 zero = {0.0, 0.0};
+  auto ok = zero == zero;  // lanes of all ones
+  for (; i + 2 <= n; i += 2) {
+    V2 xv;
+    std::memcpy(&xv, x + i, sizeof xv);
+    ok &= (xv < sincos_limit) & (xv > -sincos_limit);  // lanes of all ones or zero; zero for NaN
+    const V2 r = xv * sincos_64_over_pi + sincos_shifter;
+    const V2 y = r - sincos_shifter;
+    const V2 z = (xv - y * sincos_pi_64_hi) - y * sincos_pi_64_lo;
+    const V2 zz = z * z;
+    const V2 sz = z + (z * zz) * ((sincos_s3 * zz + sincos_s2) * zz + sincos_s1);
+    const V2 cm1 = zz * ((sincos_c3 * zz + sincos_c2) * zz + sincos_c1);
+    const auto k0 = static_cast<std::size_t>(std::bit_cast<std::uint64_t>(r[0]) & 127U);
+    const auto k1 = static_cast<std::size_t>(std::bit_cast<std::uint64_t>(r[1]) & 127U);
+    const V2 st = {sincos_table[k0][0], sincos_table[k1][0]};
+    const V2 ct = {sincos_table[k0][1], sincos_table[k1][1]};
+    const V2 sv = st + (st * cm1 + ct * sz);
+    const V2 cv = ct + (ct * cm1 - st * sz);
+    std::memcpy(s + i, &sv, sizeof sv);
+    std::memcpy(c + i, &cv, sizeof cv);
   }
-  for (std::size_t i = 0; i < n; ++i) {
-    const double xi = x[i];
-    const double ax = xi < 0 ? -xi : xi;
-    auto j = static_cast<std::int32_t>(ax * 1.27323954473516268615);
-    j += j & 1;
-    const double y = static_cast<double>(j);
-    const double z = ((ax - y * 7.85398125648498535156e-1) - y * 3.77489470793079817668e-8) -
-                     y * 2.69515142907905952645e-15;
-    const double zz = z * z;
-    const double sp = z + z * zz *
-                              ((((((1.58962301576546568060e-10 * zz - 2.50507477628578072866e-8) * zz +
-                                   2.75573136213857245213e-6) *
-                                      zz -
-                                  1.98412698295895385996e-4) *
-                                     zz +
-                                 8.33333333332211858878e-3) *
-                                    zz -
-                                1.66666666666666307295e-1));
-    const double cp = 1.0 - 0.5 * zz +
-                      zz * zz *
-                          (((((-1.13585365213876817300e-11 * zz + 2.08757008419747316778e-9) * zz -
-                              2.75573141792967388112e-7) *
-                                 zz +
-                             2.48015872888517045348e-5) *
-                                zz -
-                            1.38888888888730564116e-3) *
-                               zz +
-                           4.16666666666665929218e-2);
-    const std::int32_t q = j >> 1;
-    const bool swap = (q & 1) != 0;
-    const double sv = swap ? cp : sp;
-    const double cv = swap ? sp : cp;
-    const bool s_neg = ((q & 2) != 0) != (xi < 0);
-    s[i] = s_neg ? -sv : sv;
-    c[i] = ((q + 1) & 2) != 0 ? -cv : cv;
-  }
+  if (!(ok[0] && ok[1])) i = 0;  // a value out of range: redo everything with the scalar form
+#endif
+  for (; i < n; ++i) sincos(x[i], s[i], c[i]);
 }
 
 }  // namespace vsd::robotics::detail
