@@ -14,7 +14,7 @@ namespace vsd::scene {
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path data_dir = VSD_SCENE_TEST_DATA_DIR;
+const fs::path tool_data_dir = VSD_SCENE_TEST_DATA_DIR;
 
 struct ToolRun {
   int code = 0;
@@ -33,7 +33,7 @@ ToolRun run(std::vector<std::string> args) {
 }
 
 TEST(SceneTool, PrintsTheTreeAndTheWarningsOfAUrdf) {
-  const ToolRun r = run({(data_dir / "iiwa14.urdf").string()});
+  const ToolRun r = run({(tool_data_dir / "iiwa14.urdf").string()});
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("scene iiwa14: 11 links, 10 joints"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("joint iiwa_joint_4 (Revolute) axis [0, 0, 1] limits [-2.0944, 2.0944]"),
@@ -48,7 +48,7 @@ TEST(SceneTool, PrintsTheTreeAndTheWarningsOfAUrdf) {
 }
 
 TEST(SceneTool, SavedSceneRoundTripsThroughJson) {
-  const ToolRun json = run({(data_dir / "ur5_robot.urdf").string(), "--no-meshes", "--json"});
+  const ToolRun json = run({(tool_data_dir / "ur5_robot.urdf").string(), "--no-meshes", "--json"});
   ASSERT_EQ(json.code, 0) << json.err;
   EXPECT_EQ(json.out.rfind("{", 0), 0u);
   const fs::path file =
@@ -72,7 +72,7 @@ TEST(SceneTool, UsageAndFileErrors) {
   const ToolRun missing = run({"/nonexistent/robot.urdf"});
   EXPECT_EQ(missing.code, 1);
   EXPECT_NE(missing.err.find("/nonexistent/robot.urdf"), std::string::npos) << missing.err;
-  const ToolRun notscene = run({(data_dir / "README.md").string()});
+  const ToolRun notscene = run({(tool_data_dir / "README.md").string()});
   EXPECT_EQ(notscene.code, 1);
   EXPECT_NE(notscene.err.find("README.md"), std::string::npos) << notscene.err;
 }

@@ -329,8 +329,6 @@ TEST_F(Migrate, TheModuleRunsTheNewVersionInTheSchedulerStep) {
   EXPECT_EQ(int_of(p.root(), "count"), 157);
 }
 
-}  // namespace
-
 // The executor's database state (docs/soml.md 8.7) describes the new version after a reload, so a run
 // saved after a reload continues after attaching the new text.
 TEST_F(Migrate, TheExecutorStateFollowsTheReloadAndAttachContinues) {
@@ -415,3 +413,5 @@ TEST_F(Migrate, AReplicaWithItsOwnRegistryFollowsAReload) {
   EXPECT_EQ(q.firings(), p.firings());
 }
 #endif
+
+}  // namespace
