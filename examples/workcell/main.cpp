@@ -126,8 +126,8 @@ class Robot : public vsd::Node {
   void command(const Eigen::Isometry3d& flange_in_world) {
     controller->set_target_pose(base->world_frame().inverse() * flange_in_world);
     controller->set_mode(vsd::robotics::ControlMode::Cartesian);
-    // The controller clears `done` only in its next step, so `arrived` is kept here: false from now
-    // until the controller reports done in a later step.
+    // `arrived` is the cell's own flag: false from now until the controller reports this target done
+    // in a later step.
     set_arrived(false);
     commanded_in_step = step;
   }
