@@ -187,15 +187,12 @@ struct Session {
     std::string exe = self, flag = "--peer";
     char* argv[] = {exe.data(), flag.data(), const_cast<char*>(d.c_str()), nullptr};
     if (posix_spawn(&child, self, nullptr, nullptr, argv, environ) != 0) return;
-    // The peer has joined when it holds the model and its raw reader and writer are matched.
-    ok = p->poll_until(
-        [&] {
-          arm.set_ping(arm.ping() + 1);
-          p->publish();
-          p->poll();
-          return arm.pong() == arm.ping() && raw->matched() >= 1;
-        },
-        30s);
+    // The peer has joined when it answered the ping (from its snapshot, or the bundle if it joined
+    // first) and its raw reader and writer are matched. One ping only: a new one on every poll would stay
+    // one ahead of the answers, which arrive while poll_until() sleeps.
+    arm.set_ping(arm.ping() + 1);
+    p->publish();
+    ok = p->poll_until([&] { return arm.pong() == arm.ping() && raw->matched() >= 1; }, 30s);
   }
   ~Session() {
     p.reset();
