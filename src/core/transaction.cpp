@@ -283,11 +283,7 @@ class Applier {
   using RefLink = vsd::detail::RefLink;
 
  public:
-  /// @param values_checked the bundle's plain values, and that its composite references form no cycle,
-  /// were checked by its maker (a loader): the dry run then checks ids, classes, references and list
-  /// positions, not every value or edge again.
-  Applier(SimState& s, const Transaction& t, bool values_checked = false)
-      : s_(s), t_(t), values_checked_(values_checked) {}
+  Applier(SimState& s, const Transaction& t) : s_(s), t_(t) {}
 
   void run() {
     TxOp op;  // reused: its storage serves every operation
@@ -423,8 +419,6 @@ class Applier {
         ids.push_back(r.varint());
         check_target(op, n, ids.back(), t);
         if (ids.back() == null_id) ids.clear();
-      } else if (values_checked_) {
-        return ids;
       } else {
         Value v(t);
         t.read_bytes(v.data(), r, nullptr);
@@ -559,7 +553,6 @@ class Applier {
   // it cannot be anybody's ancestor.
   bool holds_nothing(Id id) const { return created_.contains(id) && !holders_.contains(id); }
   void add_edge(const TxOp& op, std::size_t n, Id holder, Id child) {
-    if (values_checked_) return;  // the maker proved the bundle acyclic
     // Most edges of a big bundle point at instances it has just created and that hold nothing yet
     // (a load builds top down): no walk is needed for them.
     if (child == holder || (!holds_nothing(child) && holds_up(holder, child)))
@@ -621,14 +614,9 @@ class Applier {
         SimStateInstance& x = s_.make(cls, op.id);
         for (const auto& [name, bytes] : op.values) {
           const MetaProperty& p = *cls.find_property(name);
-          void* at = const_cast<void*>(p.address(x));         // initial values: not changes
-          if (values_checked_ && !p.type().is_reference()) {  // known good: straight into the instance
-            ByteReader r(bytes.data(), bytes.size());
-            p.type().read_bytes(at, r, nullptr);
-          } else {
-            const Value v = decode(p, bytes);
-            p.type().assign(at, v.data());
-          }
+          void* at = const_cast<void*>(p.address(x));  // initial values: not changes
+          const Value v = decode(p, bytes);
+          p.type().assign(at, v.data());
         }
         s_.finish_create(x);
         break;
@@ -658,7 +646,6 @@ class Applier {
 
   SimState& s_;
   const Transaction& t_;
-  bool values_checked_;
   const MetaInstance* last_class_ = nullptr;
   std::size_t creates_ = 0;
   std::vector<std::pair<const MetaInstance*, std::size_t>> per_class_;  // creates by class
@@ -680,12 +667,5 @@ void SimState::apply(const Transaction& t) {
   if (t.empty()) return;
   detail::Applier(*this, t).run();
 }
-
-namespace detail {
-void apply_checked_values(SimState& state, const Transaction& t) {
-  if (t.empty()) return;
-  Applier(state, t, true).run();
-}
-}  // namespace detail
 
 }  // namespace vsd

@@ -156,6 +156,20 @@ struct Lost {
   std::uint64_t loser;  // the participant whose change lost
 };
 
+// The report of a lost change, made while applying the bundle m (the loser's sequence number is known
+// only when m is the loser's own bundle).
+Conflict conflict_of(const Lost& l, ConflictKind kind, const Message& m) {
+  Conflict c;
+  c.kind = kind;
+  c.writer = l.loser;
+  c.owner = l.winner.who;
+  c.seq = l.loser == m.sender ? m.seq : 0;
+  c.instance = l.instance;
+  c.property = l.property;
+  c.target = l.target;
+  return c;
+}
+
 // One operation of a bundle, for the ownership check.
 struct OpRef {
   Transaction::Op op;
@@ -1171,58 +1185,16 @@ struct Participant::Impl {
     ++stats.bundles_applied;
     ++applied_now;
     if (!waiting.empty() && !replaying) replay_waiting();
-    for (const Lost& l : lost) {
-      // The later stamped write won here, as it does everywhere. Its writer tells the loser (who may see
-      // nothing amiss: the winner's set simply overwrote its own).
-      ++stats.lost_writes;
-      Conflict c;
-      c.kind = ConflictKind::ConcurrentWrite;
-      c.writer = m.sender;
-      c.owner = l.winner.who;
-      c.seq = m.seq;
-      c.instance = l.instance;
-      c.property = std::string(l.property);
-      report(std::move(c), l.winner.who == id);
-    }
-    for (const Lost& g : gone) {
-      // The deleter tells the writer, as the winner of a concurrent set does.
-      ++stats.lost_writes;
-      Conflict c;
-      c.kind = ConflictKind::Deleted;
-      c.writer = m.sender;
-      c.owner = g.winner.who;
-      c.seq = m.seq;
-      c.instance = g.instance;
-      c.property = std::string(g.property);
-      report(std::move(c), g.winner.who == id);
-    }
-    for (const Lost& g : dangling) {
-      // A reference set to, or a list entry of, an instance deleted concurrently: null, or removed. The
-      // deleter tells the writer.
-      ++stats.lost_writes;
-      Conflict c;
-      c.kind = ConflictKind::Deleted;
-      c.writer = g.loser;
-      c.owner = g.winner.who;
-      c.seq = g.loser == m.sender ? m.seq : 0;
-      c.instance = g.instance;
-      c.property = g.property;
-      c.target = g.target;
-      report(std::move(c), g.winner.who == id && g.loser == m.sender);
-    }
-    for (const Lost& g : moved) {
-      // Both movers and every other participant see both moves and decide alike: no report sample.
-      ++stats.lost_writes;
-      Conflict c;
-      c.kind = ConflictKind::ConcurrentMove;
-      c.writer = g.loser;
-      c.owner = g.winner.who;
-      c.seq = g.loser == m.sender ? m.seq : 0;
-      c.instance = g.instance;
-      c.property = g.property;
-      c.target = g.target;
-      report(std::move(c), false);
-    }
+    // The later stamped write won here, as it does everywhere: its writer tells the loser (who may see
+    // nothing amiss: the winner's set simply overwrote its own). The deleter tells the writer of a change
+    // to, a reference to or a list entry of an instance deleted concurrently (null, or removed). Both
+    // movers and every other participant see both moves and decide alike: no report sample for those.
+    stats.lost_writes += lost.size() + gone.size() + dangling.size() + moved.size();
+    for (const Lost& l : lost) report(conflict_of(l, ConflictKind::ConcurrentWrite, m), l.winner.who == id);
+    for (const Lost& g : gone) report(conflict_of(g, ConflictKind::Deleted, m), g.winner.who == id);
+    for (const Lost& g : dangling)
+      report(conflict_of(g, ConflictKind::Deleted, m), g.winner.who == id && g.loser == m.sender);
+    for (const Lost& g : moved) report(conflict_of(g, ConflictKind::ConcurrentMove, m), false);
   }
 
   // Nobody answered a resynchronisation (every participant may have seen the same gap): go on with this

@@ -23,6 +23,38 @@ namespace vsd::soml {
 
 namespace {
 
+// A running version's classes make room for a new version's classes of the same names: each is renamed
+// to the first free `Name~N`. restore() gives the names back, newest first, when the new version is
+// refused; the constructor restores what it renamed before it throws.
+class RetiredNames {
+ public:
+  RetiredNames(Registry& reg, const std::vector<const MetaInstance*>& classes)
+      : reg_(reg), classes_(classes) {
+    try {
+      for (const MetaInstance* m : classes_) {
+        std::string retired;
+        for (int n = 1; retired.empty() || reg_.find_class_exact(retired) != nullptr; ++n)
+          retired = m->name() + "~" + std::to_string(n);
+        std::string was = m->name();
+        reg_.rename(*m, retired);
+        names_.push_back(std::move(was));
+      }
+    } catch (...) {
+      restore();
+      throw;
+    }
+  }
+  void restore() {
+    for (std::size_t i = names_.size(); i-- > 0;) reg_.rename(*classes_[i], names_[i]);
+    names_.clear();
+  }
+
+ private:
+  Registry& reg_;
+  const std::vector<const MetaInstance*>& classes_;
+  std::vector<std::string> names_;  // the original names of classes_[0 .. size)
+};
+
 std::string qualified(const Decl& d) {
   std::string s = d.name;
   for (const Decl* p = d.parent; p != nullptr && p->kind != DeclKind::Script; p = p->parent)
@@ -407,23 +439,7 @@ MigrationReport migrate(ProgramImpl& old, ProgramImpl& nw, std::string name, std
 
   // The running version's classes make room for the new ones under retired names.
   const std::vector<const MetaInstance*> old_classes = old.runtime_classes();
-  std::vector<std::string> old_names;
-  auto restore_names = [&] {
-    for (std::size_t i = old_names.size(); i-- > 0;) reg.rename(*old_classes[i], old_names[i]);
-  };
-  try {
-    for (const MetaInstance* m : old_classes) {
-      std::string retired;
-      for (int n = 1; retired.empty() || reg.find_class_exact(retired) != nullptr; ++n)
-        retired = m->name() + "~" + std::to_string(n);
-      const std::string was = m->name();
-      reg.rename(*m, retired);
-      old_names.push_back(was);
-    }
-  } catch (...) {
-    restore_names();
-    throw;
-  }
+  RetiredNames retired(reg, old_classes);
 
   auto undefine_new = [&] {
     for (const MetaInstance* m : nw.runtime_classes()) try {
@@ -442,7 +458,7 @@ MigrationReport migrate(ProgramImpl& old, ProgramImpl& nw, std::string name, std
     nw.define(std::move(name), std::move(text));
   } catch (...) {
     undefine_new();
-    restore_names();
+    retired.restore();
     throw;
   }
 
@@ -464,7 +480,7 @@ MigrationReport migrate(ProgramImpl& old, ProgramImpl& nw, std::string name, std
       nw.listener_.disconnect();
       nw.deleted_listener_.disconnect();
       undefine_new();
-      restore_names();
+      retired.restore();
       old.connect_listeners();
       if (extra.empty()) throw;
       throw Error(std::string(e.what()) + extra);
@@ -473,7 +489,7 @@ MigrationReport migrate(ProgramImpl& old, ProgramImpl& nw, std::string name, std
       nw.listener_.disconnect();
       nw.deleted_listener_.disconnect();
       undefine_new();
-      restore_names();
+      retired.restore();
       old.connect_listeners();
       throw;
     }
@@ -538,24 +554,13 @@ void Program::follow_reload(std::string name, std::string text, const Transactio
 
   // As on the source: the running version's classes make room under retired names.
   const std::vector<const MetaInstance*> old_classes = old.runtime_classes();
-  std::vector<std::string> old_names;
-  auto restore_names = [&] {
-    for (std::size_t i = old_names.size(); i-- > 0;) reg.rename(*old_classes[i], old_names[i]);
-  };
+  RetiredNames retired(reg, old_classes);
   try {
-    for (const MetaInstance* m : old_classes) {
-      std::string retired;
-      for (int n = 1; retired.empty() || reg.find_class_exact(retired) != nullptr; ++n)
-        retired = m->name() + "~" + std::to_string(n);
-      const std::string was = m->name();
-      reg.rename(*m, retired);
-      old_names.push_back(was);
-    }
     fresh->previous_ = &old;
     fresh->define(std::move(name), std::move(text));
   } catch (...) {
     fresh->undefine_own();
-    restore_names();
+    retired.restore();
     throw;
   }
 
@@ -582,7 +587,7 @@ void Program::follow_reload(std::string name, std::string text, const Transactio
         extra = "; rolling back failed too: " + std::string(r.what());
       }
       fresh->undefine_own();
-      restore_names();
+      retired.restore();
       if (!applied) {
         old.connect_listeners();
         throw;

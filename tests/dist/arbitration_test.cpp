@@ -11,7 +11,7 @@
 #include <string>
 #include <thread>
 
-#include "dist_test_util.hpp"
+#include "three_participants.hpp"
 
 using namespace std::chrono_literals;
 using vsd_dist_test::DArm;
@@ -20,31 +20,14 @@ using vsd_dist_test::poll_all;
 
 namespace {
 
-struct ArbitrationTest : testing::Test {
-  std::uint32_t domain = vsd_dist_test::fresh_domain();
-  vsd::Environment env_r{1}, env_u{2}, env_c{3};
-  vsd::SimState& r = env_r.main_state();
-  vsd::SimState& u = env_u.main_state();
-  vsd::SimState& c = env_c.main_state();
+struct ArbitrationTest : vsd_dist_test::ThreeParticipants {
   DArm* keep = nullptr;  // an arm nobody deletes
-  std::vector<std::string> log_r, log_u, log_c;
-  std::unique_ptr<vsd::dist::Participant> robot, ui, other;
-  std::vector<vsd::dist::Conflict> seen_r, seen_u;
-  vsd::Connection cr, cu;
 
-  void SetUp() override {
+  void populate() override {
     keep = &r.create<DArm>();
     keep->set_name("keep");
     r.database().add_child(*keep);
-    robot = std::make_unique<vsd::dist::Participant>(r, options("robot", domain, true, &log_r));
-    ui = std::make_unique<vsd::dist::Participant>(u, options("ui", domain, false, &log_u));
-    other = std::make_unique<vsd::dist::Participant>(c, options("monitor", domain, false, &log_c));
-    ASSERT_TRUE(
-        poll_all({robot.get(), ui.get(), other.get()}, [&] { return ui->synced() && other->synced(); }));
-    cr = robot->on_conflict().connect([&](const vsd::dist::Conflict& x) { seen_r.push_back(x); });
-    cu = ui->on_conflict().connect([&](const vsd::dist::Conflict& x) { seen_u.push_back(x); });
   }
-  bool settle(const std::function<bool()>& f) { return poll_all({robot.get(), ui.get(), other.get()}, f); }
   static std::uint64_t last_seq(const vsd::dist::Participant& p) {
     return p.stats().bundles_sent + p.stats().claims_sent;
   }

@@ -3,44 +3,25 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "dist_test_util.hpp"
+#include "three_participants.hpp"
 
 using namespace std::chrono_literals;
 using testing::HasSubstr;
 using vsd_dist_test::DArm;
-using vsd_dist_test::options;
-using vsd_dist_test::poll_all;
 
 namespace {
 
-struct OwnershipTest : testing::Test {
-  std::uint32_t domain = vsd_dist_test::fresh_domain();
-  vsd::Environment env_r{1}, env_u{2}, env_c{3};
-  vsd::SimState& r = env_r.main_state();
-  vsd::SimState& u = env_u.main_state();
-  vsd::SimState& c = env_c.main_state();
+struct OwnershipTest : vsd_dist_test::ThreeParticipants {
   DArm* arm = nullptr;
-  std::vector<std::string> log_r, log_u, log_c;
-  std::unique_ptr<vsd::dist::Participant> robot, ui, other;
-  std::vector<vsd::dist::Conflict> seen_r, seen_u;
-  vsd::Connection cr, cu;
 
-  void SetUp() override {
+  void populate() override {
     arm = &r.create<DArm>();
     r.database().add_child(*arm);
     arm->set_target(1.0);
     arm->set_position(1.0);
-    robot = std::make_unique<vsd::dist::Participant>(r, options("robot", domain, true, &log_r));
-    ui = std::make_unique<vsd::dist::Participant>(u, options("ui", domain, false, &log_u));
-    other = std::make_unique<vsd::dist::Participant>(c, options("monitor", domain, false, &log_c));
-    ASSERT_TRUE(
-        poll_all({robot.get(), ui.get(), other.get()}, [&] { return ui->synced() && other->synced(); }));
-    cr = robot->on_conflict().connect([&](const vsd::dist::Conflict& x) { seen_r.push_back(x); });
-    cu = ui->on_conflict().connect([&](const vsd::dist::Conflict& x) { seen_u.push_back(x); });
   }
   DArm& ui_arm() { return *u.find<DArm>(arm->id()); }
   DArm& other_arm() { return *c.find<DArm>(arm->id()); }
-  bool settle(const std::function<bool()>& f) { return poll_all({robot.get(), ui.get(), other.get()}, f); }
 };
 
 TEST_F(OwnershipTest, AKnownClaimUndoesTheWholeBundleAtTheWriterAndTellsTheOwner) {

@@ -38,11 +38,6 @@ void write_list(std::vector<std::uint8_t>& out, Transaction::Op op, Id holder, s
 /// A Transaction holding @p bytes (header included) with @p ops operations, unchecked (apply checks).
 Transaction make_transaction(std::vector<std::uint8_t> bytes, std::size_t ops);
 
-/// SimState::apply for a bundle whose plain values, and the absence of cycles among its composite
-/// references, its maker has already checked (loaders): the dry run still checks ids, classes,
-/// properties, references and list positions.
-void apply_checked_values(SimState& state, const Transaction& t);
-
 /// True for the properties a transaction carries in Create/Delete payloads and compares.
 bool carried_in_payload(const MetaProperty& p) noexcept;
 
