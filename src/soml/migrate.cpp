@@ -347,16 +347,24 @@ void Migration::run() {
   for (const Pair& p : pairs_) init(p);
   for (const Pair& p : pairs_) map_nets(p);
   for (const Pair& p : pairs_) {
-    report_properties(p.from->meta(), p.to->meta(), label(*p.ci->decl, nw_.stem_));
+    const std::string cls = label(*p.ci->decl, nw_.stem_);
+    report_properties(p.from->meta(), p.to->meta(), cls);
     copy_properties(*p.from, *p.to);
     const NetInst* on = old_.net_of(p.from->id());
     if (on != nullptr) {
+      // Places and transitions with members have classes of their own (port-net copies are transitions):
+      // their properties are reported per class as the object's are, e.g. "Demo.done.visits: kept".
       const std::string owner = p.from->as<Node>()->name();
       for (std::size_t i = 0; i < on->places.size(); ++i)
-        if (auto it = map_.find(on->places[i]->id()); it != map_.end())
+        if (auto it = map_.find(on->places[i]->id()); it != map_.end()) {
+          report_properties(on->places[i]->meta(), it->second->meta(), cls + "." + on->places[i]->name());
           copy_marking(*on->places[i], static_cast<Place&>(*it->second), owner + "." + on->places[i]->name());
+        }
       for (Transition* t : on->transitions)
-        if (auto it = map_.find(t->id()); it != map_.end()) copy_properties(*t, *it->second);
+        if (auto it = map_.find(t->id()); it != map_.end()) {
+          report_properties(t->meta(), it->second->meta(), cls + "." + t->name());
+          copy_properties(*t, *it->second);
+        }
     }
   }
   for (const Pair& p : pairs_) adopt_children(p);

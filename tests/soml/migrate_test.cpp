@@ -171,6 +171,43 @@ TEST_F(Migrate, MarkingsAreKeptAndNewTransitionsAndFunctionsRun) {
   EXPECT_EQ(p.root().call("twice", {vsd::Value(std::int64_t{5})}).as<std::int64_t>(), 15);
 }
 
+// A place or transition with members has a class of its own: its properties migrate and are reported
+// like an object's, under the owner's class and the node's name.
+TEST_F(Migrate, MembersOfPlacesAndTransitionsAreReportedAndKept) {
+  Program& p = load(R"(
+place ready = 1;
+place done { int visits = 2; int dropped = 1; }
+transition go { double effort = 0.5; do { effort += 1.0; done.visits += 1; } }
+arrow ready -> go;
+arrow go -> done;
+)");
+  EXPECT_EQ(p.step(1), 1u);
+  const MigrationReport r = p.reload("test.soml", R"(
+place ready = 1;
+place done { int visits = 0; string note = "v2"; }
+transition go { double effort = 0.0; int tries = 4; do { effort += 1.0; done.visits += 1; } }
+arrow ready -> go;
+arrow go -> done;
+)");
+  EXPECT_THAT(r.properties, Contains("test.done.visits: kept"));
+  EXPECT_THAT(r.properties, Contains("test.done.note: new"));
+  EXPECT_THAT(r.properties, Contains("test.done.dropped: removed"));
+  EXPECT_THAT(r.properties, Contains("test.go.effort: kept"));
+  EXPECT_THAT(r.properties, Contains("test.go.tries: new"));
+  const vsd::Node* done = nullptr;
+  const vsd::Node* go = nullptr;
+  for (const vsd::Node* c : p.root().children()) {
+    if (c->name() == "done") done = c;
+    if (c->name() == "go") go = c;
+  }
+  ASSERT_NE(done, nullptr);
+  ASSERT_NE(go, nullptr);
+  EXPECT_EQ(done->get<std::int64_t>("visits"), 3) << "the running value, not the new initialiser";
+  EXPECT_EQ(done->get<std::string>("note"), "v2");
+  EXPECT_DOUBLE_EQ(go->get<double>("effort"), 1.5);
+  EXPECT_EQ(go->get<std::int64_t>("tries"), 4);
+}
+
 TEST_F(Migrate, ReferencesFromCppNodesFollowTheMigratedObjects) {
   Program& p = running();
   auto& h = state.create<Holder>();

@@ -79,7 +79,8 @@ struct MigrationReport {
   std::size_t created = 0;   ///< objects the new version declares that the running one had not
   std::size_t deleted = 0;   ///< objects the new version no longer declares (deleted with their nets)
   /// Per migrated or new property of a class: "Demo.count: kept", "Demo.limit: new", "Demo.old: removed",
-  /// "Demo.size: converted from int to double" (one line per class and property, in declaration order).
+  /// "Demo.size: type changed from int64 to double" (one line per class and property, in declaration
+  /// order); the members of a place or transition (a port-net copy too) as "Demo.done.visits: kept".
   std::vector<std::string> properties;
   /// Schema differences handled with a loss: removed properties' values, values that did not convert,
   /// tokens in removed places, retired classes that could not be undefined.
