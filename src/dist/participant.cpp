@@ -948,8 +948,9 @@ struct Participant::Impl {
     std::map<ListKey, internal::Sequence> touched;
     std::unordered_map<Id, Top> tops;
     std::unordered_map<Id, std::string_view> created;  // class names of the instances the bundle creates
-    bool unknown_entry = false;  // an edit names a list entry this participant has not seen
-    bool entry_to_come = false;  // ... one that a bundle not applied yet of a third participant makes
+    bool unknown_entry = false;   // an edit names a list entry this participant has not seen
+    bool entry_to_come = false;   // ... one that a bundle not applied yet of a third participant makes
+    bool target_unknown = false;  // a reference or list entry names an instance unknown here
     if (m.kind == Kind::Bundle) {
       auto existing = [&](const ListKey& key) -> internal::Sequence* {
         if (auto x = touched.find(key); x != touched.end()) return &x->second;
@@ -966,6 +967,10 @@ struct Participant::Impl {
         if (auto x = tops.find(child); x != tops.end()) return x->second;
         if (auto x = top_child.find(child); x != top_child.end()) return x->second;
         return std::nullopt;
+      };
+      // An instance that is neither here nor made by this bundle: a reference to it cannot apply yet.
+      auto unknown_target = [&](Id target) {
+        return target != null_id && state.find(target) == nullptr && !created.contains(target);
       };
       auto property_here = [&](Id inst, std::string_view prop) -> const MetaProperty* {
         const MetaInstance* cls = nullptr;
@@ -1008,7 +1013,10 @@ struct Participant::Impl {
         ByteReader r(v.data(), v.size());
         const Id target = r.varint();
         auto d = deleted.find(target);
-        if (d == deleted.end()) return v;
+        if (d == deleted.end()) {
+          target_unknown = target_unknown || unknown_target(target);
+          return v;
+        }
         dangling.push_back({inst, std::string(prop), d->second, target, m.sender});
         return {null_ref, 1};
       };
@@ -1037,6 +1045,8 @@ struct Participant::Impl {
         if (auto d = deleted.find(e.target); d != deleted.end()) {
           hidden = true;  // the deletion wins: the entry is there, removed
           dangling.push_back({e.holder, std::string(e.property), d->second, e.target, m.sender});
+        } else if (unknown_target(e.target)) {
+          target_unknown = true;
         } else if (is_children(e.property)) {
           if (const auto top = top_of(e.target); top && elem < top->element) {
             hidden = true;  // a newer move of this child won
@@ -1144,10 +1154,12 @@ struct Participant::Impl {
       report(*c, c->owner == id);  // the owner tells the writer
       return;
     }
-    if (unknown_entry && entry_to_come &&
+    if (((unknown_entry && entry_to_come) || target_unknown) &&
         (waiting_since == std::chrono::steady_clock::time_point{} ||
          std::chrono::steady_clock::now() - waiting_since < 10 * opt.request_interval)) {
-      // Wait for the bundle that makes the entry (its sender's stream is behind this one's here).
+      // Wait for the bundle that makes the entry or the instance (its sender's stream is behind this one's
+      // here: bundles of different senders are not delivered in causal order). What is still missing
+      // after 10 request intervals makes this participant resynchronise.
       if (waiting_since == std::chrono::steady_clock::time_point{})
         waiting_since = std::chrono::steady_clock::now();
       waiting[m.sender].push_front(m);

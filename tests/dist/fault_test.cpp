@@ -202,6 +202,82 @@ TEST_F(FaultTest, AnEditOfAnEntryStillOnTheWayWaitsForIt) {
   EXPECT_EQ(pa.stats().resyncs + pb.stats().resyncs, 0u);
 }
 
+// The same for references: participant 0x90 saw 0x91 create a node and pointed the arm's `watched` at it
+// (clock 10); 0x91's creation (clock 5) arrives after it. The reference waits for the creation instead of
+// making its receivers resynchronise.
+TEST_F(FaultTest, AReferenceToAnInstanceStillOnTheWayWaitsForIt) {
+  vsd::dist::Participant pa(a, options("a", domain, true, &log_a));
+  vsd::dist::Participant pb(b, options("b", domain, false, &log_b));
+  ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return pb.synced(); }));
+  RawWriter raw(domain);
+  ASSERT_TRUE(raw.wait_matched(2));
+  const vsd::Id made = 0x91000005;  // an id of the third participant's range, unused here
+  ASSERT_EQ(a.find(made), nullptr);
+  auto bundle = [](const std::string& name, std::uint8_t op, vsd::Id id, std::vector<std::uint8_t> rest) {
+    std::vector<std::uint8_t> body{'V', 'S', 'D', 'W', 2};
+    vsd::ByteWriter w(body);
+    w.varint(1);
+    w.string(name);
+    w.varint(1);
+    w.u8(op);
+    w.varint(id);
+    w.varint(0);
+    body.insert(body.end(), rest.begin(), rest.end());
+    return envelope(body);
+  };
+  std::vector<std::uint8_t> ref;  // set (3): the value's length, then the reference's varint id
+  {
+    std::vector<std::uint8_t> v;
+    vsd::ByteWriter vw(v);
+    vw.varint(made);
+    vsd::ByteWriter w(ref);
+    w.varint(v.size());
+    ref.insert(ref.end(), v.begin(), v.end());
+  }
+  raw.send(0x90, 1, 1, bundle("watched", 3, arm->id(), ref), 10);
+  raw.send(0x91, 1, 1, bundle(std::string(vsd::Node::static_meta().name()), 1, made, {0}), 5);
+  auto watched = [&](vsd::SimState& s) -> vsd::Id {
+    const vsd::Node* n = s.find<DArm>(arm->id())->watched().get();
+    return n != nullptr ? n->id() : vsd::null_id;
+  };
+  ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return watched(a) == made && watched(b) == made; }))
+      << testing::PrintToString(log_a) << " " << testing::PrintToString(log_b);
+  EXPECT_GE(pa.stats().bundles_waited + pb.stats().bundles_waited, 1u);
+  EXPECT_EQ(pa.stats().resyncs + pb.stats().resyncs, 0u) << testing::PrintToString(log_b);
+  std::string diff;
+  EXPECT_TRUE(a.equals(b, &diff)) << diff;
+}
+
+// A reference to an instance nobody makes: after the wait, the receivers resynchronise and drop it alike.
+TEST_F(FaultTest, AReferenceToAnInstanceNobodyMakesResynchronisesAfterTheWait) {
+  vsd::dist::Participant pa(a, options("a", domain, true, &log_a));
+  vsd::dist::Participant pb(b, options("b", domain, false, &log_b));
+  ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return pb.synced(); }));
+  RawWriter raw(domain);
+  ASSERT_TRUE(raw.wait_matched(2));
+  std::vector<std::uint8_t> body{'V', 'S', 'D', 'W', 2};
+  vsd::ByteWriter w(body);
+  w.varint(1);
+  w.string("watched");
+  w.varint(1);
+  w.u8(3);
+  w.varint(arm->id());
+  w.varint(0);
+  w.varint(4);  // the value: a 4-byte varint id nobody has
+  w.varint(0x0abcdef0);
+  raw.send(0x92, 1, 1, envelope(body), 3);
+  ASSERT_TRUE(poll_all(
+      {&pa, &pb}, [&] { return pb.stats().resyncs >= 1 && pb.synced() && pa.synced(); }, 15s))
+      << testing::PrintToString(log_b);
+  EXPECT_GE(pb.stats().bundles_waited, 1u);
+  EXPECT_EQ(b.find<DArm>(arm->id())->watched().get(), nullptr);
+  arm->set_target(7.0);  // and the real stream goes on
+  ASSERT_TRUE(poll_all(
+      {&pa, &pb}, [&] { return b.find<DArm>(arm->id())->target() == 7.0; }, 15s));
+  std::string diff;
+  EXPECT_TRUE(a.equals(b, &diff)) << diff;
+}
+
 TEST_F(FaultTest, ADivergedParticipantResynchronisesFromASnapshot) {
   vsd::dist::Participant pa(a, options("a", domain, true, &log_a));
   vsd::dist::Participant pb(b, options("b", domain, false, &log_b));
