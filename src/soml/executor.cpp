@@ -32,6 +32,7 @@ void ProgramImpl::on_deleted(SimStateInstance& inst) {
   NetInst* n = it->second;
   if (n->dead) return;
   n->dead = true;
+  dead_tis_ += n->transitions.size();
   for (std::size_t t = 0; t < n->transitions.size(); ++t) {
     const auto i = static_cast<std::uint32_t>(n->first_ti + t);
     set_enabled(i, false);
@@ -376,7 +377,50 @@ Place* ProgramImpl::produce(NetInst& net, const TransitionInfo& t, std::uint64_t
   return to;
 }
 
+void ProgramImpl::compact_nets() {
+  constexpr std::uint32_t gone = ~std::uint32_t{0};
+  std::vector<std::uint32_t> to(tis_.size(), gone);       // old index -> new index
+  std::vector<std::uint32_t> before(tis_.size() + 1, 0);  // old index -> live entries before it
+  std::vector<TI> kept;
+  kept.reserve(tis_.size() - dead_tis_);
+  for (std::uint32_t i = 0; i < tis_.size(); ++i) {
+    before[i] = static_cast<std::uint32_t>(kept.size());
+    if (!tis_[i].net->dead) {
+      to[i] = static_cast<std::uint32_t>(kept.size());
+      kept.push_back(std::move(tis_[i]));
+    }
+  }
+  before[tis_.size()] = static_cast<std::uint32_t>(kept.size());
+  // Every list of indices keeps its order (choice, re-test and watcher order stay as they were).
+  auto remap = [&](std::vector<std::uint32_t>& v) {
+    std::size_t n = 0;
+    for (std::uint32_t i : v)
+      if (to[i] != gone) v[n++] = to[i];
+    v.resize(n);
+  };
+  remap(dirty_);
+  remap(enabled_);
+  for (std::size_t k = 0; k < enabled_.size(); ++k)
+    kept[enabled_[k]].enabled_pos = static_cast<std::int32_t>(k);
+  auto remap_all = [&](auto& table) {  // watcher tables: lists that end empty go
+    for (auto it = table.begin(); it != table.end();) {
+      remap(it->second);
+      it = it->second.empty() ? table.erase(it) : std::next(it);
+    }
+  };
+  remap_all(place_watch_);
+  remap_all(deps_map_);
+  tis_ = std::move(kept);
+  std::erase_if(net_order_, [](const NetInst* n) { return n->dead; });
+  for (NetInst* n : net_order_) n->first_ti = before[n->first_ti];  // a net's entries are contiguous
+  std::erase_if(nets_, [](const auto& entry) { return entry.second->dead; });
+  dead_nets_.clear();
+  dead_tis_ = 0;
+}
+
 std::uint64_t ProgramImpl::step(std::uint64_t n) {
+  // Between firings (not from the program's own code): drop dead nets once they are most of the list.
+  if (dead_tis_ > 64 && dead_tis_ * 2 > tis_.size() && frames_.empty() && !guarding_) compact_nets();
   std::uint64_t fired = 0;
   try {
     fired = step_loop(n);

@@ -433,6 +433,11 @@ class ProgramImpl {
   std::unordered_map<std::uint64_t, std::unique_ptr<NetInst>> nets_;  // owner id -> net
   std::vector<NetInst*> net_order_;
   std::vector<std::unique_ptr<NetInst>> dead_nets_;  // replaced by a revived one, kept for tis_
+  std::size_t dead_tis_ = 0;                         // entries of tis_ that belong to dead nets
+  // Drops the dead nets and their entries of tis_ once they are the majority, renumbering what refers to
+  // an entry (a long run that creates and deletes objects with nets would grow without bound otherwise).
+  // Only between firings: nothing may hold a TI index or a NetInst pointer across it.
+  void compact_nets();
   struct DepKey {
     std::uint64_t id;
     const MetaProperty* prop;

@@ -30,6 +30,60 @@ struct Exec : ::testing::Test {
   }
 };
 
+// Every invocation makes a net instance and deletes it when it finishes. The executor drops the entries
+// of deleted nets once they are the majority (between steps), without changing the run: stepping one
+// firing at a time (compacting often) and all at once (never) give the same trace.
+constexpr const char* invoking = R"(
+net int work(int n) {
+  place s;
+  start s;
+  transition t { do { finish n * 2; } }
+  arrow s -> t;
+}
+class Worker : Node {
+  int done = 0;
+  int sum = 0;
+  place ticks = 150;
+  transition go { invoke work(done); do { done += 1; sum += result; } }
+  arrow ticks -> go;
+}
+object a : Worker;
+object b : Worker;
+object c : Worker;
+)";
+
+std::string trace_of(Program& p, std::uint64_t chunk, std::size_t* most_entries) {
+  std::string trace;
+  p.on_firing([&](const vsd::soml::Firing& f) {
+    trace += std::to_string(f.step) + " " + f.transition->name() + " " + std::to_string(f.invocation) + "\n";
+  });
+  while (p.step(chunk) != 0) *most_entries = std::max(*most_entries, p.executor_entries());
+  return trace;
+}
+
+TEST_F(Exec, FinishedInvocationsDoNotGrowTheExecutor) {
+  Program& p = load(invoking, 7);
+  std::size_t most = 0;
+  const std::string one_by_one = trace_of(p, 1, &most);
+  for (const char* w : {"a", "b", "c"}) EXPECT_EQ(p.object(w)->get<std::int64_t>("done"), 150) << w;
+  EXPECT_EQ(p.firings(), 3u * 150u * 2u);  // per tick: go invokes; work.t finishes (and go completes)
+  EXPECT_LT(most, 3u * 150u) << "one dead entry per invocation would reach 450";
+  EXPECT_LE(p.executor_entries(), 3u + 64u);
+
+  vsd::Registry reg2;
+  vsd::Environment env2{0, reg2};
+  auto& soml2 = env2.use<vsd::soml::Module>();
+  vsd::soml::RunOptions o;
+  o.out = &out;
+  o.seed = 7;
+  Program& q = soml2.load(env2.main_state(), "net.soml", invoking, o);
+  std::size_t most_q = 0;
+  EXPECT_EQ(trace_of(q, 1'000'000, &most_q), one_by_one);
+  EXPECT_GE(most_q, 3u * 150u) << "one step() compacts only before it starts";
+  for (const char* w : {"a", "b", "c"})
+    EXPECT_EQ(q.object(w)->get<std::int64_t>("sum"), p.object(w)->get<std::int64_t>("sum")) << w;
+}
+
 TEST_F(Exec, WeightsConsumeAndProduce) {
   Program& p = load(R"(
 place a = 5;

@@ -161,6 +161,10 @@ class Program {
   [[nodiscard]] std::uint64_t condition_tests() const noexcept;
   /// @brief (instance, property) pairs that some transition's last test read and that are watched now.
   [[nodiscard]] std::size_t watched_properties() const noexcept;
+  /// @brief Entries of the executor's transition table: one per transition of every net instance, plus
+  /// those of deleted nets (finished invocations, deleted objects) not dropped yet. Dead entries are
+  /// dropped at the start of a step() once they are the majority, so a long run stays bounded.
+  [[nodiscard]] std::size_t executor_entries() const noexcept;
   /// @brief Run-time errors of conditions so far (a failing condition counts as not enabled).
   [[nodiscard]] const std::vector<std::string>& condition_errors() const noexcept;
 
