@@ -21,6 +21,10 @@ void ProgramImpl::on_change(SimStateInstance& inst, const MetaProperty& p) {
   auto it = deps_map_.find(DepKey{inst.id(), &p});
   if (it != deps_map_.end())
     for (std::uint32_t ti : it->second) mark_dirty(ti);
+  if (!whole_instance_deps_) return;
+  it = deps_map_.find(DepKey{inst.id(), nullptr});  // tests that called a C++ method of the instance
+  if (it != deps_map_.end())
+    for (std::uint32_t ti : it->second) mark_dirty(ti);
 }
 
 // A net whose owner, place or transition is deleted stops: its transitions leave the enabled set and
@@ -197,6 +201,7 @@ bool ProgramImpl::test(TI& ti) {
     // run: a change then marks its watchers dirty in the same order in a run that was saved and attached
     // again (8.7), whose tests ran at other times, as in the run that was never saved.
     for (const auto& [id, prop] : dep_scratch_) {
+      whole_instance_deps_ = whole_instance_deps_ || prop == nullptr;
       ti.deps.push_back(DepKey{id, prop});
       auto& v = deps_map_[DepKey{id, prop}];
       v.insert(std::upper_bound(v.begin(), v.end(), index), index);

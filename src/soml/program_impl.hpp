@@ -463,6 +463,7 @@ class ProgramImpl {
     }
   };
   std::unordered_map<DepKey, std::vector<std::uint32_t>, DepHash> deps_map_;
+  bool whole_instance_deps_ = false;  // some test called a C++ method: deps_map_ has (id, null) keys
   std::vector<std::pair<std::uint64_t, const MetaProperty*>> dep_scratch_;
   Connection listener_;
   Connection deleted_listener_;

@@ -876,6 +876,9 @@ Val ProgramImpl::exec(std::size_t entry) {
       case OP_MCALL: {
         VSD_SAVE();
         SimStateInstance& o = obj(R[in.a].id);
+        // What a C++ method reads is invisible here: a condition that calls one watches every property
+        // of the instance (a null property: see on_change).
+        if (deps_ != nullptr) deps_->emplace_back(o.id(), nullptr);
         const MetaMethod& m = *methods_[in.b];
         const auto& kinds = method_kinds_[in.b];
         std::vector<Value> args;

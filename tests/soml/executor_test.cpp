@@ -11,6 +11,20 @@
 #include "vsd/core.hpp"
 #include "vsd/soml.hpp"
 
+namespace exec_test {
+
+// A plant whose state a C++ method interprets: the script cannot see what full() reads.
+class MethodTank : public vsd::Node {
+  VSD_INSTANCE(MethodTank, vsd::Node)
+  VSD_PROPERTY(double, level, 0.0)
+  VSD_PROPERTY(double, limit, 0.8)
+ public:
+  bool full() { return level() > limit(); }
+  VSD_METHOD(full)
+};
+
+}  // namespace exec_test
+
 namespace {
 
 using ::testing::HasSubstr;
@@ -191,6 +205,43 @@ arrow alarm -> armed;
   EXPECT_EQ(p.run_until_quiet(), 1u);
   EXPECT_EQ(plant.name(), "cooling");  // the command gamma
   EXPECT_EQ(p.root().get<std::int64_t>("alarms"), 1);
+}
+
+// A condition that calls a C++ method is re-tested when any property of that instance changes (the
+// method's reads are invisible to the VM), and not when other instances change.
+TEST(ExecMethods, AConditionCallingACppMethodIsRetestedWhenItsInstanceChanges) {
+  vsd::Registry reg;
+  reg.add<exec_test::MethodTank>();
+  vsd::Environment env{0, reg};
+  auto& soml = env.use<vsd::soml::Module>();
+  auto& tank = env.main_state().create<exec_test::MethodTank>();
+  env.main_state().database().add_child(tank);
+  auto& other = env.main_state().create<exec_test::MethodTank>();
+  env.main_state().database().add_child(other);
+  std::ostringstream out;
+  vsd::soml::RunOptions o;
+  o.out = &out;
+  Program& p = soml.load(env.main_state(), "net.soml", R"(
+shared<MethodTank> tank;
+place watching = 1;
+place alarm;
+transition overflow { when tank != null && tank.full(); }
+arrow watching -> overflow;
+arrow overflow -> alarm;
+)",
+                         o);
+  p.root().set("tank", vsd::Value(vsd::SharedRef<vsd::Node>(&tank)));
+  EXPECT_EQ(p.run_until_quiet(), 0u);
+  const auto tests = p.condition_tests();
+  other.set_level(5.0);  // another instance: nothing to re-test
+  EXPECT_EQ(p.run_until_quiet(), 0u);
+  EXPECT_EQ(p.condition_tests(), tests);
+  tank.set_level(0.5);  // read by full(): re-tested, still false
+  EXPECT_EQ(p.run_until_quiet(), 0u);
+  EXPECT_EQ(p.condition_tests(), tests + 1);
+  tank.set_limit(0.4);  // also read by full(), never named in the script: now true
+  EXPECT_EQ(p.run_until_quiet(), 1u);
+  EXPECT_EQ(p.place("alarm")->count(), 1);
 }
 
 TEST_F(Exec, OnlyWhatTheLastTestReadIsWatched) {
