@@ -368,7 +368,7 @@ LoadReport LoadModel::apply(SimState& state, Node* parent) {
   }
   // made[i]: what instances_[i] became. The file's Database is the target's Database, or the node loaded
   // under (its children become the node's and references to it point at the node).
-  std::vector<SimStateInstance*> made(instances_.size(), nullptr);
+  BigVector<SimStateInstance*> made(instances_.size(), nullptr);
   for (std::size_t i = 0; i < instances_.size(); ++i) {
     const SavedInstance& x = instances_[i];
     if (&x == saved_root) {
