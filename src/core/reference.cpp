@@ -253,18 +253,27 @@ bool operator==(const RefListBase& a, const RefListBase& b) noexcept {
   return true;
 }
 
-void RefListBase::insert_at(std::size_t i, SimStateInstance* p) {
+namespace {
+// Throws what inserting @p p at @p i into a list of @p size elements is wrong about, if anything.
+void check_insert(std::size_t i, const SimStateInstance* p, std::size_t size) {
   if (p == nullptr) detail::throw_error("a reference list cannot hold null");
-  if (i > links_.size())
+  if (i > size)
     detail::throw_error("index " + std::to_string(i) + " is past the end of a list of " +
-                        std::to_string(links_.size()));
+                        std::to_string(size));
+}
+}  // namespace
+
+void RefListBase::insert_at(std::size_t i, SimStateInstance* p) {
+  check_insert(i, p, links_.size());
   insert_link(i, p, new detail::RefLink(composite_));
 }
 
 void RefListBase::insert_link(std::size_t i, SimStateInstance* p, detail::RefLink* l) {
-  if (p == nullptr || i > links_.size()) {
+  try {
+    check_insert(i, p, links_.size());
+  } catch (...) {
     detail::free_link(l);
-    insert_at(i, p);  // throws the error
+    throw;
   }
   l->holder = holder_;
   l->prop = prop_;
