@@ -2,8 +2,56 @@
 #include "vsd/core/detail/instance_pool.hpp"
 
 #include <algorithm>
+#include <cstdint>
+
+#include "vsd/core/detail/huge_pages.hpp"
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 namespace vsd::detail {
+
+// ---- huge pages (huge_pages.hpp; here, with the pool, their first user) ----------------------------------
+
+void advise_huge_pages(void* p, std::size_t bytes) noexcept {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  constexpr std::uintptr_t page = huge_page_bytes;
+  const auto from = reinterpret_cast<std::uintptr_t>(p);
+  const auto first = (from + page - 1) & ~(page - 1);
+  const auto last = (from + bytes) & ~(page - 1);
+  // Fails (EINVAL) where the kernel has no transparent huge pages: the memory is used as it is.
+  if (last > first) (void)::madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
+#else
+  (void)p;
+  (void)bytes;
+#endif
+}
+
+void* allocate_big(std::size_t bytes, std::size_t align) {
+  if (bytes < huge_block_bytes) {
+    return align <= __STDCPP_DEFAULT_NEW_ALIGNMENT__ ? ::operator new(bytes)
+                                                     : ::operator new(bytes, std::align_val_t(align));
+  }
+  // Aligned to a huge page, so that every huge page of it can be one (malloc gives such a block fresh
+  // pages of its own, untouched: the advice comes before the first fault).
+  void* p = ::operator new(bytes, std::align_val_t(std::max(align, huge_page_bytes)));
+  advise_huge_pages(p, bytes);
+  return p;
+}
+
+void free_big(void* p, std::size_t bytes, std::size_t align) noexcept {
+  if (bytes < huge_block_bytes) {
+    if (align <= __STDCPP_DEFAULT_NEW_ALIGNMENT__)
+      ::operator delete(p);
+    else
+      ::operator delete(p, std::align_val_t(align));
+    return;
+  }
+  ::operator delete(p, std::align_val_t(std::max(align, huge_page_bytes)));
+}
+
+// ---- InstancePool -----------------------------------------------------------------------------------------
 
 namespace {
 // Chunks start small (a state with a handful of instances of a class wastes little) and double up to
@@ -35,7 +83,7 @@ void InstancePool::add_chunk(PerClass& c, std::size_t count) {
   }
   chunks_.reserve(chunks_.size() + 1);  // nothing below may fail after the allocation
   const std::size_t bytes = c.stride * count;
-  void* memory = ::operator new(bytes, std::align_val_t(c.align));
+  void* memory = allocate_big(bytes, c.align);
   chunks_.push_back(Chunk{memory, bytes, c.align});
   c.next = static_cast<char*>(memory);
   c.end = c.next + bytes;
@@ -51,10 +99,15 @@ void* InstancePool::refill(const MetaInstance& cls) {
 }
 
 void InstancePool::reserve(const MetaInstance& cls, std::size_t count) {
-  // Room comes in chunks of at most chunk_bytes_cap, not in one block for all: chunks that size come
-  // from (and go back to) the allocator's heap, where one huge block would be fresh pages from the
-  // kernel, faulted in one by one, on every load.
+  // Up to huge_block_bytes, room comes in chunks of at most chunk_bytes_cap, not in one block for all:
+  // chunks that size come from (and go back to) the allocator's heap, where one block would be fresh
+  // pages from the kernel, faulted in one by one, on every load. Beyond it the memory is fresh pages
+  // anyway (the heap would grow by as much): one chunk for all, in huge pages where the system has them.
   PerClass& c = per_class(cls);
+  if (count >= huge_block_bytes / c.stride && c.free == nullptr) {  // (a free list is used up first)
+    if (static_cast<std::size_t>(c.end - c.next) / c.stride < count) add_chunk(c, count);
+    return;
+  }
   const std::size_t cap = std::max<std::size_t>(1, chunk_bytes_cap / c.stride);
   c.chunk = std::max(c.chunk, std::min(count, cap));
 }
@@ -62,7 +115,7 @@ void InstancePool::reserve(const MetaInstance& cls, std::size_t count) {
 void InstancePool::release() noexcept {
   for (const Chunk& k : chunks_) {
     VSD_POOL_UNPOISON(k.memory, k.bytes);
-    ::operator delete(k.memory, std::align_val_t(k.align));
+    free_big(k.memory, k.bytes, k.align);
   }
   chunks_.clear();
   classes_.clear();

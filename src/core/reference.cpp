@@ -2,10 +2,13 @@
 #include "vsd/core/reference.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <string>
 
 #include "vsd/core/bytes.hpp"
+#include "vsd/core/detail/huge_pages.hpp"
+#include "vsd/core/detail/instance_pool.hpp"  // VSD_POOL_POISON
 #include "vsd/core/error.hpp"
 #include "vsd/core/instance.hpp"
 #include "vsd/core/sim_state.hpp"
@@ -131,6 +134,62 @@ struct RefAccess {
   static std::vector<RefLink*>& links(RefListBase& r) noexcept { return r.links_; }
 };
 
+// ---- LinkBlock: a header, then the links -----------------------------------------------------------------
+
+struct LinkBlockHeader {
+  // Links still alive or still to be made, plus one while the maker lives. Atomic: a link in a free
+  // Value may be freed on another thread than the one still building or editing the state.
+  std::atomic<std::size_t> shares;
+  std::size_t bytes;
+};
+
+namespace {
+constexpr std::size_t link_header =
+    (sizeof(LinkBlockHeader) + alignof(RefLink) - 1) / alignof(RefLink) * alignof(RefLink);
+RefLink* links_of(void* header) noexcept {
+  return reinterpret_cast<RefLink*>(static_cast<char*>(header) + link_header);
+}
+void give_up(LinkBlockHeader* h, std::size_t n) noexcept {
+  if (h->shares.fetch_sub(n, std::memory_order_acq_rel) != n) return;
+  const std::size_t bytes = h->bytes;
+  h->~LinkBlockHeader();
+  VSD_POOL_UNPOISON(h, bytes);
+  free_big(h, bytes, alignof(LinkBlockHeader));
+}
+}  // namespace
+
+LinkBlock::LinkBlock(std::size_t count) {
+  count = std::min<std::size_t>(count, UINT32_MAX - 1);
+  if (count == 0) return;
+  const std::size_t bytes = link_header + count * sizeof(RefLink);
+  void* memory = allocate_big(bytes, alignof(LinkBlockHeader));
+  block_ = ::new (memory) LinkBlockHeader{{count + 1}, bytes};
+  count_ = static_cast<std::uint32_t>(count);
+}
+
+LinkBlock::~LinkBlock() {
+  if (block_ != nullptr) give_up(block_, count_ - next_ + 1);  // the unused rest and the maker's share
+}
+
+RefLink* LinkBlock::make(bool composite) {
+  if (next_ == count_) return new RefLink(composite);
+  RefLink* l = ::new (links_of(block_) + next_) RefLink(composite);
+  l->block_slot = ++next_;
+  return l;
+}
+
+void free_link(RefLink* l) noexcept {
+  if (l->block_slot == 0) {
+    delete l;
+    return;
+  }
+  auto* h =
+      reinterpret_cast<LinkBlockHeader*>(reinterpret_cast<char*>(l - (l->block_slot - 1)) - link_header);
+  l->~RefLink();  // may release a subtree, freeing other links of the block: its own share goes last
+  VSD_POOL_POISON(l, sizeof(RefLink));
+  give_up(h, 1);
+}
+
 void RefLink::reset(SimStateInstance* t) { RefAccess::reset(*this, t); }
 void RefLink::drop() noexcept { RefAccess::drop(*this); }
 void RefLink::revert() noexcept { RefAccess::revert(*this); }
@@ -156,12 +215,12 @@ RefListBase& RefListBase::operator=(const RefListBase& o) {
   } catch (...) {
     for (auto* l : links_) {  // undo, not release: instances this list adopted float again
       l->revert();
-      delete l;
+      detail::free_link(l);
     }
     links_ = std::move(old);
     throw;
   }
-  for (auto* l : old) delete l;
+  for (auto* l : old) detail::free_link(l);
   return *this;
 }
 
@@ -194,25 +253,41 @@ bool operator==(const RefListBase& a, const RefListBase& b) noexcept {
   return true;
 }
 
-void RefListBase::insert_at(std::size_t i, SimStateInstance* p) {
+namespace {
+// Throws what inserting @p p at @p i into a list of @p size elements is wrong about, if anything.
+void check_insert(std::size_t i, const SimStateInstance* p, std::size_t size) {
   if (p == nullptr) detail::throw_error("a reference list cannot hold null");
-  if (i > links_.size())
+  if (i > size)
     detail::throw_error("index " + std::to_string(i) + " is past the end of a list of " +
-                        std::to_string(links_.size()));
-  auto* l = new detail::RefLink(composite_);
+                        std::to_string(size));
+}
+}  // namespace
+
+void RefListBase::insert_at(std::size_t i, SimStateInstance* p) {
+  check_insert(i, p, links_.size());
+  insert_link(i, p, new detail::RefLink(composite_));
+}
+
+void RefListBase::insert_link(std::size_t i, SimStateInstance* p, detail::RefLink* l) {
+  try {
+    check_insert(i, p, links_.size());
+  } catch (...) {
+    detail::free_link(l);
+    throw;
+  }
   l->holder = holder_;
   l->prop = prop_;
   try {
     links_.insert(links_.begin() + static_cast<std::ptrdiff_t>(i), l);
   } catch (...) {
-    delete l;
+    detail::free_link(l);
     throw;
   }
   try {
     l->reset(p);
   } catch (...) {
     links_.erase(links_.begin() + static_cast<std::ptrdiff_t>(i));
-    delete l;
+    detail::free_link(l);
     throw;
   }
 }
@@ -223,7 +298,7 @@ void RefListBase::erase_at(std::size_t i) {
                         std::to_string(links_.size()));
   detail::RefLink* l = links_[i];
   links_.erase(links_.begin() + static_cast<std::ptrdiff_t>(i));
-  delete l;  // releases last: a cascade sees the list already updated
+  detail::free_link(l);  // releases last: a cascade sees the list already updated
 }
 
 void RefListBase::clear_all() {

@@ -138,6 +138,7 @@ StateBuilder::StateBuilder(SimState& state) noexcept : state_(state) {
 }
 
 StateBuilder::~StateBuilder() {
+  delete links_;  // gives up the block's unused rest; its links keep the block
   --state_.applying_;
   if (--state_.dispatching_ == 0 && !state_.graveyard_.empty()) state_.free_graveyard();
 }
@@ -150,6 +151,12 @@ void StateBuilder::reserve(const MetaInstance& cls, std::size_t count) {
 
 void StateBuilder::reserve_ids(std::size_t count) { state_.by_id_.reserve(state_.by_id_.size() + count); }
 
+void StateBuilder::reserve_links(std::size_t count) {
+  auto* block = new LinkBlock(count);
+  delete links_;
+  links_ = block;
+}
+
 SimStateInstance& StateBuilder::make(const MetaInstance& cls, Id id) { return state_.make(cls, id); }
 
 void StateBuilder::finish_create(SimStateInstance& x) { state_.finish_create(x); }
@@ -157,13 +164,17 @@ void StateBuilder::finish_create(SimStateInstance& x) { state_.finish_create(x);
 namespace {
 struct ListAppend : RefListBase {  // the builder's access to a list's editing operation
   using RefListBase::insert_at;
+  using RefListBase::insert_link;
 };
 }  // namespace
 
 void StateBuilder::append(SimStateInstance& holder, const MetaProperty& p, SimStateInstance& target) {
   auto& list = *static_cast<RefListBase*>(const_cast<void*>(p.address(holder)));
   const std::size_t index = list.size();
-  static_cast<ListAppend&>(list).insert_at(index, &target);
+  if (links_ != nullptr)
+    static_cast<ListAppend&>(list).insert_link(index, &target, links_->make(list.is_composite()));
+  else
+    static_cast<ListAppend&>(list).insert_at(index, &target);
   state_.list_changed(holder, p, index, target, true);
 }
 

@@ -366,9 +366,15 @@ LoadReport LoadModel::apply(SimState& state, Node* parent) {
     build.reserve_ids(creates);
     for (const auto& [cls, n] : per_class) build.reserve(*cls, n);
   }
+  // The links of all list elements in one block (a million elements: one allocation, not a million).
+  std::size_t links = roots_.size();
+  for (const SavedInstance& x : instances_)
+    for (const SavedValue& v : values_of(x))
+      if (v.slot->prop != nullptr && v.slot->prop->type().is_ref_list()) links += v.ids_count;
+  if (links >= 64) build.reserve_links(links);
   // made[i]: what instances_[i] became. The file's Database is the target's Database, or the node loaded
   // under (its children become the node's and references to it point at the node).
-  std::vector<SimStateInstance*> made(instances_.size(), nullptr);
+  BigVector<SimStateInstance*> made(instances_.size(), nullptr);
   for (std::size_t i = 0; i < instances_.size(); ++i) {
     const SavedInstance& x = instances_[i];
     if (&x == saved_root) {

@@ -18,6 +18,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "vsd/core/detail/huge_pages.hpp"
 #include "vsd/core/detail/id_map.hpp"
 #include "vsd/io/snapshot.hpp"
 
@@ -164,9 +165,12 @@ class LoadModel {
   std::uint8_t kind_ = kind_state;
   int version_ = 1;
   std::deque<ClassEntry> classes_;  // a deque: entries never move while instances point at them
-  std::vector<SavedInstance> instances_;
-  std::vector<SavedValue> values_;  // of all instances, in file order
-  std::vector<Id> ids_;             // reference targets of all values
+  // The big tables of a big file: in huge pages where the system gives them (huge_pages.hpp).
+  template <class T>
+  using BigVector = std::vector<T, vsd::detail::HugeAllocator<T>>;
+  BigVector<SavedInstance> instances_;
+  BigVector<SavedValue> values_;  // of all instances, in file order
+  BigVector<Id> ids_;             // reference targets of all values
   // "top" as the file gives it: the subtree's roots, or a state's top-level nodes (checked against what
   // its Database holds). has_top_ is false for a text file without "top"; top_at_ is where it starts.
   std::vector<Id> top_;

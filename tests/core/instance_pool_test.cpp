@@ -2,6 +2,8 @@
 // takes its ids in blocks, frees lone instances without a dispatch and reserves room for big bundles.
 // None of it may show: ids stay unique, signals and the graveyard rule hold, run-time classes keep their
 // trailing storage, and every SimState keeps its own memory.
+#include "vsd/core/detail/instance_pool.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "test_classes.hpp"
+#include "vsd/core/detail/huge_pages.hpp"
 #include "vsd/core/environment.hpp"
 #include "vsd/core/registry.hpp"
 #include "vsd/core/sim_state.hpp"
@@ -317,6 +320,52 @@ TEST(InstancePool, ADuplicateIdIsRejectedAndLeavesNothingBehind) {
   auto t = source.stop_recording().inverted();  // re-creates #r in the replica, which already has it
   EXPECT_THAT([&] { replica.apply(t); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("already exists")));
   EXPECT_EQ(replica.size(), 2u);
+}
+
+// A reservation of more than huge_block_bytes is one chunk, aligned to a huge page (so that the system
+// can back it with huge pages): the reserved instances lie back to back, and blocks given back are
+// reused before the rest of the chunk.
+TEST(InstancePool, ABigReservationIsOneHugePageAlignedChunk) {
+  const vsd::MetaInstance& cls = TRobot::static_meta();
+  const std::size_t count = vsd::detail::huge_block_bytes / cls.size() + 10;
+  vsd::detail::InstancePool pool;
+  pool.reserve(cls, count);
+  std::vector<void*> blocks;
+  blocks.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) blocks.push_back(pool.allocate(cls));
+  EXPECT_EQ(address(blocks.front()) % vsd::detail::huge_page_bytes, 0U);
+  const std::size_t stride = address(blocks[1]) - address(blocks[0]);
+  EXPECT_GE(stride, cls.size());
+  for (std::size_t i = 1; i < count; ++i) ASSERT_EQ(address(blocks[i]) - address(blocks[i - 1]), stride) << i;
+  pool.deallocate(cls, blocks[5]);
+  EXPECT_EQ(pool.allocate(cls), blocks[5]);
+  // Past the reservation, chunks are the usual small ones again.
+  const void* more = pool.allocate(cls);
+  EXPECT_TRUE(address(more) < address(blocks.front()) || address(more) >= address(blocks.back()) + stride);
+}
+
+// Reserving after deletes uses up the free blocks first (no huge chunk for a state that has room).
+TEST(InstancePool, ABigReservationWithFreeBlocksAddsNoHugeChunk) {
+  const vsd::MetaInstance& cls = TRobot::static_meta();
+  vsd::detail::InstancePool pool;
+  void* a = pool.allocate(cls);
+  pool.deallocate(cls, a);
+  pool.reserve(cls, vsd::detail::huge_block_bytes / cls.size() + 10);
+  EXPECT_EQ(pool.allocate(cls), a);
+}
+
+// HugeAllocator: a vector that grows past huge_block_bytes keeps its elements and gets a block aligned
+// to a huge page; a small one is plain memory.
+TEST(HugePages, AVectorGrowsThroughTheThreshold) {
+  std::vector<std::uint64_t, vsd::detail::HugeAllocator<std::uint64_t>> v;
+  const std::size_t n = vsd::detail::huge_block_bytes / sizeof(std::uint64_t) * 2;
+  for (std::size_t i = 0; i < n; ++i) v.push_back(i * 3);
+  for (std::size_t i = 0; i < n; i += 4097) ASSERT_EQ(v[i], i * 3);
+  EXPECT_EQ(address(v.data()) % vsd::detail::huge_page_bytes, 0U);
+  v.resize(10);
+  v.shrink_to_fit();
+  EXPECT_EQ(v.back(), 27U);
+  vsd::detail::advise_huge_pages(v.data(), 0);  // advice on nothing: a no-op
 }
 
 }  // namespace

@@ -20,6 +20,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string_view>
 #include <type_traits>
 #include <vector>
@@ -44,6 +45,9 @@ struct RefLink {
   RefLink* next = nullptr;
   bool composite = false;
   bool adopted = false;  // this link ended its target's floating state (revert() restores it)
+  // 0: a link of its own (a RefBase's, or a list's made with new); else its place + 1 in a LinkBlock.
+  // (In the padding: a link stays 48 bytes.)
+  std::uint32_t block_slot = 0;
 
   explicit RefLink(bool is_composite) noexcept : composite(is_composite) {}
   RefLink(const RefLink&) = delete;
@@ -59,6 +63,31 @@ struct RefLink {
   /// Undoes this link as if it had never been made: the count goes back and a target it adopted floats
   /// again, so nothing is deleted. For the rollback of an operation that failed half way.
   void revert() noexcept;
+};
+
+/// Frees a link of a list: deletes it, or (one of a LinkBlock) destroys it in place and gives up its
+/// share of the block.
+void free_link(RefLink* l) noexcept;
+
+/// The links of many list elements made together (a load), in one block instead of one allocation each.
+/// A block belongs to its links, not to the maker or a SimState: it is freed when its last link is freed
+/// (links can outlive their SimState, e.g. in a list moved into a free Value), and the maker's unused rest
+/// is given up when the maker dies. So the memory of a load's links goes back when the last of them goes.
+struct LinkBlockHeader;  // reference.cpp
+class LinkBlock {
+ public:
+  /// Room for @p count links (none made yet). @throws std::bad_alloc
+  explicit LinkBlock(std::size_t count);
+  LinkBlock(const LinkBlock&) = delete;
+  LinkBlock& operator=(const LinkBlock&) = delete;
+  ~LinkBlock();
+  /// A new, unlinked link from the block; from the heap when the block is used up.
+  RefLink* make(bool composite);
+
+ private:
+  LinkBlockHeader* block_ = nullptr;
+  std::uint32_t next_ = 0;
+  std::uint32_t count_ = 0;
 };
 
 }  // namespace detail
@@ -158,6 +187,8 @@ class RefListBase {
  protected:
   explicit RefListBase(bool composite) noexcept : composite_(composite) {}
   void insert_at(std::size_t i, SimStateInstance* p);
+  /// insert_at() with a link made by the caller (a LinkBlock's); freed with free_link() if it fails.
+  void insert_link(std::size_t i, SimStateInstance* p, detail::RefLink* l);
   void erase_at(std::size_t i);
   void clear_all();
 

@@ -18,6 +18,8 @@
 
 namespace vsd::detail {
 
+class LinkBlock;
+
 class StateBuilder {
  public:
   /// @brief Starts building into @p state (it counts as applying until the builder dies).
@@ -33,6 +35,9 @@ class StateBuilder {
   void reserve(const MetaInstance& cls, std::size_t count);
   /// @brief Makes room in the id map for @p count more instances.
   void reserve_ids(std::size_t count);
+  /// @brief Makes the links of the next @p count list elements appended in one block (a LinkBlock:
+  /// freed when its last link is freed) instead of one allocation each.
+  void reserve_links(std::size_t count);
   /// @brief A new instance of @p cls with id @p id and its default values; it is neither announced nor
   /// recorded before finish_create(). @throws vsd::Error when the id is taken.
   SimStateInstance& make(const MetaInstance& cls, Id id);
@@ -45,6 +50,7 @@ class StateBuilder {
 
  private:
   SimState& state_;
+  LinkBlock* links_ = nullptr;
 };
 
 }  // namespace vsd::detail
