@@ -42,6 +42,9 @@ inline V2 v2(double a, double b) noexcept { return V2{{a, b}}; }
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
 #define VSD_FK_AVX 1
 using V4 = double __attribute__((vector_size(32)));
+// The four-wide stores below write one value past a rotation column: into the next column, or for the
+// last column into the translation, which must follow the rotation directly.
+static_assert(sizeof(Frame) == 12 * sizeof(double), "Frame: rotation then translation, no padding");
 
 __attribute__((target("avx"), always_inline)) inline V4 ld(const double* v) noexcept {
   V4 r;
