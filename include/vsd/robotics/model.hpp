@@ -130,6 +130,10 @@ class Model {
   /// @brief A Data sized for this model.
   [[nodiscard]] Data make_data() const;
   /// @brief Forward kinematics of every body for joint vector @p q (dof() values, layout order).
+  ///
+  /// On x86 with AVX (detected when the model is built) coordinate-axis joints run in a four-lane form;
+  /// elsewhere, or with the environment variable VSD_ROBOTICS_NO_AVX=1 set when the model is built, in
+  /// the portable SSE2 form. Both give the same frames bit for bit.
   void forward(const double* q, Data& data) const noexcept;
   /// @brief Forward kinematics; @throws vsd::Error when @p q does not have dof() values.
   void forward(std::span<const double> q, Data& data) const;
