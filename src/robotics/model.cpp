@@ -2,7 +2,10 @@
 #include "vsd/robotics/model.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <unordered_map>
 
@@ -30,6 +33,137 @@ inline V2 v2(double a, double b) noexcept { return V2{{a, b}}; }
 #endif
 
 [[noreturn]] void fail(const std::string& msg) { throw vsd::Error(msg); }
+
+// The AVX form of forward kinematics: x86 with GCC or Clang, chosen at run time (the library is built for
+// baseline x86-64). Four lanes per operation, a 3x3 column in one register, and the fast form's constants
+// stored broadcast to four lanes, so that the products take them straight from memory (no shuffles).
+// No FMA: the same products and sums in the same order as the SSE2 form, so the same results bit for bit
+// on every machine.
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define VSD_FK_AVX 1
+using V4 = double __attribute__((vector_size(32)));
+// The four-wide stores below write one value past a rotation column: into the next column, or for the
+// last column into the translation, which must follow the rotation directly.
+static_assert(sizeof(Frame) == 12 * sizeof(double), "Frame: rotation then translation, no padding");
+
+__attribute__((target("avx"), always_inline)) inline V4 ld(const double* v) noexcept {
+  V4 r;
+  std::memcpy(&r, v, sizeof r);
+  return r;
+}
+
+bool avx_available() {
+  const char* off = std::getenv("VSD_ROBOTICS_NO_AVX");
+  if (off != nullptr && *off != '\0' && *off != '0') return false;
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx") != 0;
+}
+
+// detail::sincos_batch with four angles per operation (the same operations, so the same results).
+__attribute__((target("avx"))) void sincos_batch_avx(const double* x, double* s, double* c,
+                                                     std::size_t n) noexcept {
+  using namespace detail;
+  std::size_t i = 0;
+  const V4 zero = {0.0, 0.0, 0.0, 0.0};
+  auto ok = zero == zero;  // lanes of all ones
+  for (; i + 4 <= n; i += 4) {
+    V4 xv;
+    std::memcpy(&xv, x + i, sizeof xv);
+    ok &= (xv < sincos_limit) & (xv > -sincos_limit);  // zero for NaN
+    const V4 r = xv * sincos_64_over_pi + sincos_shifter;
+    const V4 y = r - sincos_shifter;
+    const V4 z = (xv - y * sincos_pi_64_hi) - y * sincos_pi_64_lo;
+    const V4 zz = z * z;
+    const V4 sz = z + (z * zz) * ((sincos_s3 * zz + sincos_s2) * zz + sincos_s1);
+    const V4 cm1 = zz * ((sincos_c3 * zz + sincos_c2) * zz + sincos_c1);
+    std::size_t k[4];
+    for (int l = 0; l < 4; ++l) k[l] = static_cast<std::size_t>(std::bit_cast<std::uint64_t>(r[l]) & 127U);
+    const V4 st = {sincos_table[k[0]][0], sincos_table[k[1]][0], sincos_table[k[2]][0],
+                   sincos_table[k[3]][0]};
+    const V4 ct = {sincos_table[k[0]][1], sincos_table[k[1]][1], sincos_table[k[2]][1],
+                   sincos_table[k[3]][1]};
+    const V4 sv = st + (st * cm1 + ct * sz);
+    const V4 cv = ct + (ct * cm1 - st * sz);
+    std::memcpy(s + i, &sv, sizeof sv);
+    std::memcpy(c + i, &cv, sizeof cv);
+  }
+  if (!(ok[0] && ok[1] && ok[2] && ok[3])) i = 0;  // a value out of range: the scalar form for all
+  for (; i < n; ++i) detail::sincos(x[i], s[i], c[i]);
+}
+
+// Segments i, i+1, ... in the fast form, up to the first one in the general form (whose index it
+// returns) or n. M (the product before the segment's perm) is kept in p0..p2 by columns (lane 3 unused)
+// and pt; A = C * Rz(v) is formed entry by entry already broadcast (A(k,0) = c B(k,0) + s B(k,1),
+// A(k,1) = c B(k,1) - s B(k,0), A(k,2) = B(k,2)), then M' = M * A column by column.
+__attribute__((target("avx"))) std::size_t fast_run_avx(const detail::FkStep* steps, std::size_t i,
+                                                        std::size_t n, Frame* out, const double* sines,
+                                                        const double* cosines) noexcept {
+  V4 p0 = {}, p1 = {}, p2 = {}, pt = {};
+  for (; i < n; ++i) {
+    const detail::FkStep& st = steps[i];
+    if (st.mode == 0) return i;
+    const double cv = cosines[i], sv = sines[i];
+    const V4 c = {cv, cv, cv, cv}, s = {sv, sv, sv, sv};
+    if (st.mode == 1) {
+      // The base: M = A, t = pre.p.
+      V4 k0, w0, k1, w1;
+      std::memcpy(&k0, st.col[0], sizeof k0);
+      std::memcpy(&w0, st.col[1], sizeof w0);
+      std::memcpy(&k1, st.col[2], sizeof k1);
+      std::memcpy(&w1, st.col[3], sizeof w1);
+      std::memcpy(&p2, st.col[4], sizeof p2);
+      std::memcpy(&pt, st.col[5], sizeof pt);
+      p0 = c * k0 + s * w0;
+      p1 = c * k1 + s * w1;
+    } else {
+      if (st.mode == 3) {
+        // The parent's frame from memory (columns 0 and 1 read one value past their end: lane 3).
+        const double* pr = out[st.parent].rotation.data();
+        const double* ptr = out[st.parent].translation.data();
+        std::memcpy(&p0, pr, sizeof p0);
+        std::memcpy(&p1, pr + 3, sizeof p1);
+        p2 = V4{pr[6], pr[7], pr[8], 0.0};
+        pt = V4{ptr[0], ptr[1], ptr[2], 0.0};
+      }
+      const auto& b = st.bcast;
+      // The translation first (it needs the parent's M), over the nonzero components of pre.p.
+      if (st.mask & 1U) pt = pt + p0 * ld(b[0][5]);
+      if (st.mask & 2U) pt = pt + p1 * ld(b[1][5]);
+      if (st.mask & 4U) pt = pt + p2 * ld(b[2][5]);
+      const V4 a00 = c * ld(b[0][0]) + s * ld(b[0][1]);
+      const V4 a10 = c * ld(b[1][0]) + s * ld(b[1][1]);
+      const V4 a20 = c * ld(b[2][0]) + s * ld(b[2][1]);
+      const V4 a01 = c * ld(b[0][2]) + s * ld(b[0][3]);
+      const V4 a11 = c * ld(b[1][2]) + s * ld(b[1][3]);
+      const V4 a21 = c * ld(b[2][2]) + s * ld(b[2][3]);
+      const V4 n0 = p0 * a00 + p1 * a10 + p2 * a20;
+      const V4 n1 = p0 * a01 + p1 * a11 + p2 * a21;
+      const V4 n2 = p0 * ld(b[0][4]) + p1 * ld(b[1][4]) + p2 * ld(b[2][4]);
+      p0 = n0;
+      p1 = n1;
+      p2 = n2;
+    }
+    // Columns in frame order, each store four wide: lane 3 lands on the next column's first entry (or
+    // the translation's), which the next store overwrites; the translation last, three wide.
+    double* r = out[i].rotation.data();
+    if (st.identity_perm != 0) {
+      std::memcpy(r, &p0, sizeof p0);
+      std::memcpy(r + 3, &p1, sizeof p1);
+      std::memcpy(r + 6, &p2, sizeof p2);
+    } else {
+      const V4 cols[3] = {p0, p1, p2};
+      for (int d = 0; d < 3; ++d) std::memcpy(r + 3 * d, &cols[st.dest_src[d]], sizeof(V4));
+    }
+    double* t = out[i].translation.data();
+    t[0] = pt[0];
+    t[1] = pt[1];
+    t[2] = pt[2];
+  }
+  return n;
+}
+#else
+bool avx_available() { return false; }
+#endif
 
 bool is_identity(const Frame& f) { return f.rotation.isIdentity(0.0) && f.translation.isZero(0.0); }
 
@@ -205,6 +339,30 @@ Model Model::build(std::span<const JointSpec> specs) {
       if (seg.c_translation[j] != 0.0) seg.c_mask |= static_cast<std::uint8_t>(1U << j);
     }
   }
+  if (avx_available()) {
+    m.steps_.resize(m.segments_.size());
+    for (std::size_t i = 0; i < m.segments_.size(); ++i) {
+      const Segment& seg = m.segments_[i];
+      detail::FkStep& st = m.steps_[i];
+      st.parent = seg.parent;
+      if (!seg.fast) continue;  // mode 0: the general form
+      st.mode = seg.parent < 0 ? 1 : seg.chained ? 2 : 3;
+      const auto& row = seg.chained ? seg.c_row : seg.b_row;
+      const auto& swp = seg.chained ? seg.c_swap : seg.b_swap;
+      const double* col2 = seg.chained ? seg.c_col2 : seg.b_col2;
+      const double* lt = seg.chained ? seg.c_translation : seg.pre.translation.data();
+      st.mask = seg.chained ? seg.c_mask : seg.pre_translation_mask;
+      for (int k = 0; k < 3; ++k) {
+        const double vals[6] = {row[k][0], swp[k][0], row[k][1], swp[k][1], col2[k], lt[k]};
+        for (int e = 0; e < 6; ++e) {
+          for (int l = 0; l < 4; ++l) st.bcast[k][e][l] = vals[e];
+          st.col[e][k] = vals[e];
+        }
+      }
+      for (int c = 0; c < 3; ++c) st.dest_src[seg.perm[c]] = static_cast<std::uint8_t>(c);
+      st.identity_perm = seg.perm[0] == 0 && seg.perm[1] == 1 && seg.perm[2] == 2 ? 1 : 0;
+    }
+  }
   m.body_segment_ = std::move(body_seg);
   return m;
 }
@@ -346,6 +504,20 @@ void Model::forward(const double* q, Data& data) const noexcept {
     const double v = s.dof >= 0 ? s.multiplier * q[s.dof] + s.offset : 0.0;
     values[i] = v;
   }
+#if VSD_FK_AVX
+  if (!steps_.empty()) {
+    sincos_batch_avx(values, sines, cosines, n);
+    for (std::size_t i = 0; i < n;) {
+      if (steps_[i].mode == 0) {
+        general_segment(i, out, values, sines, cosines);
+        ++i;
+      } else {
+        i = fast_run_avx(steps_.data(), i, n, out, sines, cosines);
+      }
+    }
+    return;
+  }
+#endif
   detail::sincos_batch(values, sines, cosines, n);
   // The previous fast segment's product M (before its perm), kept in registers by columns: topC holds
   // rows 0 and 1 of column C, bot01 row 2 of columns 0 and 1, bot2 = M(2, 2); the translation likewise
@@ -431,87 +603,93 @@ void Model::forward(const double* q, Data& data) const noexcept {
       t[2] = t2;
       continue;
     }
-    double* r = out[i].rotation.data();  // r[c * 3 + row]
-    double* t = out[i].translation.data();
-    const double v = values[i];
-    // Rotation of the frame after pre, times the joint's motion, in local (pre) coordinates first.
-    double a[9];  // pre rotation * motion rotation, column-major
-    const double* pr = s.pre.rotation.data();
-    const double sn = sines[i], cs = cosines[i];
-    switch (s.motion) {
-      case Motion::RotX:
-        for (int k = 0; k < 3; ++k) {
-          a[k] = pr[k];
-          a[3 + k] = cs * pr[3 + k] + sn * pr[6 + k];
-          a[6 + k] = cs * pr[6 + k] - sn * pr[3 + k];
-        }
-        break;
-      case Motion::RotY:
-        for (int k = 0; k < 3; ++k) {
-          a[k] = cs * pr[k] - sn * pr[6 + k];
-          a[3 + k] = pr[3 + k];
-          a[6 + k] = sn * pr[k] + cs * pr[6 + k];
-        }
-        break;
-      case Motion::RotZ:
-        for (int k = 0; k < 3; ++k) {
-          a[k] = cs * pr[k] + sn * pr[3 + k];
-          a[3 + k] = cs * pr[3 + k] - sn * pr[k];
-          a[6 + k] = pr[6 + k];
-        }
-        break;
-      case Motion::Rot: {
-        const Eigen::Vector3d& ax = s.axis;
-        Eigen::Matrix3d k;
-        k << 0, -ax.z(), ax.y(), ax.z(), 0, -ax.x(), -ax.y(), ax.x(), 0;
-        const Eigen::Matrix3d m =
-            s.pre.rotation * (Eigen::Matrix3d::Identity() * cs + sn * k + (1.0 - cs) * (ax * ax.transpose()));
-        for (int k2 = 0; k2 < 9; ++k2) a[k2] = m.data()[k2];
-        break;
+    general_segment(i, out, values, sines, cosines);
+  }
+}
+
+void Model::general_segment(std::size_t i, Frame* out, const double* values, const double* sines,
+                            const double* cosines) const noexcept {
+  const Segment& s = segments_[i];
+  double* r = out[i].rotation.data();  // r[c * 3 + row]
+  double* t = out[i].translation.data();
+  const double v = values[i];
+  // Rotation of the frame after pre, times the joint's motion, in local (pre) coordinates first.
+  double a[9];  // pre rotation * motion rotation, column-major
+  const double* pr = s.pre.rotation.data();
+  const double sn = sines[i], cs = cosines[i];
+  switch (s.motion) {
+    case Motion::RotX:
+      for (int k = 0; k < 3; ++k) {
+        a[k] = pr[k];
+        a[3 + k] = cs * pr[3 + k] + sn * pr[6 + k];
+        a[6 + k] = cs * pr[6 + k] - sn * pr[3 + k];
       }
-      default:
-        for (int k = 0; k < 9; ++k) a[k] = pr[k];
-        break;
+      break;
+    case Motion::RotY:
+      for (int k = 0; k < 3; ++k) {
+        a[k] = cs * pr[k] - sn * pr[6 + k];
+        a[3 + k] = pr[3 + k];
+        a[6 + k] = sn * pr[k] + cs * pr[6 + k];
+      }
+      break;
+    case Motion::RotZ:
+      for (int k = 0; k < 3; ++k) {
+        a[k] = cs * pr[k] + sn * pr[3 + k];
+        a[3 + k] = cs * pr[3 + k] - sn * pr[k];
+        a[6 + k] = pr[6 + k];
+      }
+      break;
+    case Motion::Rot: {
+      const Eigen::Vector3d& ax = s.axis;
+      Eigen::Matrix3d k;
+      k << 0, -ax.z(), ax.y(), ax.z(), 0, -ax.x(), -ax.y(), ax.x(), 0;
+      const Eigen::Matrix3d m =
+          s.pre.rotation * (Eigen::Matrix3d::Identity() * cs + sn * k + (1.0 - cs) * (ax * ax.transpose()));
+      for (int k2 = 0; k2 < 9; ++k2) a[k2] = m.data()[k2];
+      break;
     }
-    // Local translation: pre.p (+ pre.R axis v for a prismatic joint).
-    double lt[3] = {s.pre.translation[0], s.pre.translation[1], s.pre.translation[2]};
-    if (s.motion == Motion::Trans) {
-      for (int k = 0; k < 3; ++k)
-        lt[k] += v * (pr[k] * s.axis[0] + pr[3 + k] * s.axis[1] + pr[6 + k] * s.axis[2]);
-    }
-    if (!s.post_identity) {
-      // lt += a * post.p; a = a * post.R
-      const double* pp = s.post.translation.data();
-      const double* po = s.post.rotation.data();
-      for (int k = 0; k < 3; ++k) lt[k] += a[k] * pp[0] + a[3 + k] * pp[1] + a[6 + k] * pp[2];
-      double b[9];
-      for (int c = 0; c < 3; ++c)
-        for (int k = 0; k < 3; ++k)
-          b[c * 3 + k] = a[k] * po[c * 3] + a[3 + k] * po[c * 3 + 1] + a[6 + k] * po[c * 3 + 2];
-      for (int k = 0; k < 9; ++k) a[k] = b[k];
-    }
-    if (s.parent < 0) {
-      for (int k = 0; k < 9; ++k) r[k] = a[k];
-      for (int k = 0; k < 3; ++k) t[k] = lt[k];
-      continue;
-    }
-    const double* pr2 = out[s.parent].rotation.data();
-    const double* pt = out[s.parent].translation.data();
-    if (s.post_identity && s.motion != Motion::Trans) {
-      // lt is pre.p: URDF origins are mostly exact zeros, whose products the general form would add.
-      // The mask is fixed per segment, so these branches predict perfectly.
-      double tt[3] = {pt[0], pt[1], pt[2]};
-      for (int c = 0; c < 3; ++c)
-        if ((s.pre_translation_mask >> c) & 1U)
-          for (int k = 0; k < 3; ++k) tt[k] += pr2[c * 3 + k] * lt[c];
-      for (int k = 0; k < 3; ++k) t[k] = tt[k];
-    } else {
-      for (int k = 0; k < 3; ++k) t[k] = pt[k] + pr2[k] * lt[0] + pr2[3 + k] * lt[1] + pr2[6 + k] * lt[2];
-    }
+    default:
+      for (int k = 0; k < 9; ++k) a[k] = pr[k];
+      break;
+  }
+  // Local translation: pre.p (+ pre.R axis v for a prismatic joint).
+  double lt[3] = {s.pre.translation[0], s.pre.translation[1], s.pre.translation[2]};
+  if (s.motion == Motion::Trans) {
+    for (int k = 0; k < 3; ++k)
+      lt[k] += v * (pr[k] * s.axis[0] + pr[3 + k] * s.axis[1] + pr[6 + k] * s.axis[2]);
+  }
+  if (!s.post_identity) {
+    // lt += a * post.p; a = a * post.R
+    const double* pp = s.post.translation.data();
+    const double* po = s.post.rotation.data();
+    for (int k = 0; k < 3; ++k) lt[k] += a[k] * pp[0] + a[3 + k] * pp[1] + a[6 + k] * pp[2];
+    double b[9];
     for (int c = 0; c < 3; ++c)
       for (int k = 0; k < 3; ++k)
-        r[c * 3 + k] = pr2[k] * a[c * 3] + pr2[3 + k] * a[c * 3 + 1] + pr2[6 + k] * a[c * 3 + 2];
+        b[c * 3 + k] = a[k] * po[c * 3] + a[3 + k] * po[c * 3 + 1] + a[6 + k] * po[c * 3 + 2];
+    for (int k = 0; k < 9; ++k) a[k] = b[k];
   }
+  if (s.parent < 0) {
+    for (int k = 0; k < 9; ++k) r[k] = a[k];
+    for (int k = 0; k < 3; ++k) t[k] = lt[k];
+    return;
+  }
+  const double* pr2 = out[s.parent].rotation.data();
+  const double* pt = out[s.parent].translation.data();
+  if (s.post_identity && s.motion != Motion::Trans) {
+    // lt is pre.p: URDF origins are mostly exact zeros, whose products the general form would add.
+    // The mask is fixed per segment, so these branches predict perfectly.
+    double tt[3] = {pt[0], pt[1], pt[2]};
+    for (int c = 0; c < 3; ++c)
+      if ((s.pre_translation_mask >> c) & 1U)
+        for (int k = 0; k < 3; ++k) tt[k] += pr2[c * 3 + k] * lt[c];
+    for (int k = 0; k < 3; ++k) t[k] = tt[k];
+  } else {
+    for (int k = 0; k < 3; ++k) t[k] = pt[k] + pr2[k] * lt[0] + pr2[3 + k] * lt[1] + pr2[6 + k] * lt[2];
+  }
+  for (int c = 0; c < 3; ++c)
+    for (int k = 0; k < 3; ++k)
+      r[c * 3 + k] = pr2[k] * a[c * 3] + pr2[3 + k] * a[c * 3 + 1] + pr2[6 + k] * a[c * 3 + 2];
 }
 
 void Model::jacobian(const Data& data, int body,

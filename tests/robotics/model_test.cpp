@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 #include <limits>
@@ -387,6 +390,74 @@ void compare_dh_with_urdf(DhConvention conv) {
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(fa.rotation(r, c), kf.M(r, c), 1e-9);
       }
     }
+  }
+}
+
+// forward() has an AVX form (chosen at run time on x86 with AVX) and the portable SSE2 form, which
+// VSD_ROBOTICS_NO_AVX=1 selects when a model is built: both must give the same frames bit for bit, on the
+// iiwa chain and on a tree with every kind of segment (coordinate axes other than z, a general axis, a
+// post transform, fixed and prismatic joints, a second root, branches), and for angles beyond the
+// table's range (the scalar library fallback).
+Model build_with_env(const std::function<Model()>& make, bool portable) {
+  if (portable) ::setenv("VSD_ROBOTICS_NO_AVX", "1", 1);
+  Model m = make();
+  if (portable) ::unsetenv("VSD_ROBOTICS_NO_AVX");
+  return m;
+}
+
+void expect_same_bits(const Model& a, const Model& b, const std::vector<double>& q) {
+  Model::Data da = a.make_data(), db = b.make_data();
+  a.forward(q, da);
+  b.forward(q, db);
+  ASSERT_EQ(da.segment.size(), db.segment.size());
+  for (std::size_t i = 0; i < da.segment.size(); ++i) {
+    EXPECT_EQ(0,
+              std::memcmp(da.segment[i].rotation.data(), db.segment[i].rotation.data(), 9 * sizeof(double)))
+        << "segment " << i << "\n"
+        << da.segment[i].rotation << "\n"
+        << db.segment[i].rotation;
+    EXPECT_EQ(0, std::memcmp(da.segment[i].translation.data(), db.segment[i].translation.data(),
+                             3 * sizeof(double)))
+        << "segment " << i;
+  }
+}
+
+TEST(Model, AvxAndPortableFormsGiveTheSameBits) {
+  Loaded robot(read_text(robot_file("iiwa14.urdf")));
+  auto iiwa = [&] { return robot.chain("iiwa_link_0", "iiwa_link_ee"); };
+  const Model fast = build_with_env(iiwa, false), portable = build_with_env(iiwa, true);
+  std::mt19937_64 rng(7);
+  for (int n = 0; n < 200; ++n) expect_same_bits(fast, portable, random_q(fast, rng));
+  std::vector<double> far(7, 0.5);
+  far[3] = 2.5e5;  // beyond the table's range: the library's sin and cos for all
+  expect_same_bits(fast, portable, far);
+
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  std::vector<JointSpec> specs;
+  const int parents[] = {-1, 0, 1, 2, 1, 4, 5, 3, 7, 0, -1, 10, 11};
+  const Eigen::Vector3d axes[4] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+                                   Eigen::Vector3d::UnitZ(), Eigen::Vector3d(1, 2, 3).normalized()};
+  for (int i = 0; i < 13; ++i) {
+    JointSpec s;
+    s.name = s.body = "j" + std::to_string(i);
+    s.parent = parents[i];
+    s.type = i == 6   ? KinematicJointType::Fixed
+             : i == 8 ? KinematicJointType::Prismatic
+                      : KinematicJointType::Rotary;
+    s.placement.pre = Eigen::Translation3d(u(rng), i % 2 == 0 ? 0.0 : u(rng), u(rng)) *
+                      Eigen::AngleAxisd(u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized());
+    if (i == 11)
+      s.placement.post =
+          Eigen::Translation3d(0.1, 0.2, 0.3) * Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitX());
+    s.placement.axis = axes[i % 4];
+    specs.push_back(s);
+  }
+  auto tree = [&] { return Model::build(specs); };
+  const Model tf = build_with_env(tree, false), tp = build_with_env(tree, true);
+  for (int n = 0; n < 50; ++n) {
+    std::vector<double> q(static_cast<std::size_t>(tf.dof()));
+    for (double& v : q) v = 3.0 * u(rng);
+    expect_same_bits(tf, tp, q);
   }
 }
 

@@ -30,6 +30,21 @@ class Node3D;
 
 namespace vsd::robotics {
 
+namespace detail {
+/// One segment of the AVX form of forward kinematics (see model.cpp): the fast form's constants, each
+/// broadcast to four lanes (`bcast`, per row k of B) and as column vectors (`col`, lane 3 zero).
+struct alignas(32) FkStep {
+  // Per row k: B(k,0), B(k,1), B(k,1), -B(k,0), B(k,2), pre.p(k) (the c_* forms when chained).
+  double bcast[3][6][4] = {};
+  double col[6][4] = {};  // the same six as columns over k
+  std::int32_t parent = -1;
+  std::uint8_t mode = 0;  // 0: general form, 1: root, 2: chained (parent in registers), 3: parent in memory
+  std::uint8_t mask = 7;  // bit k: translation component k is nonzero
+  std::uint8_t identity_perm = 1;
+  std::uint8_t dest_src[3] = {0, 1, 2};  // frame column d is register column dest_src[d]
+};
+}  // namespace detail
+
 /// @brief A rigid transform as rotation matrix and translation (what the compiled model computes with).
 struct Frame {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
@@ -115,6 +130,10 @@ class Model {
   /// @brief A Data sized for this model.
   [[nodiscard]] Data make_data() const;
   /// @brief Forward kinematics of every body for joint vector @p q (dof() values, layout order).
+  ///
+  /// On x86 with AVX (detected when the model is built) coordinate-axis joints run in a four-lane form;
+  /// elsewhere, or with the environment variable VSD_ROBOTICS_NO_AVX=1 set when the model is built, in
+  /// the portable SSE2 form. Both give the same frames bit for bit.
   void forward(const double* q, Data& data) const noexcept;
   /// @brief Forward kinematics; @throws vsd::Error when @p q does not have dof() values.
   void forward(std::span<const double> q, Data& data) const;
@@ -162,7 +181,13 @@ class Model {
     std::uint8_t c_mask = 7;
     double c_row[3][2] = {}, c_swap[3][2] = {}, c_col2[3] = {}, c_translation[3] = {};
   };
+  // The general form of segment i (any joint, post transforms), reading its parent's frame from out.
+  void general_segment(std::size_t i, Frame* out, const double* values, const double* sines,
+                       const double* cosines) const noexcept;
   std::vector<Segment> segments_;
+  // The AVX form (x86 with AVX at run time, and not disabled by VSD_ROBOTICS_NO_AVX): one step per
+  // segment; empty when forward() uses the portable SSE2 form. Both give the same results bit for bit.
+  std::vector<detail::FkStep> steps_;
   std::vector<DofInfo> layout_;
   std::vector<int> body_segment_;
   std::vector<std::string> body_name_;
