@@ -98,8 +98,8 @@ const VectorOps& vector_access(const MetaType& t) {
 void check_index(const MetaType& t, const VectorOps& ops, const void* vec, std::size_t i) {
   const std::size_t n = ops.size(t, vec);
   if (i >= n)
-    detail::throw_error(t.name() + ": index " + std::to_string(i) + " out of range (size " + std::to_string(n) +
-                        ")");
+    detail::throw_error(t.name() + ": index " + std::to_string(i) + " out of range (size " +
+                        std::to_string(n) + ")");
 }
 }  // namespace
 

@@ -32,7 +32,9 @@ RK reg_kind(const Type& t) noexcept {
       return RK::R;
     case K::Vector:
       if (t.meta == nullptr) return RK::None;
-      return vector_elem_kind(*t.meta) != RK::None ? RK::V : t.meta->ops().vector != nullptr ? RK::X : RK::None;
+      return vector_elem_kind(*t.meta) != RK::None ? RK::V
+             : t.meta->ops().vector != nullptr     ? RK::X
+                                                   : RK::None;
     case K::Struct:
       return t.meta != nullptr ? RK::X : RK::None;
     default:
@@ -1043,7 +1045,8 @@ class Compiler {
         const int r = temp();
         at(e.loc);
         emit(OP_XDEF, r, xtype(&st));
-        for (std::size_t i = 0; i < e.args.size(); ++i) field_op(OP_XSETF, r, base + static_cast<int>(i), static_cast<int>(i));
+        for (std::size_t i = 0; i < e.args.size(); ++i)
+          field_op(OP_XSETF, r, base + static_cast<int>(i), static_cast<int>(i));
         return r;
       }
       case BK::Conversion: {

@@ -126,12 +126,12 @@ enum Op : std::uint8_t {
   OP_PVGET,   // a = element R[a] of vector property props[c] of instance b (no copy; range-checked)
   OP_FIND,    // a = the node at path S[b] from the database, or null
   // Values (X registers: structs, vectors of structs and enums; out of line like the vector ones).
-  OP_XDEF,   // X[a] = default value of xtypes[b]
-  OP_MOVX,   // X[a] = X[b] (a copy)
-  OP_XGETF,  // a = field x of struct X[b]          (register kind from the field's type)
-  OP_XSETF,  // field x of struct X[a] = b
-  OP_EQX,    // a = X[b] == X[c]
-  OP_RETX,   // return X register a (a function whose result is a Value)
+  OP_XDEF,    // X[a] = default value of xtypes[b]
+  OP_MOVX,    // X[a] = X[b] (a copy)
+  OP_XGETF,   // a = field x of struct X[b]          (register kind from the field's type)
+  OP_XSETF,   // field x of struct X[a] = b
+  OP_EQX,     // a = X[b] == X[c]
+  OP_RETX,    // return X register a (a function whose result is a Value)
   OP_XVSIZE,  // a = size of vector X[b]
   OP_XVGET,   // a = X[b][R[c]]                     (range-checked)
   OP_XVSET,   // X[a][R[b]] = c                     (range-checked)
@@ -323,7 +323,7 @@ class ProgramImpl {
   Val exec(std::size_t entry);
   void vector_op(Ins in, const Frame& frame);  // OP_MOVV .. OP_PVGET (vm.cpp)
   void store_vector(const MetaProperty& p, SimStateInstance& o, const VecReg& v);
-  void value_op(Ins in, const Frame& frame);  // OP_XDEF .. OP_XVPUSH (vm.cpp)
+  void value_op(Ins in, const Frame& frame);               // OP_XDEF .. OP_XVPUSH (vm.cpp)
   std::uint64_t new_instance(Ins in, const Frame& frame);  // OP_NEW
   std::uint64_t find_node(const std::string& path) const;  // OP_FIND
   // Vector arguments come from @p vargs (indexed like args), a vector result goes to @p vresult.

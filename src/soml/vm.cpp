@@ -459,8 +459,8 @@ static void to_registers(const MetaType& t, const void* addr, Val& v, std::strin
   x = Value(t, addr);
 }
 
-static void from_registers(const MetaType& t, void* addr, const Val& v, const std::string& s, const VecReg& vr,
-                    const Value& x, const std::string& what) {
+static void from_registers(const MetaType& t, void* addr, const Val& v, const std::string& s,
+                           const VecReg& vr, const Value& x, const std::string& what) {
   switch (t.kind()) {
     case TypeKind::Bool:
       *static_cast<bool*>(addr) = v.i != 0;
@@ -1188,7 +1188,8 @@ Val ProgramImpl::exec(std::size_t entry) {
               line += S[in.a + i];
               break;
             case RK::V:
-              line += vector_text(*print_types_[in.c][static_cast<std::size_t>(i)], vregs_[fr->base + in.a + i]);
+              line +=
+                  vector_text(*print_types_[in.c][static_cast<std::size_t>(i)], vregs_[fr->base + in.a + i]);
               break;
             case RK::X: {
               const Value& x = xregs_[fr->base + in.a + i];

@@ -354,7 +354,9 @@ struct VectorAccess {
 template <class E, class A>
 struct VectorAccess<std::vector<E, A>> {
   using V = std::vector<E, A>;
-  static std::size_t size(const MetaType&, const void* v) noexcept { return static_cast<const V*>(v)->size(); }
+  static std::size_t size(const MetaType&, const void* v) noexcept {
+    return static_cast<const V*>(v)->size();
+  }
   static void get(const MetaType&, const void* v, std::size_t i, void* out) {
     *static_cast<E*>(out) = (*static_cast<const V*>(v))[i];
   }
@@ -400,10 +402,9 @@ struct ValueOps {
   static void read_bytes(const MetaType& t, void* obj, ByteReader& in, const RefResolver* refs) {
     bytes_in(t, *static_cast<T*>(obj), in, refs);
   }
-  static constexpr TypeOps table{&construct, &copy_construct, &move_construct, &destroy,
-                                 &assign,    &equal,          &hash,           &write_text,
-                                 &read_text, &write_bytes,    &read_bytes,     nullptr,
-                                 VectorAccess<T>::ops};
+  static constexpr TypeOps table{&construct,  &copy_construct, &move_construct,     &destroy,   &assign,
+                                 &equal,      &hash,           &write_text,         &read_text, &write_bytes,
+                                 &read_bytes, nullptr,         VectorAccess<T>::ops};
 };
 
 /// Makes the MetaType of a C++ type with ValueOps<T>.
