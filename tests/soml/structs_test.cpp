@@ -137,6 +137,34 @@ arrow watch -> near;
   EXPECT_EQ(p.root().get<std::int64_t>("hits"), 1);
 }
 
+TEST_F(Structs, VectorsOfRegistryEnumsAndStringsAreValuesAndPrint) {
+  const vsd::MetaType& shade = vsd::EnumBuilder("Shade").value("Dark", 0).value("Light", 3).define(reg);
+  const vsd::MetaType& shades = reg.vector_type(shade);
+  Program& p = load(R"(
+vector<Shade> shades;
+vector<string> names;
+vector<Shade> flipped(vector<Shade> in) {
+  vector<Shade> out;
+  for (Shade s : in) out.push(s == Shade::Dark ? Shade::Light : Shade::Dark);
+  return out;
+}
+void f() {
+  vector<Shade> l;
+  l.push(Shade::Light);
+  l.push(Shade::Dark);
+  shades = flipped(l);
+  shades[1] = Shade::Light;
+  names.push("a");
+  print(l, " ", shades, " ", names, " ", shades[0] == Shade::Dark, " ", l.size());
+}
+)");
+  p.root().call("f", {});
+  EXPECT_EQ(out.str(), "[\"Light\", \"Dark\"] [\"Dark\", \"Light\"] [\"a\"] true 2\n");
+  const vsd::Value v = p.root().get("shades");
+  ASSERT_EQ(v.type(), &shades);
+  EXPECT_EQ(v.to_text(), R"(["Dark", "Light"])");
+}
+
 TEST_F(Structs, MistakesAreReportedWithTheirPosition) {
   const std::string e = struct_error_of([&] {
     load(R"(void f() {
