@@ -1341,8 +1341,14 @@ bool CheckerImpl::check_lvalue(Expr& e, Context& cx) {
         local = true;
         break;
       case BK::Property:
-      case BK::StructField:
         break;
+      case BK::StructField: {  // a field of a local (`v.x`, `v.pose.translation.x`) changes the local only
+        const Expr* o = e.as<MemberExpr>().object.get();
+        while (o->kind == ExprKind::Member && o->as<MemberExpr>().binding.kind == BK::StructField)
+          o = o->as<MemberExpr>().object.get();
+        local = o->kind == ExprKind::Name && o->as<NameExpr>().binding.kind == BK::Local;
+        break;
+      }
       case BK::MetaProperty:
         if (b->property->has(ReadOnly)) {
           diag_.error(e.loc, "property " + q(b->property->name()) + " of " + q(b->property->owner().name()) +

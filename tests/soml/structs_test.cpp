@@ -165,6 +165,27 @@ void f() {
   EXPECT_EQ(v.to_text(), R"(["Dark", "Light"])");
 }
 
+TEST_F(Structs, AConditionMayChangeAFieldOfALocalButNotOfAProperty) {
+  Program& p = load(R"(
+Vector3d target = Vector3d(1, 2, 3);
+int hits = 0;
+place watch = 1;
+transition near {
+  when { Vector3d v = target; v.z = 0; return v == Vector3d(1, 2, 0); }
+  do { hits += 1; }
+}
+arrow watch -> near;
+)");
+  EXPECT_EQ(p.run_until_quiet(), 1u);
+  EXPECT_THAT(struct_error_of([&] {
+                load(
+                    "Vector3d target;\nplace w = 1;\ntransition t { when { target.z = 0; return true; } "
+                    "}\narrow w -> t;\n",
+                    "cond.soml");
+              }),
+              HasSubstr("cond.soml:3:29: error: a condition must not change properties"));
+}
+
 TEST_F(Structs, MistakesAreReportedWithTheirPosition) {
   const std::string e = struct_error_of([&] {
     load(R"(void f() {
