@@ -8,4 +8,5 @@ vsd_add_test_suite(vsd_meta_tests
   core/registry_test.cpp
   core/class_names_test.cpp
   core/runtime_type_test.cpp
+  core/vector_access_test.cpp
 )

@@ -90,6 +90,32 @@ std::string MetaType::to_text(const void* obj) const {
   return out;
 }
 
+namespace {
+const VectorOps& vector_access(const MetaType& t) {
+  if (t.ops().vector == nullptr) detail::throw_error("type '" + t.name() + "' is not a vector");
+  return *t.ops().vector;
+}
+void check_index(const MetaType& t, const VectorOps& ops, const void* vec, std::size_t i) {
+  const std::size_t n = ops.size(t, vec);
+  if (i >= n)
+    detail::throw_error(t.name() + ": index " + std::to_string(i) + " out of range (size " +
+                        std::to_string(n) + ")");
+}
+}  // namespace
+
+std::size_t MetaType::vector_size(const void* vec) const { return vector_access(*this).size(*this, vec); }
+void MetaType::vector_get(const void* vec, std::size_t i, void* out) const {
+  const VectorOps& ops = vector_access(*this);
+  check_index(*this, ops, vec, i);
+  ops.get(*this, vec, i, out);
+}
+void MetaType::vector_set(void* vec, std::size_t i, const void* in) const {
+  const VectorOps& ops = vector_access(*this);
+  check_index(*this, ops, vec, i);
+  ops.set(*this, vec, i, in);
+}
+void MetaType::vector_push(void* vec, const void* in) const { vector_access(*this).push(*this, vec, in); }
+
 void MetaType::from_text(void* obj, std::string_view text, const RefResolver* refs,
                          std::string_view origin) const {
   const std::string fallback = origin.empty() ? "<" + name_ + " value>" : std::string();

@@ -218,9 +218,25 @@ void vector_bytes_in(const MetaType& t, void* obj, ByteReader& in, const RefReso
   });
 }
 
+std::size_t vector_size(const MetaType&, const void* obj) noexcept { return vec(obj).size; }
+void vector_get(const MetaType& t, const void* obj, std::size_t i, void* out) {
+  t.element()->assign(out, element_at(t, vec(obj), i));
+}
+void vector_set(const MetaType& t, void* obj, std::size_t i, const void* in) {
+  t.element()->assign(element_at(t, vec(obj), i), in);
+}
+void vector_push(const MetaType& t, void* obj, const void* in) {
+  RtVector& v = vec(obj);
+  reserve_one(t, v);
+  t.element()->copy_construct(element_at(t, v, v.size), in);
+  ++v.size;
+}
+constexpr VectorOps vector_access{&vector_size, &vector_get, &vector_set, &vector_push};
+
 constexpr TypeOps vector_ops{&vector_construct, &vector_copy,      &vector_move,     &vector_destroy,
                              &vector_assign,    &vector_equal,     &vector_hash,     &vector_text_out,
-                             &vector_text_in,   &vector_bytes_out, &vector_bytes_in, nullptr};
+                             &vector_text_in,   &vector_bytes_out, &vector_bytes_in, nullptr,
+                             &vector_access};
 
 bool is_identifier(std::string_view s) {
   if (s.empty()) return false;

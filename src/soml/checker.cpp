@@ -924,6 +924,11 @@ Type CheckerImpl::check_name(NameExpr& e, Context& cx) {
     t.cls = ClassRef{nullptr, m};
     return t;
   }
+  if (const MetaType* m = reg_.find_type(name); m != nullptr && m->kind() == TypeKind::Struct) {
+    e.binding.kind = BK::Construct;  // `Vector3d(1, 2, 3)`: a value built field by field
+    e.binding.meta_type = m;
+    return Type::of(K::Function);
+  }
   if (const MetaType* m = reg_.find_type(name);
       m != nullptr && (m->kind() == TypeKind::Enum || m->kind() == TypeKind::Flags)) {
     e.binding.kind = BK::Enum;
@@ -1286,6 +1291,19 @@ Type CheckerImpl::check_call(CallExpr& e, Context& cx) {
         diag_.error(e.args[0]->loc, "type mismatch: cannot convert " + q(from.name()) + " to " + q(name));
       return to;
     }
+    case BK::Construct: {
+      // No arguments: the default value; else one per field, in the order of the fields.
+      const MetaType& st = *b.meta_type;
+      std::vector<Type> params;
+      std::string fields;
+      for (const MetaType::Field& f : st.fields()) {
+        params.push_back(type_of_meta(f.type));
+        fields += (fields.empty() ? "" : ", ") + f.type->name() + " " + f.name;
+      }
+      if (e.args.empty()) return type_of_meta(&st);
+      check_args(e.args, params, e.loc, q(st.name()) + " (" + fields + "; or none for the default)", cx);
+      return type_of_meta(&st);
+    }
     case BK::Class:
       diag_.error(e.loc, q(name) + " is a class: create instances with 'new " + name + "(...)'");
       break;
@@ -1323,8 +1341,14 @@ bool CheckerImpl::check_lvalue(Expr& e, Context& cx) {
         local = true;
         break;
       case BK::Property:
-      case BK::StructField:
         break;
+      case BK::StructField: {  // a field of a local (`v.x`, `v.pose.translation.x`) changes the local only
+        const Expr* o = e.as<MemberExpr>().object.get();
+        while (o->kind == ExprKind::Member && o->as<MemberExpr>().binding.kind == BK::StructField)
+          o = o->as<MemberExpr>().object.get();
+        local = o->kind == ExprKind::Name && o->as<NameExpr>().binding.kind == BK::Local;
+        break;
+      }
       case BK::MetaProperty:
         if (b->property->has(ReadOnly)) {
           diag_.error(e.loc, "property " + q(b->property->name()) + " of " + q(b->property->owner().name()) +

@@ -31,7 +31,12 @@ RK reg_kind(const Type& t) noexcept {
     case K::Place:
       return RK::R;
     case K::Vector:
-      return t.meta != nullptr && vector_elem_kind(*t.meta) != RK::None ? RK::V : RK::None;
+      if (t.meta == nullptr) return RK::None;
+      return vector_elem_kind(*t.meta) != RK::None ? RK::V
+             : t.meta->ops().vector != nullptr     ? RK::X
+                                                   : RK::None;
+    case K::Struct:
+      return t.meta != nullptr ? RK::X : RK::None;
     default:
       return RK::None;
   }
@@ -40,8 +45,10 @@ RK reg_kind(const Type& t) noexcept {
 namespace {
 
 // The static type of the elements of vector type t (a register holds them as int, double or string).
-Type element_type(const Type& t) {
-  const MetaType* e = t.meta != nullptr ? t.meta->element() : nullptr;
+Type element_type_of(const MetaType* e);
+Type element_type(const Type& t) { return element_type_of(t.meta != nullptr ? t.meta->element() : nullptr); }
+// The static type of a value of MetaType e as the registers hold it (a vector's element, a struct's field).
+Type element_type_of(const MetaType* e) {
   if (e == nullptr) return Type::error();
   switch (e->kind()) {
     case TypeKind::Bool:
@@ -51,10 +58,19 @@ Type element_type(const Type& t) {
       return Type::of(K::Double);
     case TypeKind::String:
       return Type::of(K::String);
+    case TypeKind::Struct:
+    case TypeKind::Vector: {
+      Type t = Type::of(e->kind() == TypeKind::Struct ? K::Struct : K::Vector);
+      t.meta = e;
+      return t;
+    }
     default:
       return Type::of(K::Int);
   }
 }
+
+// A vector held as a Value (X register): its elements are structs or enums.
+bool x_vector(const Type& t) { return t.kind == K::Vector && reg_kind(t) == RK::X; }
 
 }  // namespace
 
@@ -95,6 +111,20 @@ class Compiler {
   }
   // A vector instruction whose x says the element kind (1: strings).
   std::size_t emit_v(Op op, const Type& vec, int a = 0, int b = 0, int c = 0) {
+    if (x_vector(vec)) {  // the same instruction on a Value vector
+      switch (op) {
+        case OP_VGET:
+          return emit(OP_XVGET, a, b, c);
+        case OP_VSET:
+          return emit(OP_XVSET, a, b, c);
+        case OP_VPUSH:
+          return emit(OP_XVPUSH, a, b, c);
+        case OP_VSIZE:
+          return emit(OP_XVSIZE, a, b, c);
+        default:
+          break;
+      }
+    }
     const std::size_t i = emit(op, a, b, c);
     F.code[i].x = element_type(vec).kind == K::String ? 1 : 0;
     return i;
@@ -108,6 +138,12 @@ class Compiler {
     if (target >= (1u << 24)) not_supported(P, SourceLoc{}, "a function of more than 16M instructions");
     F.code[at].c = static_cast<std::uint16_t>(target & 0xFFFF);
     F.code[at].x = static_cast<std::uint8_t>(target >> 16);
+  }
+  int xtype(const MetaType* t) {
+    auto it = std::find(P.xtypes_.begin(), P.xtypes_.end(), t);
+    if (it != P.xtypes_.end()) return static_cast<int>(it - P.xtypes_.begin());
+    P.xtypes_.push_back(t);
+    return static_cast<int>(P.xtypes_.size() - 1);
   }
   int temp() {
     const int r = top_++;
@@ -269,7 +305,7 @@ class Compiler {
   }
   void move(int dst, int src, RK k) {
     if (dst == src) return;
-    emit(k == RK::S ? OP_MOVS : k == RK::V ? OP_MOVV : OP_MOV, dst, src);
+    emit(k == RK::S ? OP_MOVS : k == RK::V ? OP_MOVV : k == RK::X ? OP_MOVX : OP_MOV, dst, src);
   }
   void expr_to(const Expr& e, int dst, const Type& want) {
     const int save = top_;
@@ -453,6 +489,14 @@ class Compiler {
         emit(OP_PLACE, r, o, place_index(b.decl->as<PlaceDecl>(), e.loc));
         return r;
       }
+      case BK::StructField: {
+        value_check(e);
+        const int o = expr(*e.object);
+        const int r = temp();
+        at(e.loc);
+        field_op(OP_XGETF, r, o, b.slot);
+        return r;
+      }
       case BK::Builtin:
         if (b.builtin == Builtin::PlaceCount) {
           const int o = expr(*e.object);
@@ -465,6 +509,12 @@ class Compiler {
         break;
     }
     not_supported(P, e.loc, "member '" + e.name + "' as a value");
+  }
+
+  void field_op(Op op, int a, int b, int field) {
+    if (field > 255) not_supported(P, SourceLoc{0, line_, 1}, "a struct with more than 256 fields");
+    const std::size_t i = emit(op, a, b);
+    F.code[i].x = static_cast<std::uint8_t>(field);
   }
 
   // The holder register and property slot of a list-valued expression (a property of a list type).
@@ -493,7 +543,8 @@ class Compiler {
       b = e.kind == ExprKind::Member ? &e.as<MemberExpr>().binding : &e.as<NameExpr>().binding;
     if (b == nullptr || (b->kind != BK::Property && b->kind != BK::MetaProperty)) return {-1, -1};
     const int slot = prop_slot(*b, e.loc);
-    if (P.props_[slot].kind != PK::Vector) not_supported(P, e.loc, "a value of type '" + e.type.name() + "'");
+    if (P.props_[slot].kind != PK::Vector && !(P.props_[slot].kind == PK::Value && x_vector(e.type)))
+      not_supported(P, e.loc, "a value of type '" + e.type.name() + "'");
     const int h = e.kind == ExprKind::Member ? expr(*e.as<MemberExpr>().object) : self_at(b->outer, e.loc);
     return {h, slot};
   }
@@ -673,6 +724,11 @@ class Compiler {
 
   int compare(TokenKind op, int l, const Type& lt, int r, const Type& rt, int into = -1) {
     const int d = into >= 0 ? into : temp();
+    if (lt.kind == K::Struct || x_vector(lt)) {  // values: == and != (the checker allows no other)
+      emit(OP_EQX, d, l, r);
+      if (op == TokenKind::BangEqual) emit(OP_NOT, d, d);
+      return d;
+    }
     if (lt.kind == K::Vector) {  // == and != (the checker allows no other)
       const K ek = element_type(lt).kind;
       const std::size_t i = emit(OP_EQV, d, l, r);
@@ -811,6 +867,26 @@ class Compiler {
       if (m.binding.kind == BK::Property || m.binding.kind == BK::MetaProperty) {
         const int o = expr(*m.object);
         emit(OP_SETP, o, coerce(v, vt, e.type), prop_slot(m.binding, e.loc));
+        return;
+      }
+      if (m.binding.kind == BK::StructField) {
+        // A field of a local changes in its register; of anything else (a property, an element, a field
+        // of those): the whole value is read, changed and stored back, so a property changes once
+        // through its setter (it signals and records).
+        const Expr& o = *m.object;
+        v = coerce(v, vt, e.type);
+        if (o.kind == ExprKind::Name && o.as<NameExpr>().binding.kind == BK::Local) {
+          at(e.loc);
+          field_op(OP_XSETF, o.as<NameExpr>().binding.slot, v, m.binding.slot);
+          return;
+        }
+        const int keep = temp();
+        move(keep, v, reg_kind(e.type));
+        const int cur = temp();
+        expr_to(o, cur, o.type);
+        at(e.loc);
+        field_op(OP_XSETF, cur, keep, m.binding.slot);
+        store(o, cur, o.type);
         return;
       }
     } else if (e.kind == ExprKind::Index && e.as<IndexExpr>().object->type.kind == K::Vector) {
@@ -958,6 +1034,21 @@ class Compiler {
       }
       case BK::Builtin:
         return builtin(e);
+      case BK::Construct: {  // a default value, then the fields in order
+        const MetaType& st = *b.meta_type;
+        std::vector<Type> want;
+        for (const MetaType::Field& f : st.fields()) {
+          Type t = element_type_of(f.type);
+          want.push_back(t);
+        }
+        const int base = args_at(e.args, want);
+        const int r = temp();
+        at(e.loc);
+        emit(OP_XDEF, r, xtype(&st));
+        for (std::size_t i = 0; i < e.args.size(); ++i)
+          field_op(OP_XSETF, r, base + static_cast<int>(i), static_cast<int>(i));
+        return r;
+      }
       case BK::Conversion: {
         const Expr& a = *e.args.at(0);
         const int o = expr(a);
@@ -1018,6 +1109,7 @@ class Compiler {
       case Builtin::Print: {
         const int base = top_;
         std::vector<RK> kinds;
+        std::vector<const MetaType*> types;
         for (std::size_t i = 0; i < e.args.size(); ++i) temp();
         for (std::size_t i = 0; i < e.args.size(); ++i) {
           const Expr& a = *e.args[i];
@@ -1025,13 +1117,14 @@ class Compiler {
           int r = expr(a);
           if (a.type.kind == K::Enum || a.type.kind == K::Bool) r = to_string(r, a.type);
           RK k = a.type.kind == K::Enum || a.type.kind == K::Bool ? RK::S : reg_kind(a.type);
-          if (k == RK::None || k == RK::V)
-            not_supported(P, a.loc, "printing a value of type '" + a.type.name() + "'");
+          if (k == RK::None) not_supported(P, a.loc, "printing a value of type '" + a.type.name() + "'");
           move(base + static_cast<int>(i), r, k);
           kinds.push_back(k);
+          types.push_back(k == RK::V ? a.type.meta : nullptr);
           top_ = save;
         }
         P.print_kinds_.push_back(std::move(kinds));
+        P.print_types_.push_back(std::move(types));
         at(e.loc);
         emit(OP_PRINT, base, static_cast<int>(e.args.size()), static_cast<int>(P.print_kinds_.size() - 1));
         top_ = base;
@@ -1091,7 +1184,7 @@ class Compiler {
           if (vh >= 0)
             emit(OP_PVSIZE, r, vh, vslot);
           else
-            emit(OP_VSIZE, r, vector_reg(o));
+            emit_v(OP_VSIZE, o.type, r, vector_reg(o));
           return r;
         }
         auto [h, slot] = list_of(o);
@@ -1189,6 +1282,8 @@ class Compiler {
           emit(OP_LOADS, l.slot, string_const(""));
         } else if (k == RK::V) {
           emit(OP_VCLEAR, l.slot);
+        } else if (k == RK::X) {
+          emit(OP_XDEF, l.slot, xtype(l.type.meta));
         } else if (k == RK::D) {
           emit(OP_LOADK, l.slot, konst(std::bit_cast<std::int64_t>(0.0)));
         } else {
@@ -1280,7 +1375,7 @@ class Compiler {
         if (r.value) {
           const int v = temp();
           expr_to(*r.value, v, F.result_type);
-          emit(F.result == RK::V ? OP_RETV : OP_RET, v);
+          emit(F.result == RK::V ? OP_RETV : F.result == RK::X ? OP_RETX : OP_RET, v);
         } else {
           emit(OP_RET0);
         }
@@ -1316,7 +1411,7 @@ class Compiler {
     const int n = temp();
     const int e = temp();
     load_int(i, 0);
-    emit(OP_VSIZE, n, hold);
+    emit_v(OP_VSIZE, vec, n, hold);
     const std::size_t top = here();
     const std::size_t jf = emit_jump(OP_JGEI, i, n);
     emit_v(OP_VGET, vec, e, hold, i);

@@ -312,8 +312,10 @@ class Debugger::Impl final : public DebugHooks {
     return o->meta().name() + "#" + std::to_string(id);
   }
 
-  std::string register_text(const Type& t, const Val& v, const std::string& s, const VecReg& vr) const {
+  std::string register_text(const Type& t, const Val& v, const std::string& s, const VecReg& vr,
+                            const Value& x) const {
     using K = Type::Kind;
+    if (reg_kind(t) == RK::X) return x.empty() ? "<" + t.name() + ">" : x.to_text();
     switch (t.kind) {
       case K::Vector:
         if (t.meta != nullptr && vector_elem_kind(*t.meta) != RK::None) return vector_text(*t.meta, vr);
@@ -534,7 +536,7 @@ std::vector<Variable> Debugger::locals(std::size_t k) const {
     Variable v;
     v.name = l.name;
     v.type = l.type.name();
-    v.value = impl_->register_text(l.type, P.regs_[r], P.sregs_[r], P.vregs_[r]);
+    v.value = impl_->register_text(l.type, P.regs_[r], P.sregs_[r], P.vregs_[r], P.xregs_[r]);
     // A later local of the same name (an inner block) hides an earlier one.
     auto same = std::find_if(out.begin(), out.end(), [&](const Variable& o) { return o.name == v.name; });
     if (same != out.end())
@@ -583,7 +585,7 @@ std::string Debugger::print(std::string_view path, std::size_t k) const {
         cur = P.regs_[r].id;
         is_instance = true;
       } else {
-        value = impl_->register_text(found->type, P.regs_[r], P.sregs_[r], P.vregs_[r]);
+        value = impl_->register_text(found->type, P.regs_[r], P.sregs_[r], P.vregs_[r], P.xregs_[r]);
       }
       if (!is_instance && parts.size() > 1)
         throw Error("SOML++ debugger: '" + first + "' is a " + found->type.name() + ", it has no members");

@@ -94,7 +94,9 @@ static PK prop_kind(const Type& t, const MetaProperty& mp) {
     case K::List:
       return PK::List;
     case K::Vector:
-      return vector_elem_kind(mp.type()) != RK::None ? PK::Vector : PK::Other;
+      return vector_elem_kind(mp.type()) != RK::None ? PK::Vector : PK::Value;
+    case K::Struct:
+      return PK::Value;
     default:
       return PK::Other;
   }
@@ -740,14 +742,14 @@ SimStateInstance& ProgramImpl::create_node(const ClassInfo& ci, Node* parent, co
 
 SimStateInstance& ProgramImpl::instantiate(const ClassInfo& ci, Node* parent, std::string name,
                                            const Val* args, const std::string* sargs, int nargs,
-                                           const VecReg* vargs) {
+                                           const VecReg* vargs, const Value* xargs) {
   SimStateInstance& inst = create_node(ci, parent, name);
-  setup(ci, inst, args, sargs, nargs, vargs);
+  setup(ci, inst, args, sargs, nargs, vargs, xargs);
   return inst;
 }
 
 void ProgramImpl::setup(const ClassInfo& ci, SimStateInstance& inst, const Val* args,
-                        const std::string* sargs, int nargs, const VecReg* vargs) {
+                        const std::string* sargs, int nargs, const VecReg* vargs, const Value* xargs) {
   std::vector<const ClassInfo*> chain;
   for (const ClassInfo* c = &ci; c != nullptr; c = c->base) chain.push_back(c);
   std::reverse(chain.begin(), chain.end());
@@ -778,7 +780,7 @@ void ProgramImpl::setup(const ClassInfo& ci, SimStateInstance& inst, const Val* 
         (c == ci.base && ci.decl->kind == DeclKind::Object && ci.object_ctor < 0 && f.nparams == 0)) {
       if (c == &ci && f.nparams != nargs)
         fail("constructor of " + ci.decl->name + " needs " + std::to_string(f.nparams) + " arguments");
-      run(c->ctor, inst.id(), 0, args, sargs, nullptr, vargs);
+      run(c->ctor, inst.id(), 0, args, sargs, nullptr, vargs, nullptr, xargs);
     } else if (f.nparams == 0) {
       run(c->ctor, inst.id(), 0, nullptr, nullptr);
     }
@@ -932,6 +934,7 @@ Value ProgramImpl::call_from_cpp(int fi, SimStateInstance& self, std::span<const
   std::vector<Val> v(args.size());
   std::vector<std::string> s(args.size());
   std::vector<VecReg> vs(args.size());
+  std::vector<Value> xs(args.size());
   for (std::size_t i = 0; i < args.size(); ++i) {
     const Value& a = args[i];
     const MetaType* t = a.type();
@@ -972,13 +975,22 @@ Value ProgramImpl::call_from_cpp(int fi, SimStateInstance& self, std::span<const
         vector_load(*t, a.data(), vs[i]);
         break;
       }
+      case RK::X: {  // a struct or a vector of structs or enums: the same type (run-time ones by definition)
+        const MetaType* want = i < f.locals.size() ? f.locals[i].type.meta : nullptr;  // params come first
+        if (want == nullptr || !detail::same_definition(*t, *want))
+          throw Error("SOML++ function " + f.name + ": argument " + std::to_string(i + 1) + " must be a " +
+                      (want != nullptr ? want->name() : std::string("value")) + ", not " + t->name());
+        xs[i] = t == want ? a : Value(*want, a.data());
+        break;
+      }
       default:
         throw Error("SOML++ function " + f.name + ": unsupported argument type");
     }
   }
   std::string sres;
   VecReg vres;
-  const Val r = run(fi, self.id(), 0, v.data(), s.data(), &sres, vs.data(), &vres);
+  Value xres;
+  const Val r = run(fi, self.id(), 0, v.data(), s.data(), &sres, vs.data(), &vres, xs.data(), &xres);
   switch (f.result_type.kind) {
     case K::Bool:
       return Value(r.i != 0);
@@ -1000,7 +1012,10 @@ Value ProgramImpl::call_from_cpp(int fi, SimStateInstance& self, std::span<const
       return Value(SharedRef<Node>(o != nullptr ? o->as<Node>() : nullptr));
     }
     case K::Vector:
+      if (f.result == RK::X) return xres;
       return vector_value(*f.result_type.meta, vres, "the result of " + f.name);
+    case K::Struct:
+      return xres;
     default:
       return {};
   }

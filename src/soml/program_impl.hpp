@@ -37,8 +37,9 @@ struct VecReg {
   [[nodiscard]] std::size_t size() const noexcept { return v.size() + s.size(); }
 };
 
-// Register kinds of a static type (V: a vector, its elements of kind vector_elem_kind()).
-enum class RK : std::uint8_t { I, D, S, R, V, None };
+// Register kinds of a static type (V: a vector, its elements of kind vector_elem_kind(); X: any other
+// value as a vsd::Value in the fourth parallel array: structs, and vectors of structs and enums).
+enum class RK : std::uint8_t { I, D, S, R, V, X, None };
 
 enum Op : std::uint8_t {
   OP_NOP,
@@ -123,7 +124,18 @@ enum Op : std::uint8_t {
   OP_EQV,     // a = V[b] == V[c]
   OP_PVSIZE,  // a = size of vector property props[c] of instance b (no copy)
   OP_PVGET,   // a = element R[a] of vector property props[c] of instance b (no copy; range-checked)
-  OP_FIND     // a = the node at path S[b] from the database, or null
+  OP_FIND,    // a = the node at path S[b] from the database, or null
+  // Values (X registers: structs, vectors of structs and enums; out of line like the vector ones).
+  OP_XDEF,    // X[a] = default value of xtypes[b]
+  OP_MOVX,    // X[a] = X[b] (a copy)
+  OP_XGETF,   // a = field x of struct X[b]          (register kind from the field's type)
+  OP_XSETF,   // field x of struct X[a] = b
+  OP_EQX,     // a = X[b] == X[c]
+  OP_RETX,    // return X register a (a function whose result is a Value)
+  OP_XVSIZE,  // a = size of vector X[b]
+  OP_XVGET,   // a = X[b][R[c]]                     (range-checked)
+  OP_XVSET,   // X[a][R[b]] = c                     (range-checked)
+  OP_XVPUSH   // X[a].push(b)
 };
 
 // OP_PLACE's operand c with this bit: a place of a port net (index into port_places_), found from the
@@ -182,7 +194,7 @@ struct OuterPlan {
   int parents = 0;
 };
 
-enum class PK : std::uint8_t { I64, Bool, Double, String, Int, Enum, Ref, List, Vector, Other };
+enum class PK : std::uint8_t { I64, Bool, Double, String, Int, Enum, Ref, List, Vector, Value, Other };
 
 struct PropSlot {
   const MetaProperty* prop = nullptr;
@@ -311,11 +323,14 @@ class ProgramImpl {
   Val exec(std::size_t entry);
   void vector_op(Ins in, const Frame& frame);  // OP_MOVV .. OP_PVGET (vm.cpp)
   void store_vector(const MetaProperty& p, SimStateInstance& o, const VecReg& v);
+  void value_op(Ins in, const Frame& frame);               // OP_XDEF .. OP_XVPUSH (vm.cpp)
   std::uint64_t new_instance(Ins in, const Frame& frame);  // OP_NEW
   std::uint64_t find_node(const std::string& path) const;  // OP_FIND
   // Vector arguments come from @p vargs (indexed like args), a vector result goes to @p vresult.
+  // Value arguments (structs, ...) come from @p xargs, a Value result goes to @p xresult.
   Val run(int f, std::uint64_t self, std::uint64_t mark, const Val* args, const std::string* sargs,
-          std::string* sresult = nullptr, const VecReg* vargs = nullptr, VecReg* vresult = nullptr);
+          std::string* sresult = nullptr, const VecReg* vargs = nullptr, VecReg* vresult = nullptr,
+          const Value* xargs = nullptr, Value* xresult = nullptr);
   Value call_from_cpp(int f, SimStateInstance& self, std::span<const Value> args);
   // The body of the MetaMethod of function @p f of @p weak: runs it in the program that runs the state
   // of @p self (the method's own program, or another attached to a replica or a loaded copy that uses
@@ -325,7 +340,8 @@ class ProgramImpl {
   // Programs by the state they run (dispatch): registered once loaded or attached, gone with them.
   void register_program();
   SimStateInstance& instantiate(const ClassInfo& ci, Node* parent, std::string name, const Val* args,
-                                const std::string* sargs, int nargs, const VecReg* vargs = nullptr);
+                                const std::string* sargs, int nargs, const VecReg* vargs = nullptr,
+                                const Value* xargs = nullptr);
   [[noreturn]] void fail(const std::string& what);
 
   // ---- executor ----
@@ -338,7 +354,7 @@ class ProgramImpl {
   std::function<void()> on_dirty_;  // called when a transition needs a test (the Module triggers its task)
   SimStateInstance& create_node(const ClassInfo& ci, Node* parent, const std::string& name);
   void setup(const ClassInfo& ci, SimStateInstance& inst, const Val* args, const std::string* sargs,
-             int nargs, const VecReg* vargs = nullptr);
+             int nargs, const VecReg* vargs = nullptr, const Value* xargs = nullptr);
   void build_net(const ClassInfo& ci, SimStateInstance& inst);
   // Hands a net (built or found) to the executor: its transitions are listed and marked for a test.
   void register_net(std::unique_ptr<NetInst> net, const ClassInfo& ci, SimStateInstance& inst);
@@ -393,7 +409,9 @@ class ProgramImpl {
   std::vector<const MetaInstance*> class_metas_;  // by NEW/ISA operand
   std::vector<const MetaType*> enum_types_;       // TOSTR of enums
   std::vector<const MetaType*> range_types_;
+  std::vector<const MetaType*> xtypes_;  // OP_XDEF, OP_XGETF, OP_XSETF operands (value types)
   std::vector<std::vector<RK>> print_kinds_;
+  std::vector<std::vector<const MetaType*>> print_types_;  // per print: the vector types of V arguments
   std::vector<OuterPlan> outer_plans_;
   std::vector<const FunctionDecl*> vslots_;                // virtual slot -> root function
   std::unordered_map<const FunctionDecl*, int> vslot_of_;  // overridden functions -> virtual slot
@@ -421,6 +439,7 @@ class ProgramImpl {
   std::vector<Val> regs_;
   std::vector<std::string> sregs_;
   std::vector<VecReg> vregs_;
+  std::vector<Value> xregs_;  // X registers, parallel like the strings
   std::vector<Frame> frames_;
   std::uint32_t top_ = 0;  // first free register of the outermost frame stack
   std::uint64_t budget_ = 0;

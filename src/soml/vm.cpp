@@ -32,6 +32,8 @@ std::string fmt_double(double d) {
   return s;
 }
 
+static void to_registers(const MetaType& t, const void* addr, Val& v, std::string& s, VecReg& vr, Value& x);
+
 namespace {
 
 inline std::int64_t wrap_add(std::int64_t a, std::int64_t b) {
@@ -207,7 +209,8 @@ std::string ProgramImpl::stack_text(std::size_t from) const {
 void ProgramImpl::fail(const std::string& what) { throw Error("SOML++ run-time error: " + what); }
 
 Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* args,
-                     const std::string* sargs, std::string* sresult, const VecReg* vargs, VecReg* vresult) {
+                     const std::string* sargs, std::string* sresult, const VecReg* vargs, VecReg* vresult,
+                     const Value* xargs, Value* xresult) {
   const Function& f = *functions_[static_cast<std::size_t>(fi)];
   const std::size_t entry = frames_.size();
   if (entry == 0) {
@@ -223,6 +226,7 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
     regs_.resize((base + static_cast<std::size_t>(f.nregs) + 1) * 2);
     sregs_.resize(regs_.size());
     vregs_.resize(regs_.size());
+    xregs_.resize(regs_.size());
   }
   for (int i = 0; i < f.nparams; ++i) {
     regs_[base + static_cast<std::size_t>(i)] = args[i];
@@ -230,6 +234,8 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
       sregs_[base + static_cast<std::size_t>(i)] = sargs[i];
     else if (f.param_kinds[static_cast<std::size_t>(i)] == RK::V)
       vregs_[base + static_cast<std::size_t>(i)] = vargs != nullptr ? vargs[i] : VecReg{};
+    else if (f.param_kinds[static_cast<std::size_t>(i)] == RK::X)
+      xregs_[base + static_cast<std::size_t>(i)] = xargs != nullptr ? xargs[i] : Value{};
   }
   frames_.push_back(Frame{&f, f.code.data(), base, self, mark});
   top_ = base + static_cast<std::uint32_t>(f.nregs);
@@ -237,6 +243,7 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
     Val v = exec(entry);
     if (sresult != nullptr && f.result == RK::S) *sresult = std::move(sregs_[base]);
     if (vresult != nullptr && f.result == RK::V) *vresult = std::move(vregs_[base]);
+    if (xresult != nullptr && f.result == RK::X) *xresult = std::move(xregs_[base]);
     top_ = saved_top;
     return v;
   } catch (const Error& e) {
@@ -259,14 +266,16 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
   if (in.c > 8) fail("more than 8 constructor arguments");
   std::string sargs[8];
   VecReg vargs[8];
+  Value xargs[8];
   Val args[8];
   for (int i = 0; i < in.c; ++i) {
     const RK k = ctor != nullptr ? ctor->param_kinds[static_cast<std::size_t>(i)] : RK::None;
     if (k == RK::S) sargs[i] = S[in.a + 1 + i];
     if (k == RK::V) vargs[i] = vregs_[frame.base + in.a + 1 + i];
+    if (k == RK::X) xargs[i] = xregs_[frame.base + in.a + 1 + i];
     args[i] = R[in.a + 1 + i];
   }
-  return instantiate(*ci, nullptr, "", args, sargs, in.c, vargs).id();
+  return instantiate(*ci, nullptr, "", args, sargs, in.c, vargs, xargs).id();
 }
 
 // find(path): names from the database down, separated by '/', as Node::path() writes them (a leading
@@ -372,7 +381,8 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
       }
       if (deps_ != nullptr) deps_->emplace_back(id, &p);
       const void* addr = p.address(o);
-      const std::size_t n = vector_size(p.type(), addr);
+      const bool value = props_[in.c].kind == PK::Value;  // a vector of structs or enums
+      const std::size_t n = value ? p.type().vector_size(addr) : vector_size(p.type(), addr);
       if (in.op == OP_PVSIZE) {
         R[in.a].i = static_cast<std::int64_t>(n);
         break;
@@ -381,7 +391,177 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
       if (i < 0 || static_cast<std::size_t>(i) >= n) {
         fail("index " + std::to_string(i) + " out of range (size " + std::to_string(n) + ")");
       }
-      vector_at(p.type(), addr, static_cast<std::size_t>(i), R[in.a], S[in.a]);
+      if (value) {
+        Value e(*p.type().element());
+        p.type().vector_get(addr, static_cast<std::size_t>(i), e.data());
+        to_registers(*p.type().element(), e.data(), R[in.a], S[in.a], V[in.a], xregs_[frame.base + in.a]);
+      } else {
+        vector_at(p.type(), addr, static_cast<std::size_t>(i), R[in.a], S[in.a]);
+      }
+      break;
+    }
+    default:
+      fail("bad instruction");
+  }
+}
+
+// ---- values (X registers) ----
+// A struct field or a vector element moves between its storage and the register of its kind: numbers,
+// bools and enums in R, strings in S, vectors of those in V, anything else (structs, vectors of structs
+// and enums) as a Value in X. Out of line like the vector instructions.
+namespace {
+
+Value field_value(const MetaType::Field& f, const void* obj) {
+  if (f.offset != MetaType::npos) return Value(*f.type, static_cast<const unsigned char*>(obj) + f.offset);
+  Value v(*f.type);
+  f.get(obj, v.data());
+  return v;
+}
+
+void set_field(const MetaType::Field& f, void* obj, const void* in) {
+  if (f.offset != MetaType::npos)
+    f.type->assign(static_cast<unsigned char*>(obj) + f.offset, in);
+  else
+    f.set(obj, in);
+}
+
+}  // namespace
+
+static void to_registers(const MetaType& t, const void* addr, Val& v, std::string& s, VecReg& vr, Value& x) {
+  switch (t.kind()) {
+    case TypeKind::Bool:
+      v.i = *static_cast<const bool*>(addr) ? 1 : 0;
+      return;
+    case TypeKind::Int:
+    case TypeKind::UInt:
+    case TypeKind::Enum:
+    case TypeKind::Flags:
+      v.i = t.load_integer(addr);
+      return;
+    case TypeKind::Float:
+      v.d = *static_cast<const float*>(addr);
+      return;
+    case TypeKind::Double:
+      v.d = *static_cast<const double*>(addr);
+      return;
+    case TypeKind::String:
+      s = *static_cast<const std::string*>(addr);
+      return;
+    case TypeKind::Vector:
+      if (vector_elem_kind(t) != RK::None) {
+        vector_load(t, addr, vr);
+        return;
+      }
+      break;
+    default:
+      break;
+  }
+  x = Value(t, addr);
+}
+
+static void from_registers(const MetaType& t, void* addr, const Val& v, const std::string& s,
+                           const VecReg& vr, const Value& x, const std::string& what) {
+  switch (t.kind()) {
+    case TypeKind::Bool:
+      *static_cast<bool*>(addr) = v.i != 0;
+      return;
+    case TypeKind::Int:
+    case TypeKind::UInt:
+    case TypeKind::Enum:
+    case TypeKind::Flags:
+      if (!t.integer_fits(v.i))
+        throw Error("the value " + std::to_string(v.i) + " does not fit " + what + " (" + t.name() + ")");
+      t.store_integer(addr, v.i);
+      return;
+    case TypeKind::Float:
+      *static_cast<float*>(addr) = static_cast<float>(v.d);
+      return;
+    case TypeKind::Double:
+      *static_cast<double*>(addr) = v.d;
+      return;
+    case TypeKind::String:
+      *static_cast<std::string*>(addr) = s;
+      return;
+    case TypeKind::Vector:
+      if (vector_elem_kind(t) != RK::None) {
+        const Value val = vector_value(t, vr, what);
+        t.assign(addr, val.data());
+        return;
+      }
+      break;
+    default:
+      break;
+  }
+  if (x.type() == nullptr || !detail::same_definition(*x.type(), t))
+    throw Error(what + " of type " + t.name() + " cannot hold a " +
+                (x.type() != nullptr ? x.type()->name() : std::string("missing value")));
+  t.assign(addr, x.data());
+}
+
+[[gnu::noinline]] void ProgramImpl::value_op(const Ins in, const Frame& frame) {
+  Val* R = regs_.data() + frame.base;
+  std::string* S = sregs_.data() + frame.base;
+  VecReg* V = vregs_.data() + frame.base;
+  Value* X = xregs_.data() + frame.base;
+  auto index = [&](const MetaType& vt, const Value& vec, std::int64_t i) {
+    const std::size_t n = vt.vector_size(vec.data());
+    if (i < 0 || static_cast<std::size_t>(i) >= n)
+      fail("index " + std::to_string(i) + " out of range (size " + std::to_string(n) + ")");
+    return static_cast<std::size_t>(i);
+  };
+  auto vec_type = [&](const Value& v) -> const MetaType& {
+    if (v.type() == nullptr || v.type()->kind() != TypeKind::Vector) fail("not a vector");
+    return *v.type();
+  };
+  switch (in.op) {
+    case OP_XDEF:
+      X[in.a] = Value(*xtypes_[in.b]);
+      break;
+    case OP_MOVX:
+      X[in.a] = X[in.b];
+      break;
+    case OP_XGETF:
+    case OP_XSETF: {
+      Value& st = X[in.op == OP_XGETF ? in.b : in.a];
+      const MetaType* t = st.type();
+      if (t == nullptr || t->kind() != TypeKind::Struct || in.x >= t->fields().size()) fail("not a struct");
+      const MetaType::Field& f = t->fields()[in.x];
+      if (in.op == OP_XGETF) {
+        const Value fv = field_value(f, st.data());
+        to_registers(*f.type, fv.data(), R[in.a], S[in.a], V[in.a], X[in.a]);
+      } else {
+        Value fv(*f.type);
+        from_registers(*f.type, fv.data(), R[in.b], S[in.b], V[in.b], X[in.b], "field '" + f.name + "'");
+        set_field(f, st.data(), fv.data());
+      }
+      break;
+    }
+    case OP_EQX:
+      R[in.a].i = X[in.b] == X[in.c] ? 1 : 0;
+      break;
+    case OP_XVSIZE:
+      R[in.a].i = static_cast<std::int64_t>(vec_type(X[in.b]).vector_size(X[in.b].data()));
+      break;
+    case OP_XVGET: {
+      const Value& vec = X[in.b];
+      const MetaType& vt = vec_type(vec);
+      const std::size_t i = index(vt, vec, R[in.c].i);
+      Value e(*vt.element());
+      vt.vector_get(vec.data(), i, e.data());
+      to_registers(*vt.element(), e.data(), R[in.a], S[in.a], V[in.a], X[in.a]);
+      break;
+    }
+    case OP_XVSET:
+    case OP_XVPUSH: {
+      Value& vec = X[in.a];
+      const MetaType& vt = vec_type(vec);
+      const int from = in.op == OP_XVSET ? in.c : in.b;
+      Value e(*vt.element());
+      from_registers(*vt.element(), e.data(), R[from], S[from], V[from], X[from], "an element");
+      if (in.op == OP_XVSET)
+        vt.vector_set(vec.data(), index(vt, vec, R[in.b].i), e.data());
+      else
+        vt.vector_push(vec.data(), e.data());
       break;
     }
     default:
@@ -621,6 +801,7 @@ Val ProgramImpl::exec(std::size_t entry) {
           regs_.resize(need * 2);
           sregs_.resize(regs_.size());
           vregs_.resize(regs_.size());
+          xregs_.resize(regs_.size());
         }
         const std::uint64_t mark = fr->mark;
         frames_.push_back(Frame{&callee, callee.code.data(), nb, self, mark});
@@ -631,8 +812,11 @@ Val ProgramImpl::exec(std::size_t entry) {
         VSD_REFRESH();
         break;
       }
+      case OP_RETX:  // a Value result: into the frame's first X register, then as OP_RET
+        if (in.a != 0) xregs_[fr->base] = std::move(xregs_[fr->base + in.a]);
+        [[fallthrough]];
       case OP_RETV:  // a vector result: into the frame's first vector register, then as OP_RET
-        if (in.a != 0) vregs_[fr->base] = std::move(vregs_[fr->base + in.a]);
+        if (in.op == OP_RETV && in.a != 0) vregs_[fr->base] = std::move(vregs_[fr->base + in.a]);
         [[fallthrough]];
       case OP_RET:
       case OP_RET0: {
@@ -711,6 +895,9 @@ Val ProgramImpl::exec(std::size_t entry) {
           case PK::Vector:
             vector_load(ps.prop->type(), addr, vregs_[fr->base + in.a]);
             break;
+          case PK::Value:
+            xregs_[fr->base + in.a] = Value(ps.prop->type(), addr);
+            break;
           default:
             if (ps.prop->type().kind() == TypeKind::Float) {
               R[in.a].d = *static_cast<const float*>(addr);
@@ -769,6 +956,14 @@ Val ProgramImpl::exec(std::size_t entry) {
           case PK::Vector:
             store_vector(p, o, vregs_[fr->base + in.b]);
             break;
+          case PK::Value: {
+            const Value& x = xregs_[fr->base + in.b];
+            if (x.type() == nullptr || !detail::same_definition(*x.type(), p.type()))
+              fail("property '" + p.name() + "' (" + p.type().name() + ") cannot hold a " +
+                   (x.type() != nullptr ? x.type()->name() : std::string("missing value")));
+            p.assign_raw(o, x.data());
+            break;
+          }
           default:
             if (p.type().kind() == TypeKind::Float) {
               const auto f = static_cast<float>(R[in.b].d);
@@ -899,6 +1094,9 @@ Val ProgramImpl::exec(std::size_t entry) {
             case RK::S:
               args.emplace_back(S[in.a + 1 + i]);
               break;
+            case RK::X:
+              args.push_back(xregs_[fr->base + in.a + 1 + i]);
+              break;
             default: {
               SimStateInstance* t = v.id == 0 ? nullptr : &obj(v.id);
               args.emplace_back(SharedRef<SimStateInstance>(t));
@@ -931,6 +1129,9 @@ Val ProgramImpl::exec(std::size_t entry) {
             R[in.a].id = t != nullptr ? t->id() : 0;
             break;
           }
+          case RK::X:
+            xregs_[fr->base + in.a] = std::move(r);
+            break;
           default:
             break;
         }
@@ -989,6 +1190,15 @@ Val ProgramImpl::exec(std::size_t entry) {
             case RK::S:
               line += S[in.a + i];
               break;
+            case RK::V:
+              line +=
+                  vector_text(*print_types_[in.c][static_cast<std::size_t>(i)], vregs_[fr->base + in.a + i]);
+              break;
+            case RK::X: {
+              const Value& x = xregs_[fr->base + in.a + i];
+              line += x.to_text();
+              break;
+            }
             default: {
               const std::uint64_t id = R[in.a + i].id;
               const SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
@@ -1034,6 +1244,18 @@ Val ProgramImpl::exec(std::size_t entry) {
         break;
       case OP_FIND:
         R[in.a].id = find_node(S[in.b]);
+        break;
+      case OP_XDEF:
+      case OP_MOVX:
+      case OP_XGETF:
+      case OP_XSETF:
+      case OP_EQX:
+      case OP_XVSIZE:
+      case OP_XVGET:
+      case OP_XVSET:
+      case OP_XVPUSH:
+        VSD_SAVE();
+        value_op(in, *fr);
         break;
       default:
         VSD_SAVE();

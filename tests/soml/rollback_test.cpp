@@ -376,7 +376,8 @@ arrow p -> t;
   const std::string before = dump(state());
   // The compiler refuses a construct (after the classes and the enum were defined).
   std::string refused = good;
-  refused.replace(refused.find("return x * 2.0;"), 15, "Vector3d v; return x;");
+  refused.replace(refused.find("return x * 2.0;"), 15, "g()[0] = 1; return x;");
+  refused.replace(refused.find("double f("), 0, "vector<int> g() { vector<int> v; return v; } ");
   try {
     load(refused);
     FAIL() << "loaded";

@@ -59,6 +59,15 @@ class RefResolver {
   ~RefResolver() = default;
 };
 
+/// @brief Element access of a Vector MetaType (std::vector<T> and run-time vectors alike). Elements go in
+/// and out by copy, so that std::vector<bool> is served too; indices are in range (MetaType checks).
+struct VectorOps {
+  std::size_t (*size)(const MetaType&, const void* vec) noexcept;
+  void (*get)(const MetaType&, const void* vec, std::size_t i, void* out);  ///< assigns to a live value
+  void (*set)(const MetaType&, void* vec, std::size_t i, const void* in);
+  void (*push)(const MetaType&, void* vec, const void* in);  ///< appends a copy
+};
+
 /// @brief The operations of a MetaType. One table may serve several MetaTypes (e.g. all enums of a size).
 struct TypeOps {
   void (*construct)(const MetaType&, void* dst);  ///< default value into raw memory
@@ -74,6 +83,8 @@ struct TypeOps {
   void (*read_bytes)(const MetaType&, void* obj, ByteReader& in, const RefResolver* refs);
   /// For reference kinds: binds the storage to the instance and property that hold it.
   void (*bind)(const MetaType&, void* obj, SimStateInstance* holder, const MetaProperty* prop) = nullptr;
+  /// For Vector types: element access.
+  const VectorOps* vector = nullptr;
 };
 
 /// @brief Describes a value type. See the file comment.
@@ -164,6 +175,17 @@ class MetaType {
   }
   /// @brief The text form of a value.
   [[nodiscard]] std::string to_text(const void* obj) const;
+
+  // Element access of a Vector type (element(): the MetaType of the elements; @p out and @p in point to
+  // live values of it). @throws vsd::Error when this is no vector or @p i is out of range.
+  /// @brief The number of elements of the vector at @p vec.
+  [[nodiscard]] std::size_t vector_size(const void* vec) const;
+  /// @brief Assigns element @p i of the vector at @p vec to @p out.
+  void vector_get(const void* vec, std::size_t i, void* out) const;
+  /// @brief Assigns @p in to element @p i of the vector at @p vec.
+  void vector_set(void* vec, std::size_t i, const void* in) const;
+  /// @brief Appends a copy of @p in to the vector at @p vec.
+  void vector_push(void* vec, const void* in) const;
   /// @brief Parses a whole text into @p obj.
   /// @param origin names the text in errors (a file, "property speed", ...); empty: "<TYPE value>".
   /// @throws vsd::Error "origin:line:col: what" on bad text.
@@ -324,6 +346,30 @@ struct DefaultValue {
   static T make() { return T{}; }
 };
 
+/// The element access of std::vector<E> (none for other types).
+template <class T>
+struct VectorAccess {
+  static constexpr const VectorOps* ops = nullptr;
+};
+template <class E, class A>
+struct VectorAccess<std::vector<E, A>> {
+  using V = std::vector<E, A>;
+  static std::size_t size(const MetaType&, const void* v) noexcept {
+    return static_cast<const V*>(v)->size();
+  }
+  static void get(const MetaType&, const void* v, std::size_t i, void* out) {
+    *static_cast<E*>(out) = (*static_cast<const V*>(v))[i];
+  }
+  static void set(const MetaType&, void* v, std::size_t i, const void* in) {
+    (*static_cast<V*>(v))[i] = *static_cast<const E*>(in);
+  }
+  static void push(const MetaType&, void* v, const void* in) {
+    static_cast<V*>(v)->push_back(*static_cast<const E*>(in));
+  }
+  static constexpr VectorOps table{&size, &get, &set, &push};
+  static constexpr const VectorOps* ops = &table;
+};
+
 /// The ops table of a C++ type T, made from the generic operations above.
 template <class T>
 struct ValueOps {
@@ -356,9 +402,9 @@ struct ValueOps {
   static void read_bytes(const MetaType& t, void* obj, ByteReader& in, const RefResolver* refs) {
     bytes_in(t, *static_cast<T*>(obj), in, refs);
   }
-  static constexpr TypeOps table{&construct, &copy_construct, &move_construct, &destroy,
-                                 &assign,    &equal,          &hash,           &write_text,
-                                 &read_text, &write_bytes,    &read_bytes,     nullptr};
+  static constexpr TypeOps table{&construct,  &copy_construct, &move_construct,     &destroy,   &assign,
+                                 &equal,      &hash,           &write_text,         &read_text, &write_bytes,
+                                 &read_bytes, nullptr,         VectorAccess<T>::ops};
 };
 
 /// Makes the MetaType of a C++ type with ValueOps<T>.

@@ -136,7 +136,8 @@ struct Binding {
     Net,           ///< decl: ClassDecl of a net
     StructField,   ///< slot: field index of meta_type
     Mark,
-    This
+    This,
+    Construct  ///< meta_type: a registry struct named as a function, `Vector3d(1, 2, 3)`
   };
 
   Kind kind = Kind::None;

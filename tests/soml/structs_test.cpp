@@ -1,0 +1,227 @@
+// SOML++ structs and vectors of structs as values in code (docs/soml.md 4.14): locals, parameters and
+// results, fields read and written, `Vector3d(x, y, z)`, ==; struct and vector<Vector3d> properties read
+// in place and written whole, by field or by element through their setter (one change that signals,
+// records and replays); MetaMethods called from C++ with Values; errors with their position.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "vsd/core.hpp"
+#include "vsd/soml.hpp"
+
+namespace {
+
+using ::testing::HasSubstr;
+using vsd::soml::Program;
+using V3 = Eigen::Vector3d;
+
+std::string struct_error_of(const std::function<void()>& fn) {
+  try {
+    fn();
+  } catch (const vsd::Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+struct Structs : ::testing::Test {
+  vsd::Registry reg;
+  vsd::Environment env{0, reg};
+  std::ostringstream out;
+  vsd::soml::Module* soml = nullptr;
+  void SetUp() override { soml = &env.use<vsd::soml::Module>(); }
+  Program& load(const std::string& text, const std::string& file = "test.soml") {
+    vsd::soml::RunOptions o;
+    o.out = &out;
+    return soml->load(env.main_state(), file, text, o);
+  }
+};
+
+TEST_F(Structs, FunctionsWithStructsAreMetaMethodsCalledWithValues) {
+  Program& p = load(R"(
+Vector3d mid(Vector3d a, Vector3d b) { return Vector3d((a.x + b.x) / 2, (a.y + b.y) / 2, (a.z + b.z) / 2); }
+// A copy is a copy: the callee changes its parameter, the caller's value stays.
+void clobber(Vector3d v) { v.x = 99; }
+vector<Vector3d> line(int n) {
+  vector<Vector3d> out;
+  for (int i = 0; i < n; i++) out.push(Vector3d(i, 2 * i, 0));
+  return out;
+}
+double sum_x(vector<Vector3d> v) { double s = 0; for (Vector3d p : v) s += p.x; return s; }
+bool copies() { Vector3d a = Vector3d(1, 2, 3); Vector3d b = a; b.y = 7; clobber(a); return a == Vector3d(1, 2, 3) && b != a; }
+Isometry3d moved(Isometry3d t, double dz) { t.translation.z += dz; return t; }
+)");
+  vsd::Node& root = p.root();
+  EXPECT_EQ(root.call("mid", {vsd::Value(V3(1, 2, 3)), vsd::Value(V3(3, 4, 5))}).as<V3>(), V3(2, 3, 4));
+  EXPECT_EQ(root.call("line", {vsd::Value(std::int64_t{3})}).as<std::vector<V3>>(),
+            (std::vector<V3>{V3(0, 0, 0), V3(1, 2, 0), V3(2, 4, 0)}));
+  EXPECT_DOUBLE_EQ(root.call("sum_x", {vsd::Value(std::vector<V3>{V3(1, 0, 0), V3(2.5, 0, 0)})}).as<double>(),
+                   3.5);
+  EXPECT_TRUE(root.call("copies", {}).as<bool>());
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = V3(1, 2, 3);
+  const Eigen::Isometry3d m = root.call("moved", {vsd::Value(t), vsd::Value(0.5)}).as<Eigen::Isometry3d>();
+  EXPECT_EQ(m.translation(), V3(1, 2, 3.5));
+  // A wrong argument is a vsd::Error naming both types, never a crash.
+  EXPECT_THAT(struct_error_of([&] {
+                root.call("mid", {vsd::Value(1.0), vsd::Value(V3(0, 0, 0))});
+              }),
+              HasSubstr("mid argument 1: expected Vector3d, got double"));
+  EXPECT_THAT(struct_error_of([&] { root.call("sum_x", {vsd::Value(std::vector<double>{1.0})}); }),
+              HasSubstr("sum_x argument 1: expected vector<Vector3d>, got vector<double>"));
+}
+
+TEST_F(Structs, PropertyWritesGoThroughTheSetterOnceAndReplay) {
+  Program& p = load(R"(
+class Body : Node {
+  Vector3d offset = Vector3d(0.5, 0, 0);
+  vector<Vector3d> path;
+}
+shared<Body> body = new Body();
+void move() {
+  body.offset.x += 1;                    // read, change the field, store: one change
+  body.offset = Vector3d(body.offset.x, 2, 3);
+  body.path.push(Vector3d(1, 1, 1));
+  body.path.push(body.offset);
+  body.path[0].z = 9;                    // one change of path
+  body.path[1] = Vector3d(4, 5, 6);
+}
+double z0() { return body.path[0].z + body.path.size(); }   // read in place
+)");
+  vsd::Node& root = p.root();
+  const vsd::Node* body = root.get<vsd::SharedRef<vsd::Node>>("body").get();
+  ASSERT_NE(body, nullptr);
+  EXPECT_EQ(body->get<V3>("offset"), V3(0.5, 0, 0)) << "a property initialiser of struct type";
+
+  std::vector<std::string> changed;
+  auto c = env.main_state().on_property_changed().connect(
+      [&](vsd::SimStateInstance&, const vsd::MetaProperty& mp) { changed.push_back(mp.name()); });
+  vsd::SimState& replica = env.create_state("replica");
+  replica.copy_from(env.main_state());
+  env.main_state().start_recording();
+  root.call("move", {});
+  vsd::Transaction t = env.main_state().stop_recording();
+
+  EXPECT_EQ(body->get<V3>("offset"), V3(1.5, 2, 3));
+  EXPECT_EQ(body->get<std::vector<V3>>("path"), (std::vector<V3>{V3(1, 1, 9), V3(4, 5, 6)}));
+  EXPECT_DOUBLE_EQ(root.call("z0", {}).as<double>(), 11.0);
+  EXPECT_EQ(std::count(changed.begin(), changed.end(), "offset"), 2);
+  EXPECT_EQ(std::count(changed.begin(), changed.end(), "path"), 4);
+  replica.apply(t);
+  std::string diff;
+  EXPECT_TRUE(replica.equals(env.main_state(), &diff)) << diff;
+}
+
+TEST_F(Structs, AConditionReadingAStructOrItsVectorIsRetestedWhenItChanges) {
+  Program& p = load(R"(
+Vector3d target;
+vector<Vector3d> points;
+int hits = 0;
+place watch = 1;
+transition near {
+  when target.z > 1.0 && points.size() > 0 && points[0].x == target.x;
+  do { hits += 1; }
+}
+arrow watch -> near;
+)");
+  EXPECT_EQ(p.run_until_quiet(), 0u);
+  p.root().set("target", vsd::Value(V3(2, 0, 5)));
+  EXPECT_EQ(p.run_until_quiet(), 0u);
+  p.root().set("points", vsd::Value(std::vector<V3>{V3(2, 0, 0)}));
+  EXPECT_EQ(p.run_until_quiet(), 1u) << "the change of points re-tested the condition";
+  EXPECT_EQ(p.root().get<std::int64_t>("hits"), 1);
+}
+
+TEST_F(Structs, VectorsOfRegistryEnumsAndStringsAreValuesAndPrint) {
+  const vsd::MetaType& shade = vsd::EnumBuilder("Shade").value("Dark", 0).value("Light", 3).define(reg);
+  const vsd::MetaType& shades = reg.vector_type(shade);
+  Program& p = load(R"(
+vector<Shade> shades;
+vector<string> names;
+vector<Shade> flipped(vector<Shade> in) {
+  vector<Shade> out;
+  for (Shade s : in) out.push(s == Shade::Dark ? Shade::Light : Shade::Dark);
+  return out;
+}
+void f() {
+  vector<Shade> l;
+  l.push(Shade::Light);
+  l.push(Shade::Dark);
+  shades = flipped(l);
+  shades[1] = Shade::Light;
+  names.push("a");
+  print(l, " ", shades, " ", names, " ", shades[0] == Shade::Dark, " ", l.size());
+}
+)");
+  p.root().call("f", {});
+  EXPECT_EQ(out.str(), "[\"Light\", \"Dark\"] [\"Dark\", \"Light\"] [\"a\"] true 2\n");
+  const vsd::Value v = p.root().get("shades");
+  ASSERT_EQ(v.type(), &shades);
+  EXPECT_EQ(v.to_text(), R"(["Dark", "Light"])");
+}
+
+TEST_F(Structs, AConditionMayChangeAFieldOfALocalButNotOfAProperty) {
+  Program& p = load(R"(
+Vector3d target = Vector3d(1, 2, 3);
+int hits = 0;
+place watch = 1;
+transition near {
+  when { Vector3d v = target; v.z = 0; return v == Vector3d(1, 2, 0); }
+  do { hits += 1; }
+}
+arrow watch -> near;
+)");
+  EXPECT_EQ(p.run_until_quiet(), 1u);
+  EXPECT_THAT(struct_error_of([&] {
+                load(
+                    "Vector3d target;\nplace w = 1;\ntransition t { when { target.z = 0; return true; } "
+                    "}\narrow w -> t;\n",
+                    "cond.soml");
+              }),
+              HasSubstr("cond.soml:3:29: error: a condition must not change properties"));
+}
+
+TEST_F(Structs, MistakesAreReportedWithTheirPosition) {
+  const std::string e = struct_error_of([&] {
+    load(R"(void f() {
+  Vector3d v;
+  v.w = 1;
+  double d = v;
+  vector<Vector3d> l;
+  l.push(1.0);
+  Vector3d u = Vector3d(1, 2);
+  bool b = v == 1.0;
+}
+)",
+         "bad.soml");
+  });
+  EXPECT_THAT(e, HasSubstr("bad.soml:3:5: error: type 'Vector3d' has no field 'w'"));
+  EXPECT_THAT(e,
+              HasSubstr("bad.soml:4:14: error: type mismatch: the initialiser of 'd' must be 'double', not "
+                        "'Vector3d'"));
+  EXPECT_THAT(e, HasSubstr("bad.soml:6:10: error: type mismatch: the element to push must be 'Vector3d', not "
+                           "'double'"));
+  EXPECT_THAT(e, HasSubstr("bad.soml:7:24: error: wrong number of arguments: 'Vector3d' (double x, double y, "
+                           "double z; or none for the default) takes 3, 2 given"));
+  EXPECT_THAT(e, HasSubstr("bad.soml:8:14: error: type mismatch"));
+}
+
+TEST_F(Structs, AnElementOutOfRangeIsARunTimeErrorWithTheCallStack) {
+  Program& p = load(R"(vector<Vector3d> points;
+double at(int i) { return points[i].y; }
+double local(int i) { vector<Vector3d> v = points; v[i].x = 1; return v[i].x; }
+)");
+  p.root().set("points", vsd::Value(std::vector<V3>{V3(1, 2, 3)}));
+  EXPECT_DOUBLE_EQ(p.root().call("at", {vsd::Value(std::int64_t{0})}).as<double>(), 2.0);
+  EXPECT_THAT(struct_error_of([&] { p.root().call("at", {vsd::Value(std::int64_t{1})}); }),
+              HasSubstr("index 1 out of range (size 1)\n  at at (test.soml:2)"));
+  EXPECT_THAT(struct_error_of([&] { p.root().call("local", {vsd::Value(std::int64_t{-1})}); }),
+              HasSubstr("index -1 out of range (size 1)\n  at local (test.soml:3)"));
+}
+
+}  // namespace
