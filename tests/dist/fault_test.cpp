@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 
 #include "dist_test_util.hpp"
@@ -66,6 +67,23 @@ struct RawWriter {
 std::vector<std::uint8_t> envelope(std::vector<std::uint8_t> body) {
   body.insert(body.begin(), {'V', 'S', 'D', 'D', 2});
   return body;
+}
+
+// A sample's payload holding a wire bundle (docs/dist.md) of one operation @p op on instance @p id whose
+// name table is @p name alone (the class of a creation, the property of a set or list edit); @p rest
+// writes what follows the operation's name index.
+std::vector<std::uint8_t> one_op(const std::string& name, std::uint8_t op, vsd::Id id,
+                                 const std::function<void(vsd::ByteWriter&)>& rest) {
+  std::vector<std::uint8_t> body{'V', 'S', 'D', 'W', 2};
+  vsd::ByteWriter w(body);
+  w.varint(1);
+  w.string(name);
+  w.varint(1);
+  w.u8(op);
+  w.varint(id);
+  w.varint(0);
+  rest(w);
+  return envelope(body);
 }
 
 struct FaultTest : testing::Test {
@@ -133,19 +151,12 @@ TEST_F(FaultTest, AnEditOfAnUnknownListEntryResynchronises) {
   ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return pb.synced(); }));
   RawWriter raw(domain);
   ASSERT_TRUE(raw.wait_matched(2));
-  std::vector<std::uint8_t> body{'V', 'S', 'D', 'W', 2};
-  vsd::ByteWriter w(body);
-  w.varint(1);
-  w.string("tools");
-  w.varint(1);  // one operation: erase entry (5, 0x77, 1) of arm.tools
-  w.u8(7);
-  w.varint(arm->id());
-  w.varint(0);
-  w.varint(5);
-  w.fixed(std::uint64_t{0x77});
-  w.varint(1);
-  w.varint(arm->id());
-  raw.send(80, 1, 1, envelope(body));
+  raw.send(80, 1, 1, one_op("tools", 7, arm->id(), [&](vsd::ByteWriter& w) {  // erase entry (5, 0x77, 1)
+             w.varint(5);
+             w.fixed(std::uint64_t{0x77});
+             w.varint(1);
+             w.varint(arm->id());
+           }));
   ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return contains(log_b, "it edits a list entry unknown here"); }))
       << testing::PrintToString(log_b);
   ASSERT_TRUE(poll_all(
@@ -171,20 +182,13 @@ TEST_F(FaultTest, AnEditOfAnEntryStillOnTheWayWaitsForIt) {
   ASSERT_TRUE(raw.wait_matched(2));
   auto insert = [&](std::uint64_t origin_clock, std::uint64_t origin_who, std::uint64_t origin_n,
                     vsd::Id target) {
-    std::vector<std::uint8_t> body{'V', 'S', 'D', 'W', 2};
-    vsd::ByteWriter w(body);
-    w.varint(1);
-    w.string("tools");
-    w.varint(1);
-    w.u8(6);  // entry insert: entry number 1 of the bundle, after the origin
-    w.varint(arm->id());
-    w.varint(0);
-    w.varint(1);
-    w.varint(origin_clock);
-    w.fixed(origin_who);
-    w.varint(origin_n);
-    w.varint(target);
-    return envelope(body);
+    return one_op("tools", 6, arm->id(), [&](vsd::ByteWriter& w) {  // entry 1 of the bundle, after the origin
+      w.varint(1);
+      w.varint(origin_clock);
+      w.fixed(origin_who);
+      w.varint(origin_n);
+      w.varint(target);
+    });
   };
   // Participant 0x90 saw 0x91's entry (clock 5) and inserted after it (clock 10); 0x91's bundle comes later.
   raw.send(0x90, 1, 1, insert(5, 0x91, 1, n2.id()), 10);
@@ -213,29 +217,20 @@ TEST_F(FaultTest, AReferenceToAnInstanceStillOnTheWayWaitsForIt) {
   ASSERT_TRUE(raw.wait_matched(2));
   const vsd::Id made = 0x91000005;  // an id of the third participant's range, unused here
   ASSERT_EQ(a.find(made), nullptr);
-  auto bundle = [](const std::string& name, std::uint8_t op, vsd::Id id, std::vector<std::uint8_t> rest) {
-    std::vector<std::uint8_t> body{'V', 'S', 'D', 'W', 2};
-    vsd::ByteWriter w(body);
-    w.varint(1);
-    w.string(name);
-    w.varint(1);
-    w.u8(op);
-    w.varint(id);
-    w.varint(0);
-    body.insert(body.end(), rest.begin(), rest.end());
-    return envelope(body);
-  };
-  std::vector<std::uint8_t> ref;  // set (3): the value's length, then the reference's varint id
-  {
-    std::vector<std::uint8_t> v;
-    vsd::ByteWriter vw(v);
-    vw.varint(made);
-    vsd::ByteWriter w(ref);
-    w.varint(v.size());
-    ref.insert(ref.end(), v.begin(), v.end());
-  }
-  raw.send(0x90, 1, 1, bundle("watched", 3, arm->id(), ref), 10);
-  raw.send(0x91, 1, 1, bundle(std::string(vsd::Node::static_meta().name()), 1, made, {0}), 5);
+  // 0x90's set of arm.watched (the value's length, then the reference's id), and 0x91's creation.
+  raw.send(0x90, 1, 1,
+           one_op("watched", 3, arm->id(),
+                  [&](vsd::ByteWriter& w) {
+                    std::vector<std::uint8_t> v;
+                    vsd::ByteWriter(v).varint(made);
+                    w.varint(v.size());
+                    for (std::uint8_t x : v) w.u8(x);
+                  }),
+           10);
+  raw.send(
+      0x91, 1, 1,
+      one_op(std::string(vsd::Node::static_meta().name()), 1, made, [](vsd::ByteWriter& w) { w.varint(0); }),
+      5);
   auto watched = [&](vsd::SimState& s) -> vsd::Id {
     const vsd::Node* n = s.find<DArm>(arm->id())->watched().get();
     return n != nullptr ? n->id() : vsd::null_id;
@@ -255,17 +250,13 @@ TEST_F(FaultTest, AReferenceToAnInstanceNobodyMakesResynchronisesAfterTheWait) {
   ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return pb.synced(); }));
   RawWriter raw(domain);
   ASSERT_TRUE(raw.wait_matched(2));
-  std::vector<std::uint8_t> body{'V', 'S', 'D', 'W', 2};
-  vsd::ByteWriter w(body);
-  w.varint(1);
-  w.string("watched");
-  w.varint(1);
-  w.u8(3);
-  w.varint(arm->id());
-  w.varint(0);
-  w.varint(4);  // the value: a 4-byte varint id nobody has
-  w.varint(0x0abcdef0);
-  raw.send(0x92, 1, 1, envelope(body), 3);
+  raw.send(0x92, 1, 1,
+           one_op("watched", 3, arm->id(),
+                  [](vsd::ByteWriter& w) {
+                    w.varint(4);  // the value: a 4-byte varint id nobody has
+                    w.varint(0x0abcdef0);
+                  }),
+           3);
   ASSERT_TRUE(poll_all(
       {&pa, &pb}, [&] { return pb.stats().resyncs >= 1 && pb.synced() && pa.synced(); }, 15s))
       << testing::PrintToString(log_b);

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "script_fixture.hpp"
 #include "vsd/core.hpp"
 #include "vsd/soml.hpp"
 
@@ -20,27 +21,7 @@ using ::testing::HasSubstr;
 using vsd::soml::Program;
 using V3 = Eigen::Vector3d;
 
-std::string struct_error_of(const std::function<void()>& fn) {
-  try {
-    fn();
-  } catch (const vsd::Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
-
-struct Structs : ::testing::Test {
-  vsd::Registry reg;
-  vsd::Environment env{0, reg};
-  std::ostringstream out;
-  vsd::soml::Module* soml = nullptr;
-  void SetUp() override { soml = &env.use<vsd::soml::Module>(); }
-  Program& load(const std::string& text, const std::string& file = "test.soml") {
-    vsd::soml::RunOptions o;
-    o.out = &out;
-    return soml->load(env.main_state(), file, text, o);
-  }
-};
+struct Structs : soml_test::ScriptTest {};
 
 TEST_F(Structs, FunctionsWithStructsAreMetaMethodsCalledWithValues) {
   Program& p = load(R"(
@@ -68,11 +49,11 @@ Isometry3d moved(Isometry3d t, double dz) { t.translation.z += dz; return t; }
   const Eigen::Isometry3d m = root.call("moved", {vsd::Value(t), vsd::Value(0.5)}).as<Eigen::Isometry3d>();
   EXPECT_EQ(m.translation(), V3(1, 2, 3.5));
   // A wrong argument is a vsd::Error naming both types, never a crash.
-  EXPECT_THAT(struct_error_of([&] {
+  EXPECT_THAT(soml_test::error_of([&] {
                 root.call("mid", {vsd::Value(1.0), vsd::Value(V3(0, 0, 0))});
               }),
               HasSubstr("mid argument 1: expected Vector3d, got double"));
-  EXPECT_THAT(struct_error_of([&] { root.call("sum_x", {vsd::Value(std::vector<double>{1.0})}); }),
+  EXPECT_THAT(soml_test::error_of([&] { root.call("sum_x", {vsd::Value(std::vector<double>{1.0})}); }),
               HasSubstr("sum_x argument 1: expected vector<Vector3d>, got vector<double>"));
 }
 
@@ -177,7 +158,7 @@ transition near {
 arrow watch -> near;
 )");
   EXPECT_EQ(p.run_until_quiet(), 1u);
-  EXPECT_THAT(struct_error_of([&] {
+  EXPECT_THAT(soml_test::error_of([&] {
                 load(
                     "Vector3d target;\nplace w = 1;\ntransition t { when { target.z = 0; return true; } "
                     "}\narrow w -> t;\n",
@@ -187,7 +168,7 @@ arrow watch -> near;
 }
 
 TEST_F(Structs, MistakesAreReportedWithTheirPosition) {
-  const std::string e = struct_error_of([&] {
+  const std::string e = soml_test::error_of([&] {
     load(R"(void f() {
   Vector3d v;
   v.w = 1;
@@ -218,9 +199,9 @@ double local(int i) { vector<Vector3d> v = points; v[i].x = 1; return v[i].x; }
 )");
   p.root().set("points", vsd::Value(std::vector<V3>{V3(1, 2, 3)}));
   EXPECT_DOUBLE_EQ(p.root().call("at", {vsd::Value(std::int64_t{0})}).as<double>(), 2.0);
-  EXPECT_THAT(struct_error_of([&] { p.root().call("at", {vsd::Value(std::int64_t{1})}); }),
+  EXPECT_THAT(soml_test::error_of([&] { p.root().call("at", {vsd::Value(std::int64_t{1})}); }),
               HasSubstr("index 1 out of range (size 1)\n  at at (test.soml:2)"));
-  EXPECT_THAT(struct_error_of([&] { p.root().call("local", {vsd::Value(std::int64_t{-1})}); }),
+  EXPECT_THAT(soml_test::error_of([&] { p.root().call("local", {vsd::Value(std::int64_t{-1})}); }),
               HasSubstr("index -1 out of range (size 1)\n  at local (test.soml:3)"));
 }
 

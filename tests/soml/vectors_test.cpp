@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "script_fixture.hpp"
 #include "vsd/core.hpp"
 #include "vsd/soml.hpp"
 
@@ -17,27 +18,7 @@ namespace {
 using ::testing::HasSubstr;
 using vsd::soml::Program;
 
-std::string error_of(const std::function<void()>& fn) {
-  try {
-    fn();
-  } catch (const vsd::Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
-
-struct Vectors : ::testing::Test {
-  vsd::Registry reg;
-  vsd::Environment env{0, reg};
-  std::ostringstream out;
-  vsd::soml::Module* soml = nullptr;
-  void SetUp() override { soml = &env.use<vsd::soml::Module>(); }
-  Program& load(const std::string& text, const std::string& file = "test.soml") {
-    vsd::soml::RunOptions o;
-    o.out = &out;
-    return soml->load(env.main_state(), file, text, o);
-  }
-};
+struct Vectors : soml_test::ScriptTest {};
 
 TEST_F(Vectors, LocalsParametersAndResultsAreValues) {
   Program& p = load(R"(
@@ -88,9 +69,10 @@ vector<bool> flags() { vector<bool> f; f.push(true); f.push(false); return f; }
 
 TEST_F(Vectors, WrongVectorArgumentsFromCppAreErrors) {
   Program& p = load("double first(vector<double> v) { return v[0]; }\n");
-  EXPECT_THAT(error_of([&] { p.root().call("first", {vsd::Value(std::vector<std::string>{"x"})}); }),
-              HasSubstr("first"));
-  EXPECT_THAT(error_of([&] { p.root().call("first", {vsd::Value(2.0)}); }), HasSubstr("first"));
+  EXPECT_THAT(
+      soml_test::error_of([&] { p.root().call("first", {vsd::Value(std::vector<std::string>{"x"})}); }),
+      HasSubstr("first"));
+  EXPECT_THAT(soml_test::error_of([&] { p.root().call("first", {vsd::Value(2.0)}); }), HasSubstr("first"));
 }
 
 TEST_F(Vectors, PropertiesAreReadInPlaceAndWrittenThroughTheSetter) {
@@ -177,20 +159,20 @@ void write_prop(int i) { ids[i] = 1; }
 )");
   vsd::Node& root = p.root();
   EXPECT_EQ(root.call("outer", {vsd::Value(std::int64_t{0})}).as<std::int64_t>(), 3);
-  std::string e = error_of([&] { root.call("outer", {vsd::Value(std::int64_t{1})}); });
+  std::string e = soml_test::error_of([&] { root.call("outer", {vsd::Value(std::int64_t{1})}); });
   EXPECT_THAT(e, HasSubstr("SOML++ run-time error: index 1 out of range (size 1)"));
   EXPECT_THAT(e, HasSubstr("at at (test.soml:3)"));
   EXPECT_THAT(e, HasSubstr("at outer (test.soml:8)"));
-  EXPECT_THAT(error_of([&] { root.call("outer", {vsd::Value(std::int64_t{-1})}); }),
+  EXPECT_THAT(soml_test::error_of([&] { root.call("outer", {vsd::Value(std::int64_t{-1})}); }),
               HasSubstr("index -1 out of range (size 1)"));
-  EXPECT_THAT(error_of([&] { root.call("set_local", {vsd::Value(std::int64_t{1})}); }),
+  EXPECT_THAT(soml_test::error_of([&] { root.call("set_local", {vsd::Value(std::int64_t{1})}); }),
               HasSubstr("index 1 out of range (size 1)\n  at set_local (test.soml:10)"));
-  EXPECT_THAT(error_of([&] { root.call("read_prop", {vsd::Value(std::int64_t{0})}); }),
+  EXPECT_THAT(soml_test::error_of([&] { root.call("read_prop", {vsd::Value(std::int64_t{0})}); }),
               HasSubstr("index 0 out of range (size 0)\n  at read_prop (test.soml:11)"));
   int changes = 0;
   auto c = env.main_state().on_property_changed().connect(
       [&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++changes; });
-  EXPECT_THAT(error_of([&] { root.call("write_prop", {vsd::Value(std::int64_t{2})}); }),
+  EXPECT_THAT(soml_test::error_of([&] { root.call("write_prop", {vsd::Value(std::int64_t{2})}); }),
               HasSubstr("index 2 out of range (size 0)\n  at write_prop (test.soml:12)"));
   EXPECT_EQ(changes, 0) << "a failed element write changes nothing";
 }
@@ -200,7 +182,7 @@ TEST_F(Vectors, ElementsThatDoNotFitAPropertyAreErrors) {
 void add(int v) { small.push(v); }
 )");
   p.root().call("add", {vsd::Value(std::int64_t{100})});
-  EXPECT_THAT(error_of([&] { p.root().call("add", {vsd::Value(std::int64_t{5000000000})}); }),
+  EXPECT_THAT(soml_test::error_of([&] { p.root().call("add", {vsd::Value(std::int64_t{5000000000})}); }),
               HasSubstr("the value 5000000000 does not fit property 'small' (elements int32)\n"
                         "  at add (test.soml:2)"));
   EXPECT_EQ(p.root().get<std::vector<std::int32_t>>("small"), (std::vector<std::int32_t>{100}));
@@ -210,7 +192,7 @@ TEST_F(Vectors, WhatTheVmCannotHoldIsRefusedWithAPosition) {
   // (Each script has a file of its own: a refused script's classes may stay registered.)
   // An element of a temporary vector cannot be assigned (it would be lost).
   EXPECT_THAT(
-      error_of([&] {
+      soml_test::error_of([&] {
         load("vector<int> make() { vector<int> v; v.push(1); return v; }\nvoid f() { make()[0] = 2; }\n",
              "b.soml");
       }),
@@ -269,7 +251,7 @@ bool absent(string path) { return find(path) == null; }
   EXPECT_TRUE(p.root().call("absent", {vsd::Value(std::string("nowhere/at/all"))}).as<bool>());
   plant.remove_child(tank);  // deleted: nothing holds it any more
   EXPECT_EQ(found("/plant/tank"), nullptr);
-  EXPECT_THAT(error_of([&] { load("shared<Node> f() { return find(1); }\n", "d.soml"); }),
+  EXPECT_THAT(soml_test::error_of([&] { load("shared<Node> f() { return find(1); }\n", "d.soml"); }),
               HasSubstr("d.soml:1:32: error: type mismatch"));
 }
 
