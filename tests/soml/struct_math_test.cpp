@@ -252,4 +252,32 @@ void show() {
             "Quaterniond(1, 0, 0, 0)) Quaterniond(0, 1, 0, 0) Vector2d(0.5, -1)\n");
 }
 
+TEST_F(StructMath, TheDebuggerShowsStructsAsPrintDoes) {
+  Program& p = load(R"(object probe {
+  Vector3d offset = Vector3d(1, 2, 3);
+  place go = 1;
+  transition t {
+    do {
+      Vector3d v = offset * 2;
+      print(v);
+    }
+  }
+  arrow go -> t;
+}
+)",
+                    "dbg.soml");
+  vsd::soml::Debugger d(p);
+  d.break_at_line(7);
+  std::string locals, prop;
+  d.on_stop([&](vsd::soml::Debugger& dd, const vsd::soml::Stop&) {
+    for (const auto& v : dd.locals()) locals += v.type + " " + v.name + " = " + v.value;
+    prop = dd.print("offset");
+    return vsd::soml::Resume::Continue;
+  });
+  EXPECT_EQ(p.step(1), 1u);
+  EXPECT_EQ(locals, "Vector3d v = Vector3d(2, 4, 6)");
+  EXPECT_EQ(prop, "offset = Vector3d(1, 2, 3)");
+  EXPECT_EQ(out.str(), "Vector3d(2, 4, 6)\n");
+}
+
 }  // namespace struct_math_test
