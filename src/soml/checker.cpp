@@ -131,6 +131,92 @@ constexpr BuiltinFn builtin_functions[] = {
     {"floor", Builtin::Floor}, {"ceil", Builtin::Ceil}, {"min", Builtin::Min},
     {"max", Builtin::Max},     {"len", Builtin::Len},   {"find", Builtin::Find}};
 
+// The Eigen structs that have arithmetic in code (docs/soml.md 4.14), by their static type.
+enum class Eig : unsigned char { None, V2, V3, V4, Quat, Iso };
+Eig eig(const Type& t) noexcept {
+  if (t.kind != K::Struct) return Eig::None;
+  if (t.meta == &meta_type<Eigen::Vector3d>()) return Eig::V3;
+  if (t.meta == &meta_type<Eigen::Vector2d>()) return Eig::V2;
+  if (t.meta == &meta_type<Eigen::Vector4d>()) return Eig::V4;
+  if (t.meta == &meta_type<Eigen::Quaterniond>()) return Eig::Quat;
+  if (t.meta == &meta_type<Eigen::Isometry3d>()) return Eig::Iso;
+  return Eig::None;
+}
+bool is_vec(Eig e) noexcept { return e == Eig::V2 || e == Eig::V3 || e == Eig::V4; }
+
+// The type of `l op r` (+ - * /) when an operand is a struct; the error type when it is not defined.
+Type struct_binary(TokenKind op, const Type& l, const Type& r) {
+  const Eig a = eig(l), b = eig(r);
+  const bool rot = a == Eig::Quat || a == Eig::Iso;
+  switch (op) {
+    case TokenKind::Plus:
+    case TokenKind::Minus:
+      if (is_vec(a) && a == b) return l;
+      break;
+    case TokenKind::Star:
+      if (is_vec(a) && r.is_numeric()) return l;
+      if (is_vec(b) && l.is_numeric()) return r;
+      if (rot && a == b) return l;        // q * q, T * T
+      if (rot && b == Eig::V3) return r;  // q * v, T * v
+      break;
+    case TokenKind::Slash:
+      if (is_vec(a) && r.is_numeric()) return l;
+      break;
+    default:
+      break;
+  }
+  return Type::error();
+}
+
+// What struct_binary accepts, for its type mismatch message.
+const char* struct_operands(TokenKind op) {
+  switch (op) {
+    case TokenKind::Plus:
+    case TokenKind::Minus:
+      return "two numbers or two vectors of one size";
+    case TokenKind::Star:
+      return "numbers, a vector and a number, two Quaterniond or two Isometry3d, or a Quaterniond or "
+             "Isometry3d and a Vector3d";
+    default:
+      return "numbers, or a vector and a number";
+  }
+}
+
+// The methods of the Eigen structs: the operation of @p name on a value of kind @p e, if it has one.
+bool struct_method(Eig e, std::string_view name, StructOp& op) {
+  if (is_vec(e)) {
+    if (name == "dot")
+      op = StructOp::Dot;
+    else if (name == "norm")
+      op = StructOp::Norm;
+    else if (name == "squared_norm")
+      op = StructOp::SquaredNorm;
+    else if (name == "normalized")
+      op = StructOp::Normalized;
+    else if (name == "cross" && e == Eig::V3)
+      op = StructOp::Cross;
+    else
+      return false;
+    return true;
+  }
+  if (e == Eig::Quat) {
+    if (name == "normalized")
+      op = StructOp::Normalized;
+    else if (name == "inverse")
+      op = StructOp::Inverse;
+    else if (name == "conjugate")
+      op = StructOp::Conjugate;
+    else
+      return false;
+    return true;
+  }
+  if (e == Eig::Iso && name == "inverse") {
+    op = StructOp::Inverse;
+    return true;
+  }
+  return false;
+}
+
 class CheckerImpl {
  public:
   CheckerImpl(Diagnostics& d, const Registry& r) : diag_(d), reg_(r) {}
@@ -992,6 +1078,14 @@ Type CheckerImpl::check_qualified(NameExpr& e, Context& cx) {
       b.outer = 0;
       continue;
     }
+    if (b.kind == BK::Construct && b.meta_type == &meta_type<Eigen::Quaterniond>() &&
+        part == "from_axis_angle") {
+      b.kind = BK::Builtin;
+      b.builtin = Builtin::StructOp;
+      b.slot = static_cast<int>(StructOp::FromAxisAngle);
+      cur = Type::of(K::Function);
+      continue;
+    }
     diag_.error(e.loc, q(so_far) + " has no member " + q(part) + " reachable with '::'");
     return Type::error();
   }
@@ -1092,7 +1186,20 @@ Type CheckerImpl::check_member(MemberExpr& e, Context& cx) {
           e.binding.meta_type = obj.meta;
           return type_of_meta(fields[i].type);
         }
-      diag_.error(e.name_loc, "type " + q(obj.name()) + " has no field " + q(n));
+      if (StructOp op{}; struct_method(eig(obj), n, op)) {  // `v.norm()`: called in check_builtin_call
+        e.binding.kind = BK::Builtin;
+        e.binding.builtin = Builtin::StructOp;
+        e.binding.slot = static_cast<int>(op);
+        e.binding.meta_type = obj.meta;
+        return Type::of(K::Function);
+      }
+      const Eig k = eig(obj);
+      diag_.error(e.name_loc, "type " + q(obj.name()) + " has no field " + q(n) +
+                                  (k == Eig::V3 ? " (its methods: dot, cross, norm, squared_norm, normalized)"
+                                   : is_vec(k)  ? " (its methods: dot, norm, squared_norm, normalized)"
+                                   : k == Eig::Quat ? " (its methods: inverse, conjugate, normalized)"
+                                   : k == Eig::Iso  ? " (its method: inverse)"
+                                                    : ""));
       return Type::error();
     }
     case K::Vector:
@@ -1204,6 +1311,32 @@ Type CheckerImpl::check_builtin_call(CallExpr& e, Builtin id, std::string_view n
       expect_type(*e.args[0], elem, cx, "the element to push");
       return Type::of(K::Void);
     }
+    case Builtin::StructOp: {
+      std::vector<Type> params;
+      Type result = self;
+      switch (static_cast<StructOp>(e.binding.slot)) {
+        case StructOp::Dot:
+          params = {self};
+          result = dbl;
+          break;
+        case StructOp::Norm:
+        case StructOp::SquaredNorm:
+          result = dbl;
+          break;
+        case StructOp::Cross:
+          params = {self};
+          break;
+        case StructOp::FromAxisAngle:
+          params = {type_of_meta(&meta_type<Eigen::Vector3d>()), dbl};
+          result = type_of_meta(&meta_type<Eigen::Quaterniond>());
+          break;
+        default:  // normalized, inverse, conjugate: no arguments, the struct's own type
+          break;
+      }
+      check_args(e.args, params, e.loc,
+                 self.kind == K::Struct ? "method " + q(name) + " of " + q(self.name()) : q(name), cx);
+      return result;
+    }
     case Builtin::None:
       break;
   }
@@ -1285,8 +1418,8 @@ Type CheckerImpl::check_call(CallExpr& e, Context& cx) {
       if (to.kind == K::Double) ok = ok || from.is_numeric();
       if (to.kind == K::Bool) ok = ok || from.is_numeric() || from.kind == K::Bool;
       if (to.kind == K::String)
-        ok =
-            ok || from.is_numeric() || from.kind == K::Bool || from.kind == K::Enum || from.kind == K::String;
+        ok = ok || from.is_numeric() || from.kind == K::Bool || from.kind == K::Enum ||
+             from.kind == K::String || from.kind == K::Struct;
       if (!ok)
         diag_.error(e.args[0]->loc, "type mismatch: cannot convert " + q(from.name()) + " to " + q(name));
       return to;
@@ -1392,13 +1525,24 @@ Type CheckerImpl::check_assign(BinaryExpr& e, Context& cx) {
       break;
     case TokenKind::PlusEqual:
       if (l.kind == K::String) {
-        if (!r.is_error() &&
-            !(r.kind == K::String || r.is_numeric() || r.kind == K::Bool || r.kind == K::Enum))
+        if (!r.is_error() && !(r.kind == K::String || r.is_numeric() || r.kind == K::Bool ||
+                               r.kind == K::Enum || r.kind == K::Struct))
           diag_.error(e.rhs->loc, "type mismatch: cannot append " + q(r.name()) + " to a string");
         break;
       }
       [[fallthrough]];
     default: {
+      if (l.kind == K::Struct) {  // v += w, v *= 2, q *= q, T *= T: the result has the type of v
+        const TokenKind op = e.op == TokenKind::MinusEqual   ? TokenKind::Minus
+                             : e.op == TokenKind::StarEqual  ? TokenKind::Star
+                             : e.op == TokenKind::SlashEqual ? TokenKind::Slash
+                             : e.op == TokenKind::PlusEqual  ? TokenKind::Plus
+                                                             : TokenKind::Percent;
+        if (!r.is_error() && !struct_binary(op, l, r).same(l))
+          diag_.error(e.loc, "type mismatch: " + std::string(token_kind_name(e.op)) + " on " + q(l.name()) +
+                                 " and " + q(r.name()));
+        break;
+      }
       const bool modulo = e.op == TokenKind::PercentEqual;
       const bool ok = modulo ? (l.kind == K::Int && (r.kind == K::Int || r.is_error()))
                              : (l.is_numeric() && (r.is_numeric() || r.is_error()) &&
@@ -1430,16 +1574,20 @@ Type CheckerImpl::check_binary(BinaryExpr& e, Context& cx) {
       if (l.kind == K::String || r.kind == K::String) {
         const auto text = [](const Type& t) {
           return t.is_error() || t.kind == K::String || t.is_numeric() || t.kind == K::Bool ||
-                 t.kind == K::Enum;
+                 t.kind == K::Enum || t.kind == K::Struct;
         };
         if (text(l) && text(r)) return type_of_meta(&meta_type<std::string>());
-        return mismatch("strings, numbers, bools and enums");
+        return mismatch("strings, numbers, bools, enums and structs");
       }
       [[fallthrough]];
     case TokenKind::Minus:
     case TokenKind::Star:
     case TokenKind::Slash:
       if (err) return Type::error();
+      if (l.kind == K::Struct || r.kind == K::Struct) {  // vector and frame arithmetic (docs/soml.md 4.14)
+        Type t = struct_binary(e.op, l, r);
+        return t.is_error() ? mismatch(struct_operands(e.op)) : t;
+      }
       if (!l.is_numeric() || !r.is_numeric()) return mismatch("numbers");
       return l.kind == K::Int && r.kind == K::Int ? integer : dbl;
     case TokenKind::Percent:
@@ -1547,10 +1695,14 @@ Type CheckerImpl::check_expr(Expr& e, Context& cx) {
         if (!o.is_error() && o.kind != K::Bool)
           diag_.error(e.loc, "type mismatch: '!' takes a bool, not " + q(o.name()));
         t = type_of_meta(&meta_type<bool>());
+      } else if ((u.op == TokenKind::Minus || u.op == TokenKind::Plus) && is_vec(eig(o))) {
+        t = o;  // -v
       } else if (u.op == TokenKind::Minus || u.op == TokenKind::Plus) {
         if (!o.is_error() && !o.is_numeric())
           diag_.error(e.loc, "type mismatch: " + std::string(token_kind_name(u.op)) +
-                                 " takes a number, not " + q(o.name()));
+                                 (o.kind == K::Struct ? " takes a number or a vector, not "
+                                                      : " takes a number, not ") +
+                                 q(o.name()));
         t = o.is_numeric()
                 ? type_of_meta(o.kind == K::Int ? &meta_type<std::int64_t>() : &meta_type<double>())
                 : Type::error();

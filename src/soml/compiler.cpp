@@ -639,6 +639,10 @@ class Compiler {
         emit(OP_NOT, r, o);
         return r;
       case TokenKind::Minus:
+        if (e.type.kind == K::Struct) {
+          emit_struct(StructOp::Neg, r, o);
+          return r;
+        }
         emit(e.type.kind == K::Double ? OP_NEGD : OP_NEGI, r, o);
         return r;
       case TokenKind::Plus:
@@ -652,6 +656,10 @@ class Compiler {
   int arith(TokenKind op, int l, const Type& lt, int r, const Type& rt, const Type& result, SourceLoc loc,
             int into = -1) {
     const int d = into >= 0 && result.kind != K::String ? into : temp();
+    if (result.kind == K::Struct) {  // vectors, quaternions, frames (docs/soml.md 4.14)
+      struct_arith(op, d, l, lt, r, rt);
+      return d;
+    }
     if (result.kind == K::String) {  // concatenation
       const int ls = to_string(l, lt), rs = to_string(r, rt);
       emit(OP_CONCAT, d, ls, rs);
@@ -686,9 +694,39 @@ class Compiler {
     return d;
   }
 
+  // One struct operation (OP_XOP): the checker typed the operands.
+  void emit_struct(StructOp op, int a, int b, int c = 0) {
+    const std::size_t i = emit(OP_XOP, a, b, c);
+    F.code[i].x = static_cast<std::uint8_t>(op);
+  }
+
+  // d = l op r where the result is a struct: v + w, v - w, v * s, s * v, v / s, q * q, q * v, T * T, T * v.
+  void struct_arith(TokenKind op, int d, int l, const Type& lt, int r, const Type& rt) {
+    if (lt.kind != K::Struct) {  // s * v: the scalar goes second
+      struct_arith(op, d, r, rt, l, lt);
+      return;
+    }
+    StructOp o = StructOp::Mul;
+    if (rt.kind != K::Struct) {
+      r = coerce(r, rt, Type::of(K::Double));
+      o = op == TokenKind::Slash ? StructOp::Div : StructOp::Scale;
+    } else if (op == TokenKind::Plus) {
+      o = StructOp::Add;
+    } else if (op == TokenKind::Minus) {
+      o = StructOp::Sub;
+    } else if (rt.meta != lt.meta) {  // q * v, T * v
+      o = StructOp::Apply;
+    }
+    emit_struct(o, d, l, r);
+  }
+
   int to_string(int r, const Type& t) {
     if (t.kind == K::String) return r;
     const int d = temp();
+    if (t.kind == K::Struct) {
+      emit_struct(StructOp::Text, d, r);
+      return d;
+    }
     int variant = 0;
     switch (t.kind) {
       case K::Int:
@@ -1147,6 +1185,21 @@ class Compiler {
         emit(OP_BUILTIN, base, static_cast<int>(b.builtin), dbl ? 1 : 0);
         top_ = base + 1;
         return base;
+      }
+      case Builtin::StructOp: {  // v.norm(), v.cross(w), q.inverse(), Quaterniond::from_axis_angle(a, t)
+        const auto op = static_cast<StructOp>(b.slot);
+        const int self = callee.kind == ExprKind::Member ? expr(*callee.as<MemberExpr>().object) : 0;
+        std::vector<Type> want;
+        for (const ExprPtr& a : e.args)
+          want.push_back(a->type.kind == K::Int ? Type::of(K::Double) : a->type);
+        const int base = args_at(e.args, want);
+        const int r = temp();
+        at(e.loc);
+        if (op == StructOp::FromAxisAngle)
+          emit_struct(op, r, base, base + 1);
+        else
+          emit_struct(op, r, self, e.args.empty() ? 0 : base);
+        return r;
       }
       case Builtin::Find: {
         const int path = expr(*e.args.at(0));

@@ -315,7 +315,7 @@ class Debugger::Impl final : public DebugHooks {
   std::string register_text(const Type& t, const Val& v, const std::string& s, const VecReg& vr,
                             const Value& x) const {
     using K = Type::Kind;
-    if (reg_kind(t) == RK::X) return x.empty() ? "<" + t.name() + ">" : x.to_text();
+    if (reg_kind(t) == RK::X) return x.empty() ? "<" + t.name() + ">" : value_text(x);
     switch (t.kind) {
       case K::Vector:
         if (t.meta != nullptr && vector_elem_kind(*t.meta) != RK::None) return vector_text(*t.meta, vr);
@@ -379,6 +379,7 @@ class Debugger::Impl final : public DebugHooks {
           }
           return s + "]";
         }
+        if (t.kind() == TypeKind::Struct) return value_text(Value(t, addr));  // as print shows it
         return t.to_text(addr);
     }
   }

@@ -135,7 +135,8 @@ enum Op : std::uint8_t {
   OP_XVSIZE,  // a = size of vector X[b]
   OP_XVGET,   // a = X[b][R[c]]                     (range-checked)
   OP_XVSET,   // X[a][R[b]] = c                     (range-checked)
-  OP_XVPUSH   // X[a].push(b)
+  OP_XVPUSH,  // X[a].push(b)
+  OP_XOP      // a = StructOp x over b and c (struct_ops.cpp): structs in X, scalars in D, Text into S
 };
 
 // OP_PLACE's operand c with this bit: a place of a port net (index into port_places_), found from the
@@ -324,6 +325,7 @@ class ProgramImpl {
   void vector_op(Ins in, const Frame& frame);  // OP_MOVV .. OP_PVGET (vm.cpp)
   void store_vector(const MetaProperty& p, SimStateInstance& o, const VecReg& v);
   void value_op(Ins in, const Frame& frame);               // OP_XDEF .. OP_XVPUSH (vm.cpp)
+  void struct_op(Ins in, const Frame& frame);              // OP_XOP (struct_ops.cpp)
   std::uint64_t new_instance(Ins in, const Frame& frame);  // OP_NEW
   std::uint64_t find_node(const std::string& path) const;  // OP_FIND
   // Vector arguments come from @p vargs (indexed like args), a vector result goes to @p vresult.
@@ -568,5 +570,9 @@ void vector_at(const MetaType& vt, const void* addr, std::size_t i, Val& v, std:
 Value vector_value(const MetaType& vt, const VecReg& r, const std::string& what);
 /// The text of a vector register ("[1, 2]", strings quoted), for the debugger.
 std::string vector_text(const MetaType& vt, const VecReg& r);
+/// The text print and string() show of an X register's Value (struct_ops.cpp): a struct as it is built,
+/// `Vector3d(1, 2.5, 0)`, `Isometry3d(Vector3d(1, 2, 3), Quaterniond(1, 0, 0, 0))`, vectors of structs as
+/// lists of those; anything else in its vsd-text form.
+std::string value_text(const Value& v);
 
 }  // namespace vsd::soml

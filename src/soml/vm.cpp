@@ -1196,7 +1196,7 @@ Val ProgramImpl::exec(std::size_t entry) {
               break;
             case RK::X: {
               const Value& x = xregs_[fr->base + in.a + i];
-              line += x.to_text();
+              line += value_text(x);
               break;
             }
             default: {
@@ -1256,6 +1256,10 @@ Val ProgramImpl::exec(std::size_t entry) {
       case OP_XVPUSH:
         VSD_SAVE();
         value_op(in, *fr);
+        break;
+      case OP_XOP:
+        VSD_SAVE();
+        struct_op(in, *fr);
         break;
       default:
         VSD_SAVE();

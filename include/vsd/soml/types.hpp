@@ -113,7 +113,30 @@ enum class Builtin : unsigned char {
   PlaceClear,  ///< place.clear()
   Size,        ///< vector/list .size()
   Push,        ///< vector/list .push(x)
-  Find         ///< find(path): the database node at a path ("/plant/tank", as Node::path()), or null
+  Find,        ///< find(path): the database node at a path ("/plant/tank", as Node::path()), or null
+  StructOp     ///< a method of a registry struct (`v.norm()`) or `Quaterniond::from_axis_angle`: op in slot
+};
+
+/// @brief The operations on the Eigen structs (Vector2d/3d/4d, Quaterniond, Isometry3d) in code: the
+/// operators, methods and static functions of docs/soml.md 4.14. Which struct an operation works on is
+/// the static type of its first operand (the VM checks it); scalars are doubles.
+enum class StructOp : unsigned char {
+  Add,            ///< a + b (vectors of one size)
+  Sub,            ///< a - b
+  Neg,            ///< -a
+  Scale,          ///< a * s, s * a (vector, scalar)
+  Div,            ///< a / s
+  Dot,            ///< a.dot(b): double
+  Norm,           ///< a.norm(): double
+  SquaredNorm,    ///< a.squared_norm(): double
+  Normalized,     ///< a.normalized() (vectors, quaternions)
+  Cross,          ///< a.cross(b) (Vector3d)
+  Mul,            ///< q * q, T * T
+  Apply,          ///< q * v (rotate), T * v (transform a point): Vector3d
+  Inverse,        ///< q.inverse(), T.inverse()
+  Conjugate,      ///< q.conjugate()
+  FromAxisAngle,  ///< Quaterniond::from_axis_angle(Vector3d axis, double angle)
+  Text            ///< string(a), "..." + a: the text print shows, `Vector3d(1, 2.5, 0)`
 };
 
 /// @brief What a name or member resolved to.
