@@ -538,6 +538,9 @@ MigrationReport migrate(ProgramImpl& old, ProgramImpl& nw, std::string name, std
 
 // Loader helpers shared by the compiler.
 RK reg_kind(const Type& t) noexcept;
+// The MetaType that stores a value of static type @p t (script enums and vectors of them: the run-time
+// enum of this load and its vector); null for types without one.
+const MetaType* storage_type(ProgramImpl& p, Registry& reg, const Type& t);
 int compile_function(ProgramImpl& p, int index, const FunctionDecl& fd);
 int new_function(ProgramImpl& p, std::string name);
 int compile_condition(ProgramImpl& p, const TransitionDecl& t, const std::string& name);
