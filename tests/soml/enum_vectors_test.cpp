@@ -218,6 +218,44 @@ void f() {
   EXPECT_EQ(printed, "history = [Mode::Run]");
 }
 
+// The result of an invoked net reaches the invoking transition's action as `result` for every value
+// type held out of the registers: vectors of script enums, of ints, structs.
+TEST_F(EnumVectors, NetResultsOfVectorAndStructTypeReachTheInvokingAction) {
+  Program& p = load(R"(enum Mode { Idle, Run }
+net vector<Mode> modes(int n) {
+  place s; start s;
+  transition t { do { vector<Mode> r; for (int i = 0; i < n; i++) r.push(Mode::Run); finish r; } }
+  arrow s -> t;
+}
+net vector<int> ints(int n) {
+  place s; start s;
+  transition t { do { vector<int> r; for (int i = 0; i < n; i++) r.push(i * 10); finish r; } }
+  arrow s -> t;
+}
+net Vector3d point(double x) {
+  place s; start s;
+  transition t { do { finish Vector3d(x, 2, 3); } }
+  arrow s -> t;
+}
+place a = 1;
+place b;
+place c;
+place d;
+transition get_modes { invoke modes(2); do { print("modes ", result, " ", result[1] == Mode::Run); } }
+transition get_ints { invoke ints(3); do { print("ints ", result, " ", result.size()); } }
+transition get_point { invoke point(1.5); do { print("point ", result, " x ", result.x); } }
+arrow a -> get_modes;
+arrow get_modes -> b;
+arrow b -> get_ints;
+arrow get_ints -> c;
+arrow c -> get_point;
+arrow get_point -> d;
+)");
+  p.run_until_quiet();
+  EXPECT_EQ(out.str(), "modes [\"Run\", \"Run\"] true\nints [0, 10, 20] 3\npoint [1.5, 2, 3] x 1.5\n");
+  EXPECT_EQ(p.place("d")->tokens(), 1);
+}
+
 TEST_F(EnumVectors, MistakesAreReportedWithTheirPosition) {
   const std::string e = soml_test::error_of([&] {
     load(R"(enum Mode { Idle, Run }
