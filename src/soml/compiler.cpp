@@ -1025,12 +1025,12 @@ class Compiler {
         top_ = r + 1;
         std::vector<Type> want;
         args_at(e.args, want);
-        if ((reg_kind(e.type) == RK::None || reg_kind(e.type) == RK::V) && e.type.kind != K::Void)
+        if (reg_kind(e.type) == RK::None && e.type.kind != K::Void)
           not_supported(P, e.loc, "a method returning '" + e.type.name() + "'");
         P.methods_.push_back(b.method);
         P.method_kinds_.emplace_back();
         for (const ExprPtr& a : e.args) {
-          if (reg_kind(a->type) == RK::None || reg_kind(a->type) == RK::V)
+          if (reg_kind(a->type) == RK::None)
             not_supported(P, a->loc, "an argument of type '" + a->type.name() + "'");
           P.method_kinds_.back().push_back(reg_kind(a->type));
         }

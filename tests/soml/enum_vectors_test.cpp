@@ -3,6 +3,8 @@
 // functions that take and return one with Values, reads and writes the properties as Values of that type;
 // the changes record and replay, a reload keeps the value when the enum is unchanged, a refused load
 // leaves the Registry as it was, the debugger shows the elements; misuse is an error with its position.
+// Also: net results of vector and struct type, and vectors as arguments and results of built-in classes'
+// MetaMethods.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -13,6 +15,26 @@
 #include "script_fixture.hpp"
 #include "vsd/core.hpp"
 #include "vsd/soml.hpp"
+
+namespace enum_vectors_test {
+
+// A built-in class whose MetaMethods take and return vectors (std::vector<T> of the registry).
+class Arm : public vsd::Node {
+  VSD_INSTANCE(Arm, vsd::Node)
+  VSD_PROPERTY(std::vector<double>, joints, {})
+ public:
+  std::vector<double> scaled(std::vector<double> v, double k) {
+    for (double& x : v) x *= k;
+    return v;
+  }
+  VSD_METHOD(scaled)
+  std::int64_t count(std::vector<std::int32_t> ids) { return static_cast<std::int64_t>(ids.size()); }
+  VSD_METHOD(count)
+  std::vector<std::string> tags() { return {"left", "arm"}; }
+  VSD_METHOD(tags)
+};
+
+}  // namespace enum_vectors_test
 
 namespace {
 
@@ -254,6 +276,35 @@ arrow get_point -> d;
   p.run_until_quiet();
   EXPECT_EQ(out.str(), "modes [\"Run\", \"Run\"] true\nints [0, 10, 20] 3\npoint [1.5, 2, 3] x 1.5\n");
   EXPECT_EQ(p.place("d")->tokens(), 1);
+}
+
+// Vectors as arguments and results of a built-in class's MetaMethods: converted to and from the
+// method's std::vector<T> (sized integers range-checked like a property store).
+TEST_F(EnumVectors, BuiltInMethodsTakeAndReturnVectors) {
+  reg.add<enum_vectors_test::Arm>();
+  Program& p = load(R"(shared<Arm> arm = new Arm();
+void f() {
+  vector<double> v;
+  v.push(1.0);
+  v.push(2.5);
+  vector<double> w = arm.scaled(v, 2);
+  arm.joints = arm.scaled(arm.joints, 3);
+  vector<int32> ids;
+  ids.push(7);
+  ids.push(8);
+  print(w, " ", arm.count(ids), " ", arm.tags(), " ", arm.tags().size(), " ", arm.joints);
+}
+int too_big() { vector<int32> ids; ids.push(5000000000); return arm.count(ids); }
+)");
+  auto* arm = p.root().get<vsd::SharedRef<vsd::Node>>("arm").get();
+  ASSERT_NE(arm, nullptr);
+  arm->set("joints", vsd::Value(std::vector<double>{1.0}));
+  p.root().call("f", {});
+  EXPECT_EQ(out.str(), "[2.0, 5.0] 2 [\"left\", \"arm\"] 2 [3.0]\n");
+  EXPECT_THAT(
+      soml_test::error_of([&] { p.root().call("too_big", {}); }),
+      HasSubstr("the value 5000000000 does not fit argument 1 of method 'count' (elements int32)\n  at "
+                "too_big (test.soml:13)"));
 }
 
 TEST_F(EnumVectors, MistakesAreReportedWithTheirPosition) {
