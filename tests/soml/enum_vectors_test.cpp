@@ -198,13 +198,15 @@ void f() { history.push(Mode::Run); history.push(Mode::Idle); }
 )");
   p.root().call("f", {});
   const vsd::MetaType* modes = reg.find_type("vector<soml::Mode>");
-  p.reload("test.soml", R"(enum Mode { Idle, Run }
+  const vsd::soml::MigrationReport r = p.reload("test.soml", R"(enum Mode { Idle, Run }
 vector<Mode> history;
 vector<Mode> fresh;
 int n = 0;
 void f() { fresh = history; fresh.push(Mode::Run); n = fresh.size(); }
 )");
   EXPECT_EQ(reg.find_type("vector<soml::Mode>"), modes) << "the same enum, so the same vector type";
+  EXPECT_THAT(r.properties, ::testing::Contains(HasSubstr(".history: kept")));
+  EXPECT_TRUE(r.warnings.empty());
   EXPECT_EQ(names(p.root().get("history")), "Run Idle");
   p.root().call("f", {});
   EXPECT_EQ(names(p.root().get("fresh")), "Run Idle Run");
@@ -214,6 +216,11 @@ void f() { fresh = history; fresh.push(Mode::Run); n = fresh.size(); }
                   [&] { p.reload("test.soml", "enum Mode { Idle, Run, Stop }\nvector<Mode> history;\n"); }),
               HasSubstr("test.soml:1:6"));
   EXPECT_EQ(names(p.root().get("history")), "Run Idle");
+  // Another type for the property: the value does not convert, a warning says so, the new one is empty.
+  const vsd::soml::MigrationReport ints =
+      p.reload("test.soml", "enum Mode { Idle, Run }\nvector<int> history;\n");
+  EXPECT_THAT(ints.warnings, ::testing::Contains(HasSubstr("history: the value")));
+  EXPECT_TRUE(p.root().get<std::vector<std::int64_t>>("history").empty());
 }
 
 TEST_F(EnumVectors, TheDebuggerShowsTheElementsAsEnums) {
