@@ -323,7 +323,8 @@ class ProgramImpl {
   Val exec(std::size_t entry);
   void vector_op(Ins in, const Frame& frame);  // OP_MOVV .. OP_PVGET (vm.cpp)
   void store_vector(const MetaProperty& p, SimStateInstance& o, const VecReg& v);
-  Value method_vector_arg(const MetaMethod& m, std::size_t i, const VecReg& v);  // OP_MCALL (vm.cpp)
+  // OP_MCALL (vm.cpp): a vector argument appended to @p args, a vector result into @p out.
+  void method_vector_arg(const MetaMethod& m, std::size_t i, const VecReg& v, std::vector<Value>& args);
   void method_vector_result(const MetaMethod& m, const Value& r, VecReg& out);
   void value_op(Ins in, const Frame& frame);               // OP_XDEF .. OP_XVPUSH (vm.cpp)
   std::uint64_t new_instance(Ins in, const Frame& frame);  // OP_NEW

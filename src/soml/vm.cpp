@@ -306,14 +306,16 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
 }
 
 // Vector arguments and results of a built-in class's MetaMethod (OP_MCALL), out of line like the vector
-// instructions: argument @p i as a Value of the method's std::vector<T> (range-checked), and the result
-// into a vector register.
-[[gnu::noinline]] Value ProgramImpl::method_vector_arg(const MetaMethod& m, std::size_t i, const VecReg& v) {
+// instructions: argument @p i appended to @p args as a Value of the method's std::vector<T> (range-checked),
+// and the result into a vector register.
+[[gnu::noinline]] void ProgramImpl::method_vector_arg(const MetaMethod& m, std::size_t i, const VecReg& v,
+                                                      std::vector<Value>& args) {
   const MetaType* want = i < m.arguments().size() ? m.arguments()[i] : nullptr;
   if (want == nullptr || vector_elem_kind(*want) == RK::None)
     fail("argument " + std::to_string(i + 1) + " of method '" + m.name() + "' is not a vector");
   try {
-    return vector_value(*want, v, "argument " + std::to_string(i + 1) + " of method '" + m.name() + "'");
+    args.push_back(
+        vector_value(*want, v, "argument " + std::to_string(i + 1) + " of method '" + m.name() + "'"));
   } catch (const Error& e) {
     fail(e.what());
   }
@@ -1119,7 +1121,7 @@ Val ProgramImpl::exec(std::size_t entry) {
               args.push_back(xregs_[fr->base + in.a + 1 + i]);
               break;
             case RK::V:
-              args.push_back(method_vector_arg(m, i, vregs_[fr->base + in.a + 1 + i]));
+              method_vector_arg(m, i, vregs_[fr->base + in.a + 1 + i], args);
               break;
             default: {
               SimStateInstance* t = v.id == 0 ? nullptr : &obj(v.id);
