@@ -254,6 +254,8 @@ class CheckerImpl {
                          bool allow_object, const char* what);
   Type resolve_type(const TypeName& t, const ScopeDecl& scope);
   Type type_of_meta(const MetaType* m) const;
+  // The type of the elements of vector type @p v (a script enum's, or its MetaType's element).
+  Type element_of(const Type& v) const;
   struct Endpoint {
     const Decl* decl = nullptr;
     bool local = false;
@@ -473,6 +475,15 @@ Type CheckerImpl::type_of_meta(const MetaType* m) const {
   return t;
 }
 
+Type CheckerImpl::element_of(const Type& v) const {
+  if (v.enum_decl != nullptr) {
+    Type e = Type::of(K::Enum);
+    e.enum_decl = v.enum_decl;
+    return e;
+  }
+  return v.meta != nullptr ? type_of_meta(v.meta->element()) : Type::error();
+}
+
 ClassRef CheckerImpl::resolve_class(const std::vector<std::string>& parts, SourceLoc loc,
                                     const ScopeDecl& scope, bool allow_object, const char* what) {
   Found f = find_lexical(&scope, parts[0]);
@@ -528,6 +539,13 @@ Type CheckerImpl::resolve_type(const TypeName& t, const ScopeDecl& scope) {
       }
       Type e = resolve_type(t.args[0], scope);
       if (e.is_error()) return e;
+      if (e.kind == K::Enum && e.enum_decl != nullptr) {
+        // A script enum has no MetaType before the load: the loader makes its vector type, so that a
+        // refused script leaves the Registry as it was.
+        Type v = Type::of(K::Vector);
+        v.enum_decl = e.enum_decl;
+        return v;
+      }
       const MetaType* v = e.meta != nullptr ? reg_.find_type("vector<" + e.meta->name() + ">") : nullptr;
       if (v == nullptr) {
         diag_.error(t.loc, q(t.spelling()) + " is not a type the meta-information system knows");
@@ -1306,8 +1324,7 @@ Type CheckerImpl::check_builtin_call(CallExpr& e, Builtin id, std::string_view n
       if (cx.body == Body::Condition || cx.body == Body::ArrowCondition)
         diag_.error(e.loc, "a condition must not change properties ('push')");
       if (!arity(1)) return Type::of(K::Void);
-      Type elem =
-          self.kind == K::List ? Type::reference(self.cls, self.shared) : type_of_meta(self.meta->element());
+      Type elem = self.kind == K::List ? Type::reference(self.cls, self.shared) : element_of(self);
       expect_type(*e.args[0], elem, cx, "the element to push");
       return Type::of(K::Void);
     }
@@ -1750,7 +1767,7 @@ Type CheckerImpl::check_expr(Expr& e, Context& cx) {
       Type o = check_value(*ix.object, cx);
       expect_type(*ix.index, type_of_meta(&meta_type<std::int64_t>()), cx, "an index");
       if (o.kind == K::Vector)
-        t = type_of_meta(o.meta->element());
+        t = element_of(o);
       else if (o.kind == K::List)
         t = Type::reference(o.cls, o.shared);
       else {
@@ -1880,7 +1897,7 @@ void CheckerImpl::check_stmt(Stmt& s, Context& cx) {
       Type r = check_value(*f.range, cx);
       Type elem = Type::error();
       if (r.kind == K::Vector)
-        elem = type_of_meta(r.meta->element());
+        elem = element_of(r);
       else if (r.kind == K::List)
         elem = Type::reference(r.cls, r.shared);
       else if (!r.is_error())

@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "program_impl.hpp"
+#include "vsd/core/environment.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/core/registry.hpp"
 
@@ -31,7 +32,7 @@ RK reg_kind(const Type& t) noexcept {
     case K::Place:
       return RK::R;
     case K::Vector:
-      if (t.meta == nullptr) return RK::None;
+      if (t.meta == nullptr) return t.enum_decl != nullptr ? RK::X : RK::None;  // a script enum's: as a Value
       return vector_elem_kind(*t.meta) != RK::None ? RK::V
              : t.meta->ops().vector != nullptr     ? RK::X
                                                    : RK::None;
@@ -46,7 +47,14 @@ namespace {
 
 // The static type of the elements of vector type t (a register holds them as int, double or string).
 Type element_type_of(const MetaType* e);
-Type element_type(const Type& t) { return element_type_of(t.meta != nullptr ? t.meta->element() : nullptr); }
+Type element_type(const Type& t) {
+  if (t.kind == K::Vector && t.enum_decl != nullptr) {  // a script enum's (an int in a register)
+    Type e = Type::of(K::Enum);
+    e.enum_decl = t.enum_decl;
+    return e;
+  }
+  return element_type_of(t.meta != nullptr ? t.meta->element() : nullptr);
+}
 // The static type of a value of MetaType e as the registers hold it (a vector's element, a struct's field).
 Type element_type_of(const MetaType* e) {
   if (e == nullptr) return Type::error();
@@ -1055,12 +1063,12 @@ class Compiler {
         top_ = r + 1;
         std::vector<Type> want;
         args_at(e.args, want);
-        if ((reg_kind(e.type) == RK::None || reg_kind(e.type) == RK::V) && e.type.kind != K::Void)
+        if (reg_kind(e.type) == RK::None && e.type.kind != K::Void)
           not_supported(P, e.loc, "a method returning '" + e.type.name() + "'");
         P.methods_.push_back(b.method);
         P.method_kinds_.emplace_back();
         for (const ExprPtr& a : e.args) {
-          if (reg_kind(a->type) == RK::None || reg_kind(a->type) == RK::V)
+          if (reg_kind(a->type) == RK::None)
             not_supported(P, a->loc, "an argument of type '" + a->type.name() + "'");
           P.method_kinds_.back().push_back(reg_kind(a->type));
         }
@@ -1336,7 +1344,9 @@ class Compiler {
         } else if (k == RK::V) {
           emit(OP_VCLEAR, l.slot);
         } else if (k == RK::X) {
-          emit(OP_XDEF, l.slot, xtype(l.type.meta));
+          const MetaType* t = storage_type(P, P.state_.environment().registry(), l.type);
+          if (t == nullptr) not_supported(P, l.loc, "a local of type '" + l.type.name() + "'");
+          emit(OP_XDEF, l.slot, xtype(t));
         } else if (k == RK::D) {
           emit(OP_LOADK, l.slot, konst(std::bit_cast<std::int64_t>(0.0)));
         } else {

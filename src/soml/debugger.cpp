@@ -45,6 +45,27 @@ std::string quoted(const std::string& s) {
   return q + "\"";
 }
 
+// A value as the debugger shows it: a vector of enums as its enums are shown ("[Mode::Idle, Mode::Run]",
+// without the "soml::" of script enums), structs and vectors of them as print shows them
+// ("Vector3d(1, 2, 3)"), anything else as the type writes it.
+std::string shown_text(const MetaType& t, const void* addr) {
+  const MetaType* et = t.kind() == TypeKind::Vector ? t.element() : nullptr;
+  if (t.kind() == TypeKind::Struct || (et != nullptr && et->kind() == TypeKind::Struct))
+    return value_text(Value(t, addr));
+  if (et == nullptr || et->kind() != TypeKind::Enum) return t.to_text(addr);
+  std::string name = et->name();
+  if (name.rfind("soml::", 0) == 0) name = name.substr(6);
+  std::string s = "[";
+  Value e(*et);
+  for (std::size_t i = 0, n = t.vector_size(addr); i < n; ++i) {
+    t.vector_get(addr, i, e.data());
+    const std::int64_t v = et->load_integer(e.data());
+    const std::string_view label = et->enum_name(v);
+    s += (i != 0 ? ", " : "") + (label.empty() ? std::to_string(v) : name + "::" + std::string(label));
+  }
+  return s + "]";
+}
+
 bool is_ident(std::string_view s) {
   if (s.empty() || (std::isdigit(static_cast<unsigned char>(s[0])) != 0)) return false;
   return std::all_of(s.begin(), s.end(),
@@ -315,7 +336,7 @@ class Debugger::Impl final : public DebugHooks {
   std::string register_text(const Type& t, const Val& v, const std::string& s, const VecReg& vr,
                             const Value& x) const {
     using K = Type::Kind;
-    if (reg_kind(t) == RK::X) return x.empty() ? "<" + t.name() + ">" : value_text(x);
+    if (reg_kind(t) == RK::X) return x.empty() ? "<" + t.name() + ">" : shown_text(*x.type(), x.data());
     switch (t.kind) {
       case K::Vector:
         if (t.meta != nullptr && vector_elem_kind(*t.meta) != RK::None) return vector_text(*t.meta, vr);
@@ -379,8 +400,7 @@ class Debugger::Impl final : public DebugHooks {
           }
           return s + "]";
         }
-        if (t.kind() == TypeKind::Struct) return value_text(Value(t, addr));  // as print shows it
-        return t.to_text(addr);
+        return shown_text(t, addr);
     }
   }
 

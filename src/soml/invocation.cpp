@@ -15,8 +15,8 @@ namespace vsd::soml {
 
 namespace {
 
-// The value of property @p s of @p o as a register (and its string, for strings).
-Val load_value(const PropSlot& s, const SimStateInstance& o, std::string& str) {
+// The value of property @p s of @p o as a register (and its string, vector or Value, for those kinds).
+Val load_value(const PropSlot& s, const SimStateInstance& o, std::string& str, VecReg& vec, Value& x) {
   Val v{};
   const MetaProperty& p = *s.prop;
   const void* a = p.address(o);
@@ -42,6 +42,12 @@ Val load_value(const PropSlot& s, const SimStateInstance& o, std::string& str) {
       v.id = t != nullptr ? t->id() : 0;
       break;
     }
+    case PK::Vector:
+      vector_load(p.type(), a, vec);
+      break;
+    case PK::Value:  // structs, vectors of structs and enums
+      x = Value(p.type(), a);
+      break;
     default:
       if (p.type().kind() == TypeKind::Float) {
         float f = 0;
@@ -107,9 +113,12 @@ std::pair<NetInst*, int> ProgramImpl::complete_action(const NetInst& inner) {
     const std::uint64_t mark = m != nullptr ? m->id() : 0;
     if (t.action >= 0) {
       std::string str;
+      VecReg vec;
+      Value x;
       Val r{};
-      if (ci->result_slot >= 0) r = load_value(props_[static_cast<std::size_t>(ci->result_slot)], inv, str);
-      run(t.action, parent->id(), mark, &r, &str);
+      if (ci->result_slot >= 0)
+        r = load_value(props_[static_cast<std::size_t>(ci->result_slot)], inv, str, vec, x);
+      run(t.action, parent->id(), mark, &r, &str, nullptr, &vec, nullptr, &x);
     }
     return {outer, index};
   }

@@ -44,7 +44,7 @@ ProgramImpl::~ProgramImpl() {
 
 // The MetaType that stores a value of static type t (references to script classes are stored as
 // references to their nearest built-in class: the checker already typed them).
-static const MetaType* storage_type(ProgramImpl& p, Registry& reg, const Type& t) {
+const MetaType* storage_type(ProgramImpl& p, Registry& reg, const Type& t) {
   switch (t.kind) {
     case K::Bool:
       return t.meta != nullptr ? t.meta : &meta_type<bool>();
@@ -61,7 +61,12 @@ static const MetaType* storage_type(ProgramImpl& p, Registry& reg, const Type& t
       }
       return t.meta;
     case K::Struct:
+      return t.meta;
     case K::Vector:
+      if (t.enum_decl != nullptr) {  // of a script enum: the vector of its run-time enum (made on demand)
+        auto it = p.enums_.find(t.enum_decl);
+        return it != p.enums_.end() ? &reg.vector_type(*it->second) : nullptr;
+      }
       return t.meta;
     case K::Ref:
     case K::List: {
@@ -976,7 +981,9 @@ Value ProgramImpl::call_from_cpp(int fi, SimStateInstance& self, std::span<const
         break;
       }
       case RK::X: {  // a struct or a vector of structs or enums: the same type (run-time ones by definition)
-        const MetaType* want = i < f.locals.size() ? f.locals[i].type.meta : nullptr;  // params come first
+        const MetaType* want = i < f.locals.size()  // params come first
+                                   ? storage_type(*this, state_.environment().registry(), f.locals[i].type)
+                                   : nullptr;
         if (want == nullptr || !detail::same_definition(*t, *want))
           throw Error("SOML++ function " + f.name + ": argument " + std::to_string(i + 1) + " must be a " +
                       (want != nullptr ? want->name() : std::string("value")) + ", not " + t->name());

@@ -324,6 +324,9 @@ class ProgramImpl {
   Val exec(std::size_t entry);
   void vector_op(Ins in, const Frame& frame);  // OP_MOVV .. OP_PVGET (vm.cpp)
   void store_vector(const MetaProperty& p, SimStateInstance& o, const VecReg& v);
+  // OP_MCALL (vm.cpp): a vector argument appended to @p args, a vector result into @p out.
+  void method_vector_arg(const MetaMethod& m, std::size_t i, const VecReg& v, std::vector<Value>& args);
+  void method_vector_result(const MetaMethod& m, const Value& r, VecReg& out);
   void value_op(Ins in, const Frame& frame);               // OP_XDEF .. OP_XVPUSH (vm.cpp)
   void struct_op(Ins in, const Frame& frame);              // OP_XOP (struct_ops.cpp)
   std::uint64_t new_instance(Ins in, const Frame& frame);  // OP_NEW
@@ -540,6 +543,9 @@ MigrationReport migrate(ProgramImpl& old, ProgramImpl& nw, std::string name, std
 
 // Loader helpers shared by the compiler.
 RK reg_kind(const Type& t) noexcept;
+// The MetaType that stores a value of static type @p t (script enums and vectors of them: the run-time
+// enum of this load and its vector); null for types without one.
+const MetaType* storage_type(ProgramImpl& p, Registry& reg, const Type& t);
 int compile_function(ProgramImpl& p, int index, const FunctionDecl& fd);
 int new_function(ProgramImpl& p, std::string name);
 int compile_condition(ProgramImpl& p, const TransitionDecl& t, const std::string& name);

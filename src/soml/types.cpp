@@ -66,8 +66,9 @@ bool Type::same(const Type& o) const noexcept {
     case Kind::Enum:
       return enum_decl == o.enum_decl && (enum_decl != nullptr || meta == o.meta);
     case Kind::Struct:
-    case Kind::Vector:
       return meta == o.meta;
+    case Kind::Vector:  // of a MetaType, or of a script enum (enum_decl; no MetaType before the load)
+      return meta == o.meta && enum_decl == o.enum_decl;
     case Kind::Ref:
     case Kind::List:
       return cls == o.cls && shared == o.shared;
@@ -102,7 +103,9 @@ std::string Type::name() const {
     case Kind::Enum:
       return enum_decl != nullptr ? enum_decl->name : (meta != nullptr ? meta->name() : "enum");
     case Kind::Struct:
+      return meta != nullptr ? meta->name() : "?";
     case Kind::Vector:
+      if (enum_decl != nullptr) return "vector<" + enum_decl->name + ">";
       return meta != nullptr ? meta->name() : "?";
     case Kind::Ref:
       return (shared ? "shared<" : "ref<") + cls.name() + ">";

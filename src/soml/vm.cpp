@@ -305,6 +305,29 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
   p.assign_raw(o, value.data());
 }
 
+// Vector arguments and results of a built-in class's MetaMethod (OP_MCALL), out of line like the vector
+// instructions: argument @p i appended to @p args as a Value of the method's std::vector<T> (range-checked),
+// and the result into a vector register.
+[[gnu::noinline]] void ProgramImpl::method_vector_arg(const MetaMethod& m, std::size_t i, const VecReg& v,
+                                                      std::vector<Value>& args) {
+  const MetaType* want = i < m.arguments().size() ? m.arguments()[i] : nullptr;
+  if (want == nullptr || vector_elem_kind(*want) == RK::None)
+    fail("argument " + std::to_string(i + 1) + " of method '" + m.name() + "' is not a vector");
+  try {
+    args.push_back(
+        vector_value(*want, v, "argument " + std::to_string(i + 1) + " of method '" + m.name() + "'"));
+  } catch (const Error& e) {
+    fail(e.what());
+  }
+}
+
+[[gnu::noinline]] void ProgramImpl::method_vector_result(const MetaMethod& m, const Value& r, VecReg& out) {
+  if (r.type() == nullptr || r.type() != m.result() || vector_elem_kind(*r.type()) == RK::None)
+    fail("method '" + m.name() + "' returned " + (r.type() != nullptr ? r.type()->name() : "nothing") +
+         ", not " + (m.result() != nullptr ? m.result()->name() : "a vector"));
+  vector_load(*r.type(), r.data(), out);
+}
+
 // The vector instructions, out of line: they are rare next to the arithmetic and calls that the
 // interpreter loop keeps in registers (fib(27) and the 10^7 loop of benchmarks/ must not pay for them).
 [[gnu::noinline]] void ProgramImpl::vector_op(const Ins in, const Frame& frame) {
@@ -1097,6 +1120,9 @@ Val ProgramImpl::exec(std::size_t entry) {
             case RK::X:
               args.push_back(xregs_[fr->base + in.a + 1 + i]);
               break;
+            case RK::V:
+              method_vector_arg(m, i, vregs_[fr->base + in.a + 1 + i], args);
+              break;
             default: {
               SimStateInstance* t = v.id == 0 ? nullptr : &obj(v.id);
               args.emplace_back(SharedRef<SimStateInstance>(t));
@@ -1131,6 +1157,9 @@ Val ProgramImpl::exec(std::size_t entry) {
           }
           case RK::X:
             xregs_[fr->base + in.a] = std::move(r);
+            break;
+          case RK::V:
+            method_vector_result(m, r, vregs_[fr->base + in.a]);
             break;
           default:
             break;

@@ -129,13 +129,13 @@ std::string joined(const std::vector<std::string>& v, std::size_t from = 0) {
 // Scripts that run without errors: object tokens (philosophers, supervisor), communication arrows,
 // invocations that are mid-flight at many of the split points, substitution, place and transition
 // properties, `new`, script enums (run-time enums the file defines), weights and inhibitor arrows,
-// struct and vector<Vector3d> properties.
+// struct and vector<Vector3d> properties, vectors of script enums (vectors of the run-time enums).
 const char* const continuing[] = {
     "run_philosophers.soml",      "run_communication.soml",    "invoke_fetch.soml",
     "subst_relay.soml",           "run_supervisor.soml",       "run_place_properties.soml",
     "run_nodes_meta.soml",        "run_arrow_conditions.soml", "run_enums.soml",
     "run_weights_inhibitor.soml", "run_comm_objects.soml",     "subst_members.soml",
-    "run_structs.soml"};
+    "run_structs.soml",           "run_enum_vectors.soml"};
 constexpr std::uint64_t most = 40;  // firings per script at most (the philosophers never stop)
 
 TEST(Attach, AReplicaThatAppliedTheRecordedBundlesContinuesIdentically) {

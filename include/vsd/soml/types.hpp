@@ -52,7 +52,8 @@ struct Type {
     String,
     Enum,        ///< script enum (enum_decl) or registry enum (meta)
     Struct,      ///< registry struct (meta): Vector3d, Isometry3d, ...
-    Vector,      ///< std::vector of a MetaType (meta)
+    Vector,      ///< std::vector of a MetaType (meta), or of a script enum (enum_decl, meta null: its
+                 ///< MetaType, the run-time enum's vector, is made when the script loads)
     Ref,         ///< reference to an instance of cls (shared: shared aggregation)
     List,        ///< list of references to cls
     Place,       ///< a place (decl); cls is its token class, empty for black tokens
@@ -64,7 +65,7 @@ struct Type {
 
   Kind kind = Kind::Error;
   const MetaType* meta = nullptr;  ///< storage MetaType where there is one (int32 property, Vector3d, ...)
-  const EnumDecl* enum_decl = nullptr;  ///< script enum
+  const EnumDecl* enum_decl = nullptr;  ///< script enum (Enum; Vector: the element)
   ClassRef cls;                         ///< Ref, List, Place (token class), Class
   const Decl* decl = nullptr;           ///< Place, Transition, Net, Function
   bool shared = false;                  ///< Ref, List: shared (not counted) references
