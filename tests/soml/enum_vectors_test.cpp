@@ -281,7 +281,7 @@ arrow c -> get_point;
 arrow get_point -> d;
 )");
   p.run_until_quiet();
-  EXPECT_EQ(out.str(), "modes [\"Run\", \"Run\"] true\nints [0, 10, 20] 3\npoint [1.5, 2, 3] x 1.5\n");
+  EXPECT_EQ(out.str(), "modes [\"Run\", \"Run\"] true\nints [0, 10, 20] 3\npoint Vector3d(1.5, 2, 3) x 1.5\n");
   EXPECT_EQ(p.place("d")->tokens(), 1);
 }
 
