@@ -29,6 +29,12 @@ using BK = Binding::Kind;
 
 std::string q(std::string_view s) { return "'" + std::string(s) + "'"; }
 
+// The kind of @p d with its article: "a class", "an enum", "an object".
+std::string a_kind(const Decl& d) {
+  const std::string_view k = d.kind_name();
+  return (k.find_first_of("aeiou") == 0 ? "an " : "a ") + std::string(k);
+}
+
 std::string join(const std::vector<std::string>& parts, const char* sep) {
   std::string s;
   for (const auto& p : parts) {
@@ -310,8 +316,8 @@ void CheckerImpl::declare(ScopeDecl& s) {
     // What may stand where.
     if ((s.kind == DeclKind::Place || s.kind == DeclKind::Transition) && d.kind != DeclKind::Property &&
         d.kind != DeclKind::Function) {
-      diag_.error(d.loc, "a " + std::string(s.kind_name()) + " holds only properties and functions, not a " +
-                             std::string(d.kind_name()));
+      diag_.error(d.loc, "a " + std::string(s.kind_name()) + " holds only properties and functions, not " +
+                             a_kind(d));
       continue;
     }
     switch (d.kind) {
@@ -498,8 +504,7 @@ ClassRef CheckerImpl::resolve_class(const std::vector<std::string>& parts, Sourc
   if (f.decl != nullptr) {
     if (f.decl->kind == DeclKind::Class || (allow_object && f.decl->kind == DeclKind::Object))
       return ClassRef{&f.decl->as<ClassDecl>(), nullptr};
-    diag_.error(loc, q(name) + " is " + (f.decl->kind == DeclKind::Object ? "an " : "a ") +
-                         std::string(f.decl->kind_name()) + ", not a class (" + what + ")");
+    diag_.error(loc, q(name) + " is " + a_kind(*f.decl) + ", not a class (" + what + ")");
     return {};
   }
   if (f.ok()) {
@@ -744,10 +749,10 @@ CheckerImpl::Endpoint CheckerImpl::resolve_endpoint(const std::vector<std::strin
   }
   if (f.decl != nullptr && parent_scope(*f.decl) == &scope) local = true;  // `o.p` written inside o
   if (f.decl == nullptr || (f.decl->kind != DeclKind::Place && f.decl->kind != DeclKind::Transition)) {
-    const std::string what = f.decl != nullptr   ? std::string(f.decl->kind_name())
-                             : f.prop != nullptr ? "property"
-                                                 : "function";
-    diag_.error(loc, role + " " + q(name) + ", which is a " + what + ", not a place or transition");
+    const std::string what = f.decl != nullptr   ? a_kind(*f.decl)
+                             : f.prop != nullptr ? "a property"
+                                                 : "a function";
+    diag_.error(loc, role + " " + q(name) + ", which is " + what + ", not a place or transition");
     return {};
   }
   return {f.decl, local};
@@ -979,7 +984,7 @@ Type CheckerImpl::bind_found(const Found& f, Binding& b, SourceLoc loc, std::str
     default:
       break;
   }
-  diag_.error(loc, q(name) + " is a " + std::string(d.kind_name()) + ", not a value");
+  diag_.error(loc, q(name) + " is " + a_kind(d) + ", not a value");
   return Type::error();
 }
 

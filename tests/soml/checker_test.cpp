@@ -10,6 +10,7 @@
 #include "vsd/core/registry.hpp"
 
 using testing::HasSubstr;
+using testing::Not;
 using namespace vsd::soml;
 
 namespace {
@@ -97,6 +98,18 @@ TEST(Checker, EnumsOfTheRegistryByName) {
   EXPECT_THAT(out, HasSubstr("enum 'TestMode' has no value 'Nope'"));
   EXPECT_THAT(out, HasSubstr("expression is enum 'TestMode', not a value (write TestMode::Value)"));
   EXPECT_EQ(bad->diagnostics.error_count(), 3u) << out;
+}
+
+TEST(Checker, KindsInMessagesHaveTheirArticle) {
+  auto bad = check(
+      "enum Mode { Idle }\nobject o { }\nclass C { }\n"
+      "ref<Mode> r;\nclass D : o { }\nvoid f() { int x = o; }\nplace p { enum E { A } }\n");
+  const std::string out = bad->diagnostics.format();
+  EXPECT_THAT(out, HasSubstr("'Mode' is an enum, not a class (in a reference type)"));
+  EXPECT_THAT(out, HasSubstr("'o' is an object, not a class (as a base class)"));
+  EXPECT_THAT(out, HasSubstr("a place holds only properties and functions, not an enum"));
+  EXPECT_THAT(out, Not(HasSubstr("a enum")));
+  EXPECT_THAT(out, Not(HasSubstr("a object")));
 }
 
 TEST(Checker, NumbersLocalsIntoReusedSlots) {
