@@ -12,7 +12,7 @@ PACKAGES=(
   cmake
   g++
   libeigen3-dev
-  # compiler cache: .ci/run's five builds (and the packaging tests' builds of vsd) reuse identical objects
+  # compiler cache: the packaging tests' builds of vsd reuse the objects of .ci/run's Release tree
   ccache
   # vsd::soml_analysis: the PNML reader's XML parser (the module is skipped without it)
   libpugixml-dev

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 #include <unordered_map>
+#include <utility>
 
 #include "vsd/core/error.hpp"
 #include "vsd/robotics/detail/sincos.hpp"
@@ -62,33 +63,7 @@ bool avx_available() {
 // detail::sincos_batch with four angles per operation (the same operations, so the same results).
 __attribute__((target("avx"))) void sincos_batch_avx(const double* x, double* s, double* c,
                                                      std::size_t n) noexcept {
-  using namespace detail;
-  std::size_t i = 0;
-  const V4 zero = {0.0, 0.0, 0.0, 0.0};
-  auto ok = zero == zero;  // lanes of all ones
-  for (; i + 4 <= n; i += 4) {
-    V4 xv;
-    std::memcpy(&xv, x + i, sizeof xv);
-    ok &= (xv < sincos_limit) & (xv > -sincos_limit);  // zero for NaN
-    const V4 r = xv * sincos_64_over_pi + sincos_shifter;
-    const V4 y = r - sincos_shifter;
-    const V4 z = (xv - y * sincos_pi_64_hi) - y * sincos_pi_64_lo;
-    const V4 zz = z * z;
-    const V4 sz = z + (z * zz) * ((sincos_s3 * zz + sincos_s2) * zz + sincos_s1);
-    const V4 cm1 = zz * ((sincos_c3 * zz + sincos_c2) * zz + sincos_c1);
-    std::size_t k[4];
-    for (int l = 0; l < 4; ++l) k[l] = static_cast<std::size_t>(std::bit_cast<std::uint64_t>(r[l]) & 127U);
-    const V4 st = {sincos_table[k[0]][0], sincos_table[k[1]][0], sincos_table[k[2]][0],
-                   sincos_table[k[3]][0]};
-    const V4 ct = {sincos_table[k[0]][1], sincos_table[k[1]][1], sincos_table[k[2]][1],
-                   sincos_table[k[3]][1]};
-    const V4 sv = st + (st * cm1 + ct * sz);
-    const V4 cv = ct + (ct * cm1 - st * sz);
-    std::memcpy(s + i, &sv, sizeof sv);
-    std::memcpy(c + i, &cv, sizeof cv);
-  }
-  if (!(ok[0] && ok[1] && ok[2] && ok[3])) i = 0;  // a value out of range: the scalar form for all
-  for (; i < n; ++i) detail::sincos(x[i], s[i], c[i]);
+  detail::sincos_lanes(std::make_index_sequence<4>{}, x, s, c, n);
 }
 
 // Segments i, i+1, ... in the fast form, up to the first one in the general form (whose index it

@@ -8,11 +8,13 @@
 #include <cstdlib>
 #include <cstring>
 #include <functional>
+#include <initializer_list>
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 #include <limits>
 #include <numbers>
 #include <random>
+#include <span>
 
 #include "kdl_chain.hpp"
 #include "test_util.hpp"
@@ -251,6 +253,37 @@ TEST(Model, TipNotBelowBaseIsAnError) {
   }
 }
 
+// A tree of joints j0, j1, ... below @p parents (-1: a root), each after a random origin (on the x-z plane
+// for even i), rotating about axes[i % axes.size()], but j6 fixed and j8 prismatic.
+std::vector<JointSpec> random_tree(std::initializer_list<int> parents, std::span<const Eigen::Vector3d> axes,
+                                   std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  std::vector<JointSpec> specs;
+  int i = 0;
+  for (const int parent : parents) {
+    JointSpec s;
+    s.name = s.body = "j" + std::to_string(i);
+    s.parent = parent;
+    s.type = i == 6   ? KinematicJointType::Fixed
+             : i == 8 ? KinematicJointType::Prismatic
+                      : KinematicJointType::Rotary;
+    s.placement.pre = Eigen::Translation3d(u(rng), i % 2 == 0 ? 0.0 : u(rng), u(rng)) *
+                      Eigen::AngleAxisd(u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized());
+    s.placement.axis = axes[static_cast<std::size_t>(i) % axes.size()];
+    specs.push_back(s);
+    ++i;
+  }
+  return specs;
+}
+
+// Joint values in (-6, 6), beyond the limits random_q() keeps to.
+std::vector<double> random_angles(const Model& m, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  std::vector<double> q(static_cast<std::size_t>(m.dof()));
+  for (double& v : q) v = 3.0 * u(rng);
+  return q;
+}
+
 // The fast form (a rotation about x, y or z after a general origin; the parent's product kept in
 // registers when it is the previous segment) against the plain composition parent * pre * R(axis, v),
 // on a tree: chained segments, a branch back to an earlier body, fixed and prismatic segments between.
@@ -258,26 +291,11 @@ TEST(Model, CoordinateAxisJointsMatchThePlainComposition) {
   const Eigen::Vector3d axes[3] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
                                    Eigen::Vector3d::UnitZ()};
   std::mt19937_64 rng(99);
-  std::uniform_real_distribution<double> u(-2.0, 2.0);
-  std::vector<JointSpec> specs;
-  const int parents[] = {-1, 0, 1, 2, 1, 4, 5, 3, 7, 0};
-  for (int i = 0; i < 10; ++i) {
-    JointSpec s;
-    s.name = s.body = "j" + std::to_string(i);
-    s.parent = parents[i];
-    s.type = i == 6   ? KinematicJointType::Fixed
-             : i == 8 ? KinematicJointType::Prismatic
-                      : KinematicJointType::Rotary;
-    s.placement.pre = Eigen::Translation3d(u(rng), i % 2 == 0 ? 0.0 : u(rng), u(rng)) *
-                      Eigen::AngleAxisd(u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized());
-    s.placement.axis = axes[i % 3];
-    specs.push_back(s);
-  }
+  const std::vector<JointSpec> specs = random_tree({-1, 0, 1, 2, 1, 4, 5, 3, 7, 0}, axes, rng);
   const Model m = Model::build(specs);
   Model::Data d = m.make_data();
   for (int trial = 0; trial < 20; ++trial) {
-    std::vector<double> q(static_cast<std::size_t>(m.dof()));
-    for (double& v : q) v = 3.0 * u(rng);
+    const std::vector<double> q = random_angles(m, rng);
     m.forward(q, d);
     std::vector<Eigen::Isometry3d> want;
     int k = 0;
@@ -432,33 +450,14 @@ TEST(Model, AvxAndPortableFormsGiveTheSameBits) {
   far[3] = 2.5e5;  // beyond the table's range: the library's sin and cos for all
   expect_same_bits(fast, portable, far);
 
-  std::uniform_real_distribution<double> u(-2.0, 2.0);
-  std::vector<JointSpec> specs;
-  const int parents[] = {-1, 0, 1, 2, 1, 4, 5, 3, 7, 0, -1, 10, 11};
   const Eigen::Vector3d axes[4] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
                                    Eigen::Vector3d::UnitZ(), Eigen::Vector3d(1, 2, 3).normalized()};
-  for (int i = 0; i < 13; ++i) {
-    JointSpec s;
-    s.name = s.body = "j" + std::to_string(i);
-    s.parent = parents[i];
-    s.type = i == 6   ? KinematicJointType::Fixed
-             : i == 8 ? KinematicJointType::Prismatic
-                      : KinematicJointType::Rotary;
-    s.placement.pre = Eigen::Translation3d(u(rng), i % 2 == 0 ? 0.0 : u(rng), u(rng)) *
-                      Eigen::AngleAxisd(u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized());
-    if (i == 11)
-      s.placement.post =
-          Eigen::Translation3d(0.1, 0.2, 0.3) * Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitX());
-    s.placement.axis = axes[i % 4];
-    specs.push_back(s);
-  }
+  std::vector<JointSpec> specs = random_tree({-1, 0, 1, 2, 1, 4, 5, 3, 7, 0, -1, 10, 11}, axes, rng);
+  specs[11].placement.post =
+      Eigen::Translation3d(0.1, 0.2, 0.3) * Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitX());
   auto tree = [&] { return Model::build(specs); };
   const Model tf = build_with_env(tree, false), tp = build_with_env(tree, true);
-  for (int n = 0; n < 50; ++n) {
-    std::vector<double> q(static_cast<std::size_t>(tf.dof()));
-    for (double& v : q) v = 3.0 * u(rng);
-    expect_same_bits(tf, tp, q);
-  }
+  for (int n = 0; n < 50; ++n) expect_same_bits(tf, tp, random_angles(tf, rng));
 }
 
 TEST(DhChain, StandardAgreesWithItsUrdfChainAndKdl) { compare_dh_with_urdf(DhConvention::Standard); }

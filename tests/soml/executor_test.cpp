@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "script_fixture.hpp"
 #include "vsd/core.hpp"
 #include "vsd/soml.hpp"
 
@@ -30,18 +31,8 @@ namespace {
 using ::testing::HasSubstr;
 using vsd::soml::Program;
 
-struct Exec : ::testing::Test {
-  vsd::Registry reg;
-  vsd::Environment env{0, reg};
-  std::ostringstream out;
-  vsd::soml::Module* soml = nullptr;
-  void SetUp() override { soml = &env.use<vsd::soml::Module>(); }
-  Program& load(const std::string& text, std::uint64_t seed = 1) {
-    vsd::soml::RunOptions o;
-    o.out = &out;
-    o.seed = seed;
-    return soml->load(env.main_state(), "net.soml", text, o);
-  }
+struct Exec : soml_test::ScriptTest {
+  Exec() { script_file = "net.soml"; }
 };
 
 // Every invocation makes a net instance and deletes it when it finishes. The executor drops the entries

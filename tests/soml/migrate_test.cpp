@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "script_fixture.hpp"
 #include "vsd/core.hpp"
 #include "vsd/soml.hpp"
 
@@ -34,14 +35,7 @@ using ::testing::HasSubstr;
 using vsd::soml::MigrationReport;
 using vsd::soml::Program;
 
-std::string error_of(const std::function<void()>& fn) {
-  try {
-    fn();
-  } catch (const vsd::Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using soml_test::error_of;
 
 const char* const v1 = R"(
 class Box : Node { int v = 1; }
@@ -88,20 +82,11 @@ int twice(int x) { return x * 3; }
 void make() { b = new Box(); b.v = 41; }
 )";
 
-struct Migrate : ::testing::Test {
-  vsd::Registry reg;
-  vsd::Environment env{0, reg};
+struct Migrate : soml_test::ScriptTest {
   vsd::SimState& state = env.main_state();
-  std::ostringstream out;
-  vsd::soml::Module* soml = nullptr;
   void SetUp() override {
     reg.add<Holder>();
-    soml = &env.use<vsd::soml::Module>();
-  }
-  Program& load(const std::string& text) {
-    vsd::soml::RunOptions o;
-    o.out = &out;
-    return soml->load(state, "test.soml", text, o);
+    ScriptTest::SetUp();
   }
   // The running v1: one firing of t1, a Box made by code.
   Program& running() {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "script_fixture.hpp"
 #include "vsd/core.hpp"
 #include "vsd/soml.hpp"
 
@@ -20,18 +21,8 @@ using vsd::soml::Place;
 using vsd::soml::Program;
 using vsd::soml::Transition;
 
-struct Nets : ::testing::Test {
-  vsd::Registry reg;
-  vsd::Environment env{0, reg};
-  std::ostringstream out;
-  vsd::soml::Module* soml = nullptr;
-  void SetUp() override { soml = &env.use<vsd::soml::Module>(); }
-  Program& load(const std::string& text, std::uint64_t seed = 1) {
-    vsd::soml::RunOptions o;
-    o.out = &out;
-    o.seed = seed;
-    return soml->load(env.main_state(), "net.soml", text, o);
-  }
+struct Nets : soml_test::ScriptTest {
+  Nets() { script_file = "net.soml"; }
   template <class T>
   static T* child(const vsd::Node& n, std::string_view name) {
     return dynamic_cast<T*>(n.find_child(name));

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 
+#include "script_fixture.hpp"
 #include "vsd/core.hpp"
 #include "vsd/soml.hpp"
 
@@ -32,18 +33,9 @@ std::string dump(const vsd::SimState& state) {
   return s;
 }
 
-struct Rollback : ::testing::Test {
-  vsd::Registry reg;
-  vsd::Environment env{0, reg};
-  std::ostringstream out;
-  vsd::soml::Module* soml = nullptr;
-  void SetUp() override { soml = &env.use<vsd::soml::Module>(); }
+struct Rollback : soml_test::ScriptTest {
+  Rollback() { script_file = "net.soml"; }
   vsd::SimState& state() { return env.main_state(); }
-  Program& load(const std::string& text) {
-    vsd::soml::RunOptions o;
-    o.out = &out;
-    return soml->load(state(), "net.soml", text, o);
-  }
   // Steps once, expects an error saying @p what, and that the state is as before the step.
   void fails_whole(Program& p, const std::string& what) {
     const std::string before = dump(state());

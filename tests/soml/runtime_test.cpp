@@ -5,6 +5,7 @@
 #include <sstream>
 #include <string>
 
+#include "script_fixture.hpp"
 #include "vsd/core.hpp"
 #include "vsd/soml.hpp"
 
@@ -13,27 +14,9 @@ namespace {
 using ::testing::HasSubstr;
 using vsd::soml::Program;
 
-std::string error_of(const std::function<void()>& fn) {
-  try {
-    fn();
-  } catch (const vsd::Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using soml_test::error_of;
 
-// Each test has a registry of its own: script classes are defined into it.
-struct Runtime : ::testing::Test {
-  vsd::Registry reg;
-  vsd::Environment env{0, reg};
-  std::ostringstream out;
-  vsd::soml::Module* soml = nullptr;
-  void SetUp() override { soml = &env.use<vsd::soml::Module>(); }
-  Program& load(const std::string& text, vsd::soml::RunOptions o = {}) {
-    o.out = &out;
-    return soml->load(env.main_state(), "test.soml", text, o);
-  }
-};
+struct Runtime : soml_test::ScriptTest {};
 
 TEST_F(Runtime, ClassesObjectsAndNetsBecomeDatabaseContent) {
   Program& p = load(R"(

@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <utility>
 
 namespace vsd::robotics::detail {
 
@@ -181,36 +182,57 @@ inline constexpr double sincos_c1 = -0.5, sincos_c2 = 1.0 / 24.0, sincos_c3 = -1
   c = ct + (ct * cm1 - st * sz);
 }
 
-/// @brief sincos() of @p n values: the same results, two angles per SSE2 instruction (GCC and Clang vector
-/// extensions) when every |x| < 1e5; the scalar form otherwise.
-inline void sincos_batch(const double* x, double* s, double* c, std::size_t n) noexcept {
+#if defined(__GNUC__)
+/// @brief @p N doubles in one vector (GCC and Clang vector extensions). A member typedef: in a function
+/// template GCC drops a vector_size that depends on a template parameter.
+template <std::size_t N>
+struct sincos_vector {
+  typedef double type __attribute__((vector_size(N * sizeof(double))));
+};
+#endif
+
+/// @brief sincos() of @p n values, sizeof...(L) angles per vector operation (GCC and Clang vector
+/// extensions) when every |x| < 1e5; the scalar form otherwise. The same operations in every lane, so the
+/// same results for any lane count. Always inlined: the caller's target decides the instructions
+/// (sincos_batch(): two lanes, SSE2; the AVX form of forward kinematics: four lanes, AVX).
+/// @param lanes std::make_index_sequence<lanes per operation>{}
+template <std::size_t... L>
+[[gnu::always_inline]] inline void sincos_lanes([[maybe_unused]] std::index_sequence<L...> lanes,
+                                                const double* x, double* s, double* c,
+                                                std::size_t n) noexcept {
   std::size_t i = 0;
 #if defined(__GNUC__)
-  using V2 = double __attribute__((vector_size(16)));
-  const V2 zero = {0.0, 0.0};
+  constexpr std::size_t width = sizeof...(L);
+  using V = typename sincos_vector<width>::type;
+  const V zero = {};
   auto ok = zero == zero;  // lanes of all ones
-  for (; i + 2 <= n; i += 2) {
-    V2 xv;
+  for (; i + width <= n; i += width) {
+    V xv;
     std::memcpy(&xv, x + i, sizeof xv);
     ok &= (xv < sincos_limit) & (xv > -sincos_limit);  // lanes of all ones or zero; zero for NaN
-    const V2 r = xv * sincos_64_over_pi + sincos_shifter;
-    const V2 y = r - sincos_shifter;
-    const V2 z = (xv - y * sincos_pi_64_hi) - y * sincos_pi_64_lo;
-    const V2 zz = z * z;
-    const V2 sz = z + (z * zz) * ((sincos_s3 * zz + sincos_s2) * zz + sincos_s1);
-    const V2 cm1 = zz * ((sincos_c3 * zz + sincos_c2) * zz + sincos_c1);
-    const auto k0 = static_cast<std::size_t>(std::bit_cast<std::uint64_t>(r[0]) & 127U);
-    const auto k1 = static_cast<std::size_t>(std::bit_cast<std::uint64_t>(r[1]) & 127U);
-    const V2 st = {sincos_table[k0][0], sincos_table[k1][0]};
-    const V2 ct = {sincos_table[k0][1], sincos_table[k1][1]};
-    const V2 sv = st + (st * cm1 + ct * sz);
-    const V2 cv = ct + (ct * cm1 - st * sz);
+    const V r = xv * sincos_64_over_pi + sincos_shifter;
+    const V y = r - sincos_shifter;
+    const V z = (xv - y * sincos_pi_64_hi) - y * sincos_pi_64_lo;
+    const V zz = z * z;
+    const V sz = z + (z * zz) * ((sincos_s3 * zz + sincos_s2) * zz + sincos_s1);
+    const V cm1 = zz * ((sincos_c3 * zz + sincos_c2) * zz + sincos_c1);
+    const std::size_t k[width] = {static_cast<std::size_t>(std::bit_cast<std::uint64_t>(r[L]) & 127U)...};
+    const V st = {sincos_table[k[L]][0]...};
+    const V ct = {sincos_table[k[L]][1]...};
+    const V sv = st + (st * cm1 + ct * sz);
+    const V cv = ct + (ct * cm1 - st * sz);
     std::memcpy(s + i, &sv, sizeof sv);
     std::memcpy(c + i, &cv, sizeof cv);
   }
-  if (!(ok[0] && ok[1])) i = 0;  // a value out of range: redo everything with the scalar form
+  if (!(ok[L] && ...)) i = 0;  // a value out of range: redo everything with the scalar form
 #endif
   for (; i < n; ++i) sincos(x[i], s[i], c[i]);
+}
+
+/// @brief sincos() of @p n values: the same results, two angles per SSE2 instruction (GCC and Clang vector
+/// extensions) when every |x| < 1e5; the scalar form otherwise.
+inline void sincos_batch(const double* x, double* s, double* c, std::size_t n) noexcept {
+  sincos_lanes(std::make_index_sequence<2>{}, x, s, c, n);
 }
 
 }  // namespace vsd::robotics::detail
