@@ -56,7 +56,7 @@ class PlantModule : public vsd::Module {
         t.set_level(std::max(0.0, t.level() + rate * s.dt));
         t.set_time(s.time);
       });
-    });
+    }, vsd::Phase::dynamics);
   }
 };
 

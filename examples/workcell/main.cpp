@@ -179,9 +179,9 @@ int main(int argc, char** argv) try {
 
   vsd::Environment env;
   env.scheduler().set_base_step(0.01);  // 10 ms: control, physics write-back, collision, sensors
-  env.use<vsd::robotics::Module>();     // "robotics control", priority 10
-  env.use<vsd::physics::Module>();      // "physics", priority 20 (ODE steps 1 ms inside)
-  auto& collision = env.use<vsd::collision::Module>(0.01);  // "collision update", priority 30
+  env.use<vsd::robotics::Module>();     // "robotics control", phase controllers
+  env.use<vsd::physics::Module>();      // "physics", phase dynamics (ODE steps 1 ms inside)
+  auto& collision = env.use<vsd::collision::Module>(0.01);  // "collision update", phase collision
   env.use<CellModule>();
   auto& soml = env.use<vsd::soml::Module>();  // "soml nets": event-driven, after the periodic tasks
   vsd::SimState& s = env.main_state();
@@ -336,7 +336,7 @@ int main(int argc, char** argv) try {
           b->set_resting(b->slow_steps >= rest_steps);
         }
       },
-      40);
+      vsd::Phase::sensors);
 
   // --- The supervisor.
   vsd::soml::Program& net = soml.load(s, script, read_text(script));

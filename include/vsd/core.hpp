@@ -26,6 +26,8 @@
 #include "vsd/core/savepoint.hpp"
 #include "vsd/core/scheduler.hpp"
 #include "vsd/core/sim_state.hpp"
+#include "vsd/core/state_context.hpp"
 #include "vsd/core/transaction.hpp"
 #include "vsd/core/type_builder.hpp"
 #include "vsd/core/value.hpp"
+#include "vsd/core/watch.hpp"

@@ -28,6 +28,7 @@
 #include "vsd/core/element_index.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/core/sim_state.hpp"
+#include "vsd/core/watch.hpp"
 #include "vsd/scene/geometry.hpp"
 #include "vsd/scene/hull.hpp"
 
@@ -163,20 +164,29 @@ struct CollisionWorld::Impl {
   std::vector<std::string> warnings;          // each once
   std::unordered_set<std::string> warned;
 
-  // Pending work, by id (an instance may be deleted before the next sync).
-  std::vector<Id> moved;               // Node3Ds whose frame changed: hulls at or below move
-  std::vector<Id> restructured;        // nodes re-parented: hulls at or below may enter or leave
-  std::vector<Id> hulls_to_refresh;    // created hulls, changed role or geometry
-  std::vector<Id> geometries_changed;  // rebuild the shape
   std::uint64_t sync_count = 0;
   std::size_t last_moved = 0;
 
   std::vector<Contact> contacts;
   std::set<PairKey> pairs;  // pairs in contact after the last update
   PairSignal begin, end;
-  std::vector<Connection> connections;
 
-  Impl(SimState& s, Options o) : state(s), options(std::move(o)) {
+  // Pending work: queued watches, drained by sync() (de-duplicated ids; an instance may be gone by then).
+  Watch moved;               // Node3Ds whose frame changed: hulls at or below move
+  Watch restructured;        // nodes re-parented: hulls at or below may enter or leave
+  Watch hulls_to_refresh;    // created hulls, changed role or geometry
+  Watch geometries_changed;  // rebuild the shape
+  // Deletions at once: a deleted hull ends its pairs now, while it can still be named.
+  Watch deletions;
+
+  Impl(SimState& s, Options o)
+      : state(s),
+        options(std::move(o)),
+        moved(s),
+        restructured(s),
+        hulls_to_refresh(s),
+        geometries_changed(s),
+        deletions(s, [this](SimStateInstance& i, const MetaProperty*, Changes) { deleted(i); }) {
     if (options.max_contacts_per_pair == 0) options.max_contacts_per_pair = 1;
   }
 
@@ -296,43 +306,31 @@ struct CollisionWorld::Impl {
     }
   }
 
-  // -- listeners --------------------------------------------------------------------------------------
-  void connect() {
-    connections.push_back(state.on_property_changed(Node3D::static_meta(), true)
-                              .connect([this](SimStateInstance& inst, const MetaProperty& p) {
-                                if (&p == &Node3D::vsd_prop_frame() || p.name() == "frame") {
-                                  moved.push_back(inst.id());
-                                } else if (inst.as<Hull>() != nullptr && (&p == &Hull::vsd_prop_role() ||
-                                                                          &p == &Hull::vsd_prop_geometry())) {
-                                  hulls_to_refresh.push_back(inst.id());
-                                }
-                              }));
-    connections.push_back(state.on_property_changed(Geometry::static_meta(), true)
-                              .connect([this](SimStateInstance& inst, const MetaProperty& p) {
-                                if (p.name() != "name") geometries_changed.push_back(inst.id());
-                              }));
-    connections.push_back(
-        state.index().on_created(Hull::static_meta(), true).connect([this](SimStateInstance& i) {
-          hulls_to_refresh.push_back(i.id());
-        }));
-    connections.push_back(
-        state.index().on_deleted(Hull::static_meta(), true).connect([this](SimStateInstance& i) {
-          remove(static_cast<Hull&>(i));
-        }));
-    connections.push_back(
-        state.index().on_deleted(Geometry::static_meta(), true).connect([this](SimStateInstance& i) {
-          shapes.erase(i.id());
-        }));
-    const auto reparented = [this](vsd::Node& /*parent*/, vsd::Node& child) {
-      restructured.push_back(child.id());
-    };
-    connections.push_back(state.on_child_added().connect(reparented));
-    connections.push_back(state.on_child_removed().connect(reparented));
-    if (root_id != 0) {
-      connections.push_back(state.on_deleted().connect([this](SimStateInstance& i) {
-        if (i.id() == root_id) root_gone = true;
-      }));
-    }
+  // -- what the world depends on -----------------------------------------------------------------------
+  void watch() {
+    moved.properties(Node3D::static_meta(), {&Node3D::vsd_prop_frame()});
+    restructured.reparented(vsd::Node::static_meta());
+    hulls_to_refresh.properties(Hull::static_meta(), {&Hull::vsd_prop_role(), &Hull::vsd_prop_geometry()})
+        .created(Hull::static_meta());
+    std::vector<const MetaProperty*> shape;  // everything of a Geometry but its name
+    for (const MetaProperty* p : Geometry::static_meta().properties())
+      if (p != &Geometry::vsd_prop_name()) shape.push_back(p);
+    geometries_changed.properties(Geometry::static_meta(), shape);
+    deletions.deleted(Hull::static_meta()).deleted(Geometry::static_meta());
+    if (root_id != 0) deletions.deleted(vsd::Node::static_meta());
+  }
+
+  void deleted(SimStateInstance& i) {
+    if (auto* h = i.as<Hull>()) remove(*h);
+    if (i.as<Geometry>() != nullptr) shapes.erase(i.id());
+    if (i.id() == root_id) root_gone = true;
+  }
+
+  static std::vector<Id> ids_of(Watch& w) {
+    std::vector<Id> ids;
+    ids.reserve(w.size());
+    w.drain([&](const Watch::Report& r) { ids.push_back(r.id); });
+    return ids;
   }
 
   // Calls fn for every Hull at or below the node with id @p id (when it still exists).
@@ -366,8 +364,8 @@ struct CollisionWorld::Impl {
     }
     // Geometry first: the refreshes below then see the new shapes.
     if (!geometries_changed.empty()) {
-      std::unordered_set<Id> changed(geometries_changed.begin(), geometries_changed.end());
-      geometries_changed.clear();
+      const std::vector<Id> ids = ids_of(geometries_changed);
+      std::unordered_set<Id> changed(ids.begin(), ids.end());
       for (Id g : changed) shapes.erase(g);
       std::vector<Hull*> users;
       for (auto& [h, e] : entries)
@@ -378,15 +376,13 @@ struct CollisionWorld::Impl {
       last_moved += users.size();
     }
     if (!hulls_to_refresh.empty()) {
-      std::vector<Id> ids;
-      ids.swap(hulls_to_refresh);
+      const std::vector<Id> ids = ids_of(hulls_to_refresh);
       for (Id id : ids)
         if (auto* h = state.find<Hull>(id)) refresh(*h);
       last_moved += ids.size();
     }
     if (!restructured.empty()) {
-      std::vector<Id> ids;
-      ids.swap(restructured);
+      const std::vector<Id> ids = ids_of(restructured);
       for (Id id : ids)
         for_hulls_below(id, [&](Hull& h) {
           refresh(h);
@@ -394,8 +390,7 @@ struct CollisionWorld::Impl {
         });
     }
     if (!moved.empty()) {
-      std::vector<Id> ids;
-      ids.swap(moved);
+      const std::vector<Id> ids = ids_of(moved);
       std::vector<fcl::CollisionObjectd*> updated;
       for (Id id : ids) {
         for_hulls_below(id, [&](Hull& h) {
@@ -557,7 +552,7 @@ CollisionWorld::CollisionWorld(SimState& state, Options options)
       throw Error("collision: the root node of a collision world must belong to its SimState");
     m.root_id = m.options.root->id();
   }
-  m.connect();
+  m.watch();
   state.index().for_each(Hull::static_meta(), true,
                          [&](SimStateInstance& i) { m.refresh(static_cast<Hull&>(i)); });
   m.manager.setup();
@@ -673,8 +668,8 @@ std::optional<RayHit> CollisionWorld::ray_cast(const Eigen::Vector3d& origin,
   return best;
 }
 
-CollisionWorld::PairSignal& CollisionWorld::on_contact_begin() noexcept { return impl_->begin; }
-CollisionWorld::PairSignal& CollisionWorld::on_contact_end() noexcept { return impl_->end; }
+CollisionWorld::PairSink CollisionWorld::on_contact_begin() noexcept { return PairSink(impl_->begin); }
+CollisionWorld::PairSink CollisionWorld::on_contact_end() noexcept { return PairSink(impl_->end); }
 std::size_t CollisionWorld::size() const noexcept { return impl_->entries.size(); }
 bool CollisionWorld::contains(const scene::Hull& hull) const { return impl_->entries.contains(&hull); }
 std::size_t CollisionWorld::shape_count() const noexcept {

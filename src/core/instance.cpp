@@ -116,7 +116,7 @@ void SimStateInstance::list_erase(const MetaProperty& p, std::size_t index) {
   state_->list_changed(*this, p, index, target, false);
 }
 
-PropertySignal& SimStateInstance::on_changed() {
+Sink<void(SimStateInstance&, const MetaProperty&)> SimStateInstance::on_changed() {
   auto& slot = state_->instance_signals_[this];
   if (!slot) {
     slot = std::make_unique<PropertySignal>();
@@ -124,7 +124,7 @@ PropertySignal& SimStateInstance::on_changed() {
     slot->on_first_listener([](void* self) { static_cast<SimStateInstance*>(self)->watch_ |= own_watch; },
                             this);
   }
-  return *slot;
+  return Sink<void(SimStateInstance&, const MetaProperty&)>(*slot);
 }
 
 void SimStateInstance::notify_changed(const MetaProperty& p, const void* old_value) {

@@ -29,7 +29,21 @@ SimState::SimState(Environment& env, std::string name) : env_(&env), name_(std::
   root_ = static_cast<Database*>(&make(Database::static_meta(), 1));
 }
 
+/// A per-class property signal, with what its first listener needs to switch on the class's watch bits.
+struct SimState::TypeSignal {
+  PropertySignal signal;
+  SimState* state;
+  const MetaInstance* cls;
+  bool subtypes;
+  static void hook(void* self) {
+    auto* t = static_cast<TypeSignal*>(self);
+    t->state->enable_class_watch(*t->cls, t->subtypes);
+  }
+};
+
 SimState::~SimState() {
+  // Modules' per-state data first, while every instance and signal it may touch is whole.
+  context_.clear();
   ++applying_;  // no cascades while tearing down
   // First cut every reference to every instance (free references outside become null), so that the
   // instances can then be freed in any order.
@@ -99,7 +113,8 @@ SimStateInstance& SimState::make(const MetaInstance& cls, Id id) {
   obj->state_ = this;
   obj->id_ = id;
   obj->life_ = SimStateInstance::floating_bit;
-  obj->watch_ = state_watch_ ? SimStateInstance::state_watch : 0;
+  obj->watch_ = static_cast<std::uint8_t>((state_watch_ ? SimStateInstance::state_watch : 0) |
+                                          (type_signals_ != 0 && class_watched(cls) ? SimStateInstance::class_watch : 0));
   index_.add(*obj);
   return *obj;
 }
@@ -286,9 +301,11 @@ void SimState::clear_reference(SimStateInstance& inst, const MetaProperty& p) {
 
 // ---- signals ----------------------------------------------------------------------------------------------
 
-// Watching: an instance's watch_ byte sends its setters down the slow path. It is switched on for every
-// instance when the SimState starts recording or one of its signals gains a first listener (the signals'
-// on_first_listener hook), and switched off lazily, per instance, when a change finds nobody interested.
+// Watching: an instance's watch_ byte sends its setters down the slow path. The state-wide bit is switched
+// on for every instance when the SimState starts recording or its state-wide property signal gains a first
+// listener; the class bit only for the instances of the classes that a per-class signal covers (so an
+// instance of a class nobody watches keeps its one-branch setter). Both are switched off lazily, per
+// instance, when a change finds nobody interested.
 
 void SimState::enable_state_watch() {
   state_watch_ = true;
@@ -297,34 +314,49 @@ void SimState::enable_state_watch() {
 
 void SimState::watch_hook(void* state) { static_cast<SimState*>(state)->enable_state_watch(); }
 
-bool SimState::state_watch_wanted() const noexcept {
-  if (recording_ || property_changed_.has_listeners()) return true;
-  if (type_signals_ == 0) return false;
-  for (const auto* table : {&type_exact_, &type_tree_})
-    for (const auto& s : *table)
-      if (s && s->has_listeners()) return true;
+bool SimState::state_watch_wanted() const noexcept { return recording_ || property_changed_.has_listeners(); }
+
+void SimState::enable_class_watch(const MetaInstance& cls, bool subtypes) {
+  std::fill(class_watch_.begin(), class_watch_.end(), std::uint8_t{0});  // new instances ask again
+  index_.for_each(cls, subtypes, [](SimStateInstance& x) { x.watch_ |= SimStateInstance::class_watch; });
+}
+
+bool SimState::class_watched(const MetaInstance& cls) noexcept {
+  const std::size_t k = cls.index();
+  if (k < class_watch_.size() && class_watch_[k] != 0) return class_watch_[k] == 2;
+  const bool watched = class_watched_slow(cls);
+  if (class_watch_.size() <= k) class_watch_.resize(k + 1, 0);
+  class_watch_[k] = watched ? 2 : 1;
+  return watched;
+}
+
+bool SimState::class_watched_slow(const MetaInstance& cls) const noexcept {
+  if (type_signal(cls, false) != nullptr) return true;
+  for (const MetaInstance* m = &cls; m != nullptr; m = m->base())
+    if (type_signal(*m, true) != nullptr) return true;
   return false;
 }
 
-PropertySignal& SimState::on_property_changed() { return property_changed_; }
-
-PropertySignal& SimState::on_property_changed(const MetaInstance& type, bool include_subtypes) {
+SimState::PropertySink SimState::on_property_changed(const MetaInstance& type, bool include_subtypes) {
   auto& table = include_subtypes ? type_tree_ : type_exact_;
   if (table.size() <= type.index()) table.resize(type.index() + 1);
   auto& slot = table[type.index()];
   if (!slot) {
-    slot = std::make_unique<PropertySignal>();
-    slot->on_first_listener(&SimState::watch_hook, this);
+    slot = std::make_unique<TypeSignal>();
+    slot->state = this;
+    slot->cls = &type;
+    slot->subtypes = include_subtypes;
+    slot->signal.on_first_listener(&TypeSignal::hook, slot.get());
     ++type_signals_;
   }
-  return *slot;
+  return PropertySink(slot->signal);
 }
 
 PropertySignal* SimState::type_signal(const MetaInstance& m, bool tree) const noexcept {
   const auto& table = tree ? type_tree_ : type_exact_;
   if (m.index() >= table.size()) return nullptr;
-  PropertySignal* s = table[m.index()].get();
-  return s != nullptr && s->has_listeners() ? s : nullptr;
+  TypeSignal* s = table[m.index()].get();
+  return s != nullptr && s->signal.has_listeners() ? &s->signal : nullptr;
 }
 
 void SimState::emit_property(SimStateInstance& inst, const MetaProperty& p) {
@@ -357,7 +389,7 @@ void SimState::emit_property(SimStateInstance& inst, const MetaProperty& p) {
   const bool state_wide = property_changed_.has_listeners();
   if (own == nullptr && exact == nullptr && trees == 0 && !state_wide && !recording_) {
     // Nobody is interested in this instance: back to the fast path until a signal gains a listener.
-    inst.watch_ &= static_cast<std::uint8_t>(~SimStateInstance::state_watch);
+    inst.watch_ &= static_cast<std::uint8_t>(~(SimStateInstance::state_watch | SimStateInstance::class_watch));
     if (state_watch_ && !state_watch_wanted()) state_watch_ = false;
     return;
   }
@@ -374,7 +406,7 @@ void SimState::emit_property(SimStateInstance& inst, const MetaProperty& p) {
 
 void SimState::property_changed(SimStateInstance& inst, const MetaProperty& p, const void* old_value) {
   Dispatch d(*this);
-  if (recording_ && !p.has(Transient)) {
+  if (recording_ && !p.has(Transient) && derive_depth_ != dispatching_) {
     detail::write_set(recorded_, inst, p, old_value, p.address(inst));
     ++recorded_ops_;
   }
@@ -384,7 +416,7 @@ void SimState::property_changed(SimStateInstance& inst, const MetaProperty& p, c
 void SimState::list_changed(SimStateInstance& holder, const MetaProperty& p, std::size_t index,
                             SimStateInstance& target, bool inserted) {
   Dispatch d(*this);
-  if (recording_ && !p.has(Transient)) {
+  if (recording_ && !p.has(Transient) && derive_depth_ != dispatching_) {
     detail::write_list(recorded_, inserted ? Transaction::Op::Insert : Transaction::Op::Erase, holder.id(), p,
                        index, target.id());
     ++recorded_ops_;
@@ -399,6 +431,10 @@ void SimState::list_changed(SimStateInstance& holder, const MetaProperty& p, std
       child_removed_.emit(parent, child);
       root_->notify_detached(parent, child);
     }
+  } else if (&p == &NamedModelInstance::vsd_prop_extensions()) {
+    auto& owner = static_cast<NamedModelInstance&>(holder);
+    auto& ext = static_cast<Extension&>(target);
+    (inserted ? extension_added_ : extension_removed_).emit(owner, ext);
   }
   if (holder.watch_ != 0) emit_property(holder, p);
 }

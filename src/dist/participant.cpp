@@ -1552,8 +1552,10 @@ std::string Participant::participant_name(std::uint64_t id) const {
   if (auto it = impl_->names.find(id); it != impl_->names.end()) return it->second;
   return hex(id);
 }
-Signal<void(const Conflict&)>& Participant::on_conflict() noexcept { return impl_->conflict_signal; }
-Signal<void()>& Participant::on_synced() noexcept { return impl_->synced_signal; }
+Sink<void(const Conflict&)> Participant::on_conflict() noexcept {
+  return Sink<void(const Conflict&)>(impl_->conflict_signal);
+}
+Sink<void()> Participant::on_synced() noexcept { return Sink<void()>(impl_->synced_signal); }
 const ParticipantStats& Participant::stats() const noexcept { return impl_->stats; }
 
 }  // namespace vsd::dist

@@ -16,6 +16,7 @@
 #include "ode_runtime.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/core/sim_state.hpp"
+#include "vsd/core/watch.hpp"
 #include "vsd/scene/hull.hpp"
 #include "vsd/scene/link.hpp"
 #include "vsd/scene/node3d.hpp"
@@ -192,7 +193,6 @@ constexpr std::size_t npos = static_cast<std::size_t>(-1);
 struct Simulation::Impl {
   detail::OdeRuntime runtime;  // first member: ODE stays initialised until everything below is gone
   vsd::SimState* state;
-  std::vector<Connection> connections;
 
   std::unordered_map<const World*, std::unique_ptr<WorldRec>> worlds;
   std::unordered_map<const RigidBody*, std::unique_ptr<BodyRec>> bodies;
@@ -212,66 +212,78 @@ struct Simulation::Impl {
   std::vector<dContact> contact_buffer;
   SimulationStats stats;
 
-  explicit Impl(vsd::SimState& s) : state(&s) { connect(); }
+  // What the mirror depends on. An at-once Watch whose callback only takes notes (layout dirty; node
+  // moved by someone else; body property touched) and applies deletions at once, so no record dangles.
+  // No subscription on plain Nodes: a World on a plain node is seen through its own attachment
+  // (reparented), and structure through children added and removed, so plain nodes and script objects
+  // keep their fast setters.
+  Watch watch;
+
+  explicit Impl(vsd::SimState& s)
+      : state(&s), watch(s, [this](SimStateInstance& i, const MetaProperty* p, Changes what) { heard(i, p, what); }) {
+    subscribe();
+  }
   ~Impl() { clear_all(); }
 
-  // ---- listeners: take notes only ----
-  void connect() {
-    auto& idx = state->index();
-    auto mark = [this](SimStateInstance&) { dirty = true; };
-    connections.push_back(idx.on_created(Node3D::static_meta(), true).connect(mark));
-    connections.push_back(idx.on_created(RigidBody::static_meta(), true).connect(mark));
-    connections.push_back(idx.on_created(World::static_meta(), true).connect(mark));
-    connections.push_back(idx.on_created(Joint::static_meta(), true).connect(mark));
-    auto gone = [this](SimStateInstance& i) { deleted(i); };
-    connections.push_back(idx.on_deleted(Node3D::static_meta(), true).connect(gone));
-    connections.push_back(idx.on_deleted(RigidBody::static_meta(), true).connect(gone));
-    connections.push_back(idx.on_deleted(World::static_meta(), true).connect(gone));
-    connections.push_back(idx.on_deleted(Joint::static_meta(), true).connect(gone));
-    // Node, not Node3D: a World may sit on any node (the Database root included), and attaching an
-    // extension or a child is a change of the holder's `extensions` or `children` list.
-    connections.push_back(
-        state->on_property_changed(vsd::Node::static_meta(), true)
-            .connect([this](SimStateInstance& i, const MetaProperty& p) { node_changed(i, p); }));
-    connections.push_back(
-        state->on_property_changed(RigidBody::static_meta(), true)
-            .connect([this](SimStateInstance& i, const MetaProperty& p) { body_changed(i, p); }));
-    connections.push_back(state->on_property_changed(World::static_meta(), true)
-                              .connect([this](SimStateInstance&, const MetaProperty& p) {
-                                if (!writing || &p != &World::vsd_prop_time()) dirty = true;
-                              }));
-    connections.push_back(state->on_property_changed(Joint::static_meta(), true)
-                              .connect([this](SimStateInstance&, const MetaProperty& p) {
-                                if (&p != &Joint::vsd_prop_position() && &p != &Joint::vsd_prop_rate() &&
-                                    &p != &Joint::vsd_prop_position2() && &p != &Joint::vsd_prop_rate2())
-                                  dirty = true;
-                              }));
-    connections.push_back(state->on_property_changed(scene::Geometry::static_meta(), true)
-                              .connect([this](SimStateInstance& i, const MetaProperty&) {
-                                meshes.erase(i.as<scene::Geometry>());
-                                dirty = true;
-                              }));
-    connections.push_back(
-        idx.on_deleted(scene::Geometry::static_meta(), true).connect([this](SimStateInstance& i) {
-          meshes.erase(i.as<scene::Geometry>());
-          dirty = true;
-        }));
-    // Density decides derived masses; friction and restitution are read at contact time.
-    connections.push_back(state->on_property_changed(scene::Material::static_meta(), true)
-                              .connect([this](SimStateInstance&, const MetaProperty& p) {
-                                if (&p == &scene::Material::vsd_prop_density()) dirty = true;
-                              }));
+  void subscribe() {
+    const auto& link = scene::Link::static_meta();
+    std::vector<const MetaProperty*> link_props;  // what a Link adds to a Node3D: mass and inertia
+    for (const MetaProperty* p : link.properties())
+      if (&p->owner() == &link) link_props.push_back(p);
+    std::vector<const MetaProperty*> joint_props;  // all but the measured values the step writes
+    for (const MetaProperty* p : Joint::static_meta().properties())
+      if (p != &Joint::vsd_prop_position() && p != &Joint::vsd_prop_rate() && p != &Joint::vsd_prop_position2() &&
+          p != &Joint::vsd_prop_rate2())
+        joint_props.push_back(p);
+    for (const MetaInstance* cls : {&Node3D::static_meta(), &RigidBody::static_meta(), &World::static_meta(),
+                                    &Joint::static_meta()})
+      watch.created(*cls).deleted(*cls);
+    watch.deleted(scene::Geometry::static_meta())
+        .reparented(vsd::Node::static_meta())
+        .reparented(RigidBody::static_meta())
+        .reparented(World::static_meta())
+        .reparented(Joint::static_meta())
+        .properties(Node3D::static_meta(), {&Node3D::vsd_prop_frame()})
+        .properties(Hull::static_meta(), {&Hull::vsd_prop_role(), &Hull::vsd_prop_geometry(), &Hull::vsd_prop_material()})
+        .properties(link, link_props)
+        .all_properties(RigidBody::static_meta())
+        .all_properties(World::static_meta())
+        .properties(Joint::static_meta(), joint_props)
+        .all_properties(scene::Geometry::static_meta())
+        // Density decides derived masses; friction and restitution are read at contact time.
+        .properties(scene::Material::static_meta(), {&scene::Material::vsd_prop_density()});
+  }
+
+  void heard(SimStateInstance& inst, const MetaProperty* p, Changes what) {
+    if (what.has(Changes::deleted)) {
+      if (inst.as<scene::Geometry>() != nullptr) {
+        meshes.erase(inst.as<scene::Geometry>());
+        dirty = true;
+      } else {
+        deleted(inst);
+      }
+    } else if (what.has(Changes::created) || what.has(Changes::parent)) {
+      dirty = true;
+    } else if (inst.as<RigidBody>() != nullptr) {
+      body_changed(inst, *p);
+    } else if (inst.as<World>() != nullptr) {
+      if (!writing || p != &World::vsd_prop_time()) dirty = true;
+    } else if (inst.as<scene::Geometry>() != nullptr) {
+      meshes.erase(inst.as<scene::Geometry>());
+      dirty = true;
+    } else if (inst.as<Joint>() != nullptr || inst.as<scene::Material>() != nullptr) {
+      dirty = true;
+    } else {
+      node_changed(inst, *p);
+    }
   }
 
   void node_changed(SimStateInstance& inst, const MetaProperty& p) {
     if (writing) return;
     if (&p == &Node3D::vsd_prop_frame()) {
       moved.push_back(inst.id());
-    } else if (&p == &vsd::Node::vsd_prop_children() ||
-               &p == &vsd::NamedModelInstance::vsd_prop_extensions() || &p == &Hull::vsd_prop_role() ||
-               &p == &Hull::vsd_prop_geometry() || &p == &Hull::vsd_prop_material() ||
-               inst.as<scene::Link>() != nullptr) {
-      dirty = true;
+    } else {
+      dirty = true;  // a Hull's role, geometry or material, a Link's mass or inertia
     }
   }
 

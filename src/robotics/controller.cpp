@@ -31,9 +31,9 @@ bool clamped(const Model& m, std::vector<double>& q) {
 // clears `done` at once, not only this class's setters.
 void on_controller_changed(SimStateInstance& inst, const MetaProperty& p) {
   auto& c = static_cast<JointController&>(inst);
-  const std::string_view name = p.name();
-  if (name == "target" || name == "target_pose" || name == "tip" ||
-      (name == "mode" && (c.mode() == ControlMode::Position || c.mode() == ControlMode::Cartesian)))
+  if (&p == &JointController::vsd_prop_target() || &p == &JointController::vsd_prop_target_pose() ||
+      &p == &JointController::vsd_prop_tip() ||
+      (&p == &JointController::vsd_prop_mode() && (c.mode() == ControlMode::Position || c.mode() == ControlMode::Cartesian)))
     c.set_done(false);
 }
 

@@ -1,11 +1,11 @@
 // KinematicTree, the per-SimState listeners that make joint values move link frames, and the builders.
 #include "vsd/robotics/kinematic_tree.hpp"
 
-#include <mutex>
 #include <unordered_map>
 
 #include "vsd/core/error.hpp"
 #include "vsd/core/sim_state.hpp"
+#include "vsd/core/watch.hpp"
 #include "vsd/robotics/controller.hpp"
 #include "vsd/scene/joint.hpp"
 #include "vsd/scene/link.hpp"
@@ -18,129 +18,137 @@ void on_controller_changed(SimStateInstance& inst, const MetaProperty& p);
 
 namespace {
 
-// What vsd::robotics keeps per SimState: its listeners, the topology version and the mimic followers.
+// What vsd::robotics keeps per SimState, in the state's context: an at-once Watch that derives link frames
+// and mimic values from joint values, and the topology version that compiled models compare with.
+//
+// A joint value is the one recorded property of a joint set. The owner's `frame` and a mimic follower's
+// value are derived (SimState::Deriving): signalled, so world frames, collision and carried objects follow,
+// but not recorded — every state that this module serves derives them itself from the recorded value.
 struct Tracker {
-  std::vector<Connection> connections;
+  explicit Tracker(SimState& s);
+  void heard(SimStateInstance& inst, const MetaProperty* p, Changes what);
+  void joint_changed(KinematicJoint& j, const MetaProperty& p);
+  void node_changed(scene::Node3D& node, const MetaProperty& p);
+  const std::vector<KinematicJoint*>& followers_of(const KinematicJoint& j);
+
+  SimState& state;
   std::uint64_t version = 1;
   std::uint64_t followers_version = 0;
   std::unordered_map<const KinematicJoint*, std::vector<KinematicJoint*>> followers;
   int depth = 0;  // nested updates (mimic chains); a cycle stops here instead of recursing forever
+  Watch watch;    // last: goes first
 };
-
-// Keyed by address; an entry whose SimState died is recognised by its dead connection (as vsd::scene does).
-std::mutex trackers_mutex;
-std::unordered_map<const SimState*, std::unique_ptr<Tracker>>& trackers() {
-  static auto* map = new std::unordered_map<const SimState*, std::unique_ptr<Tracker>>();
-  return *map;
-}
-
-Tracker* find_tracker(const SimState& state) {
-  std::lock_guard lock(trackers_mutex);
-  auto it = trackers().find(&state);
-  if (it == trackers().end() || it->second->connections.empty() ||
-      !it->second->connections.front().connected())
-    return nullptr;
-  return it->second.get();
-}
 
 void sync_owner_frame(KinematicJoint& j) {
   if (auto* owner = j.owner(); owner != nullptr)
-    if (auto* node = owner->as<scene::Node3D>()) node->set_frame(j.motion_frame());
-}
-
-const std::vector<KinematicJoint*>& followers_of(Tracker& t, SimState& state, const KinematicJoint& j) {
-  if (t.followers_version != t.version) {
-    t.followers.clear();
-    for (KinematicJoint* f : state.index().of<KinematicJoint>())
-      if (f->mimic().get() != nullptr) t.followers[f->mimic().get()].push_back(f);
-    t.followers_version = t.version;
-  }
-  static const std::vector<KinematicJoint*> none;
-  auto it = t.followers.find(&j);
-  return it == t.followers.end() ? none : it->second;
+    if (auto* node = owner->as<scene::Node3D>()) {
+      SimState::Deriving derived(j.state());
+      node->set_frame(j.motion_frame());
+    }
 }
 
 void sync_mimic(KinematicJoint& f) {
   if (f.mimic().get() == nullptr) return;
+  SimState::Deriving derived(f.state());
   f.set_position(f.mimic_multiplier() * f.mimic()->position() + f.mimic_offset());
 }
 
-void on_joint_changed(Tracker& t, SimStateInstance& inst, const MetaProperty& p) {
-  auto& j = static_cast<KinematicJoint&>(inst);
-  const std::string_view name = p.name();
-  if (name == "velocity" || name == "name") return;
-  if (t.depth > 64) return;  // a mimic cycle (compile() rejects it); do not recurse without end
-  ++t.depth;
+Tracker::Tracker(SimState& s)
+    : state(s), watch(s, [this](SimStateInstance& i, const MetaProperty* p, Changes what) { heard(i, p, what); }) {
+  // Every property of a joint but its velocity, name and description; of a node its frame (part of the
+  // model unless a joint derives it) and extensions (a joint attached or removed); of a controller what
+  // makes it start anew; and every node that changes parent (the tree's shape).
+  std::vector<const MetaProperty*> joint_props;
+  for (const MetaProperty* p : KinematicJoint::static_meta().properties())
+    if (p != &KinematicJoint::vsd_prop_velocity() && p != &KinematicJoint::vsd_prop_name() &&
+        p != &KinematicJoint::vsd_prop_description())
+      joint_props.push_back(p);
+  watch.properties(KinematicJoint::static_meta(), joint_props)
+      .properties(scene::Node3D::static_meta(),
+                  {&scene::Node3D::vsd_prop_frame(), &vsd::NamedModelInstance::vsd_prop_extensions()})
+      .properties(JointController::static_meta(),
+                  {&JointController::vsd_prop_target(), &JointController::vsd_prop_target_pose(),
+                   &JointController::vsd_prop_tip(), &JointController::vsd_prop_mode()})
+      .reparented(vsd::Node::static_meta());
+}
+
+void Tracker::heard(SimStateInstance& inst, const MetaProperty* p, Changes what) {
+  if (what.has(Changes::parent)) {
+    ++version;
+  } else if (auto* j = inst.as<KinematicJoint>()) {
+    joint_changed(*j, *p);
+  } else if (auto* c = inst.as<JointController>()) {
+    on_controller_changed(*c, *p);
+  } else {
+    node_changed(static_cast<scene::Node3D&>(inst), *p);
+  }
+}
+
+const std::vector<KinematicJoint*>& Tracker::followers_of(const KinematicJoint& j) {
+  if (followers_version != version) {
+    followers.clear();
+    for (KinematicJoint* f : state.index().of<KinematicJoint>())
+      if (f->mimic().get() != nullptr) followers[f->mimic().get()].push_back(f);
+    followers_version = version;
+  }
+  static const std::vector<KinematicJoint*> none;
+  auto it = followers.find(&j);
+  return it == followers.end() ? none : it->second;
+}
+
+void Tracker::joint_changed(KinematicJoint& j, const MetaProperty& p) {
+  if (depth > 64) return;  // a mimic cycle (compile() rejects it); do not recurse without end
+  ++depth;
   struct Leave {
     int& d;
     ~Leave() { --d; }
-  } leave{t.depth};
-  const bool value = name == "position" || name == "position2";
-  if (!value && name != "description") ++t.version;
-  if (name == "mimic" || name == "mimic_multiplier" || name == "mimic_offset") {
+  } leave{depth};
+  const bool position = &p == &KinematicJoint::vsd_prop_position();
+  const bool value = position || &p == &KinematicJoint::vsd_prop_position2();
+  if (!value) ++version;
+  if (&p == &KinematicJoint::vsd_prop_mimic() || &p == &KinematicJoint::vsd_prop_mimic_multiplier() ||
+      &p == &KinematicJoint::vsd_prop_mimic_offset()) {
     sync_mimic(j);  // never dropped: the follower takes its master's value at once
     return;
   }
-  if (name == "position" && j.mimic().get() != nullptr) {
+  if (position && j.mimic().get() != nullptr) {
     // A follower's value is its master's, whoever wrote it.
     const double want = j.mimic_multiplier() * j.mimic()->position() + j.mimic_offset();
     if (j.position() != want) {
+      SimState::Deriving derived(state);
       j.set_position(want);
       return;
     }
   }
   sync_owner_frame(j);
-  if (name == "position") {
-    if (scene::Joint* d = j.description().get(); d != nullptr) d->set_position(j.position());
+  if (position) {
     // Copy: a follower's update may rebuild the table.
-    const std::vector<KinematicJoint*> fs = followers_of(t, inst.state(), j);
+    const std::vector<KinematicJoint*> fs = followers_of(j);
     for (KinematicJoint* f : fs) sync_mimic(*f);
   }
 }
 
-void on_node_changed(Tracker& t, SimStateInstance& inst, const MetaProperty& p) {
-  const std::string_view name = p.name();
-  if (name == "extensions") {
-    ++t.version;
-    auto& node = static_cast<scene::Node3D&>(inst);
+void Tracker::node_changed(scene::Node3D& node, const MetaProperty& p) {
+  if (&p == &vsd::NamedModelInstance::vsd_prop_extensions()) {
+    ++version;
     if (auto* j = node.find_extension<KinematicJoint>()) sync_owner_frame(*j);
-  } else if (name == "frame") {
+  } else if (node.find_extension<KinematicJoint>() == nullptr) {
     // The frame of a node moved by a joint is derived; any other node's frame is part of the model.
-    if (static_cast<scene::Node3D&>(inst).find_extension<KinematicJoint>() == nullptr) ++t.version;
+    ++version;
   }
 }
 
-void on_scene_joint_changed(SimStateInstance& inst, const MetaProperty& p) {
-  if (p.name() != "position") return;
-  auto& d = static_cast<scene::Joint&>(inst);
-  if (scene::Link* child = d.child_link().get())
-    if (auto* j = child->find_extension<KinematicJoint>(); j != nullptr && j->description().get() == &d)
-      j->set_position(d.position());
-}
+Tracker& tracker(SimState& state) { return state.context().get_or_emplace<Tracker>(state); }
 
-Tracker& tracker(SimState& state) {
-  if (Tracker* t = find_tracker(state)) return *t;
-  auto t = std::make_unique<Tracker>();
-  Tracker* raw = t.get();
-  t->connections.push_back(
-      state.on_property_changed(KinematicJoint::static_meta(), true)
-          .connect([raw](SimStateInstance& i, const MetaProperty& p) { on_joint_changed(*raw, i, p); }));
-  t->connections.push_back(
-      state.on_property_changed(scene::Node3D::static_meta(), true)
-          .connect([raw](SimStateInstance& i, const MetaProperty& p) { on_node_changed(*raw, i, p); }));
-  t->connections.push_back(
-      state.on_property_changed(scene::Joint::static_meta(), true).connect(&on_scene_joint_changed));
-  t->connections.push_back(
-      state.on_property_changed(JointController::static_meta(), true).connect(&on_controller_changed));
-  t->connections.push_back(state.on_child_added().connect([raw](vsd::Node&, vsd::Node&) { ++raw->version; }));
-  t->connections.push_back(
-      state.on_child_removed().connect([raw](vsd::Node&, vsd::Node&) { ++raw->version; }));
-  std::lock_guard lock(trackers_mutex);
-  auto& slot = trackers()[&state];
-  // A dead entry (its SimState is gone and the address reused) is replaced; its connections are inert.
-  slot = std::move(t);
-  return *raw;
-}
+}  // namespace
+
+void track(SimState& state) { (void)tracker(state); }
+
+void untrack(SimState& state) noexcept { state.context().erase<Tracker>(); }
+
+std::uint64_t topology_version(SimState& state) { return tracker(state).version; }
+
+namespace {
 
 KinematicJointType type_of(scene::JointType t, std::string_view name, std::vector<std::string>* warnings) {
   switch (t) {
@@ -160,10 +168,6 @@ KinematicJointType type_of(scene::JointType t, std::string_view name, std::vecto
 }
 
 }  // namespace
-
-void track(SimState& state) { (void)tracker(state); }
-
-std::uint64_t topology_version(SimState& state) { return tracker(state).version; }
 
 // ---- KinematicTree --------------------------------------------------------------------------------------
 

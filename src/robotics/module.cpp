@@ -25,23 +25,30 @@ void Module::register_types(vsd::Registry& registry) {
 
 void Module::attach(vsd::Environment& env) {
   env.use<scene::Module>();
-  for (SimState* s : env.states()) track(*s);
   vsd::Environment* e = &env;
   control_task_ = env.scheduler().add_periodic(
       "robotics control", env.scheduler().base_step(),
-      [e](const vsd::StepInfo& info) {
+      [this, e](const vsd::StepInfo& info) {
         // Controllers compute the commands, then the bindings send them and read the robots back.
-        for (SimState* s : e->states()) {
+        for (SimState* s : e->states_served(*this, Service::stepped)) {
           for (JointController* c : s->index().of<JointController>()) c->step(info.dt);
           for (HardwareBinding* b : s->index().of<HardwareBinding>()) b->cycle(info.dt);
         }
       },
-      10);
+      Phase::controllers);
 }
 
 void Module::detach(vsd::Environment& env) {
   if (control_task_ != 0) env.scheduler().remove(control_task_);
   control_task_ = 0;
+}
+
+void Module::serve(SimState& state, Service /*from*/, Service to) {
+  if (to == Service::none) {
+    untrack(state);
+  } else {
+    track(state);
+  }
 }
 
 }  // namespace vsd::robotics

@@ -1,6 +1,7 @@
 #include "vsd/scene/module.hpp"
 
 #include "vsd/core/registry.hpp"
+#include "vsd/core/sim_state.hpp"
 #include "vsd/scene/geometry.hpp"
 #include "vsd/scene/hull.hpp"
 #include "vsd/scene/joint.hpp"
@@ -10,6 +11,7 @@
 #include "vsd/scene/scene.hpp"
 #include "vsd/scene/support.hpp"
 #include "vsd/scene/texture_map.hpp"
+#include "world_frames.hpp"
 
 namespace vsd::scene {
 
@@ -29,6 +31,14 @@ void Module::register_types(vsd::Registry& registry) {
   registry.add<Scene>();
   registry.add_type<SpatialRelation>();
   registry.add<Support>();
+}
+
+void Module::serve(vsd::SimState& state, vsd::Service /*from*/, vsd::Service to) {
+  if (to == vsd::Service::none) {
+    state.context().erase<WorldFrameWatch>();
+  } else {
+    state.context().get_or_emplace<WorldFrameWatch>(state);
+  }
 }
 
 }  // namespace vsd::scene

@@ -1,45 +1,29 @@
 // Node3D world frames: the lazy cache and the per-SimState listeners that keep it honest.
 #include "vsd/scene/node3d.hpp"
 
-#include <mutex>
-#include <unordered_map>
 #include <vector>
 
 #include "vsd/core/sim_state.hpp"
+#include "world_frames.hpp"
 
 namespace vsd::scene {
 
-namespace {
-
-// One listener set per SimState. The map is keyed by address; an entry whose signal is gone (its SimState
-// was destroyed) is recognised by its dead connection and replaced when the address is reused.
-// Guarded by a mutex because SimStates of different threads share it; a node asks only once (tracked_).
-std::mutex tracking_mutex;
-std::unordered_map<const SimState*, Connection>& tracked_states() {
-  static auto* map = new std::unordered_map<const SimState*, Connection>();  // outlives every static user
-  return *map;
+WorldFrameWatch::WorldFrameWatch(SimState& state)
+    : watch(state, [](SimStateInstance& inst, const MetaProperty*, Changes) {
+        Node3D::invalidate_below(static_cast<vsd::Node&>(inst));
+      }) {
+  // Plain nodes between Node3Ds are transparent, so re-parenting any node may move Node3Ds below it.
+  watch.properties(Node3D::static_meta(), {&Node3D::vsd_prop_frame()}).reparented(vsd::Node::static_meta());
 }
 
-void on_node3d_changed(SimStateInstance& inst, const MetaProperty& p) {
-  // The property objects of subclasses are the base's, but compare the name too for run-time subclasses.
-  if (&p == &Node3D::vsd_prop_frame() || p.name() == "frame")
-    Node3D::invalidate_below(static_cast<Node3D&>(inst));
+WorldFrameWatch::~WorldFrameWatch() {
+  // Without the watch no cache of this state can be trusted: all dirty, all untracked.
+  watch.state().index().for_each(Node3D::static_meta(), true, [](SimStateInstance& i) {
+    auto& n = static_cast<Node3D&>(i);
+    n.world_clean_ = false;
+    n.tracked_ = false;
+  });
 }
-
-void on_reparented(vsd::Node& /*parent*/, vsd::Node& child) { Node3D::invalidate_below(child); }
-
-void ensure_tracking(SimState& state) {
-  std::lock_guard lock(tracking_mutex);
-  auto& map = tracked_states();
-  auto it = map.find(&state);
-  if (it != map.end() && it->second.connected()) return;
-  // Listeners that need no context: they live as long as the SimState's signals (release()).
-  state.on_child_added().connect(&on_reparented).release();
-  state.on_child_removed().connect(&on_reparented).release();
-  map[&state] = state.on_property_changed(Node3D::static_meta(), true).connect(&on_node3d_changed);
-}
-
-}  // namespace
 
 Node3D* Node3D::frame_parent() const noexcept {
   for (vsd::Node* p = parent(); p != nullptr; p = p->parent())
@@ -92,8 +76,8 @@ const Eigen::Isometry3d& Node3D::update_world_frame() const {
     chain.push_back(n);
   }
   if (!tracked_) {
-    // Before any cache of this SimState becomes clean, its listeners must exist.
-    ensure_tracking(state());
+    // Before any cache of this SimState becomes clean, its watch must exist.
+    state().context().get_or_emplace<WorldFrameWatch>(state());
     for (const Node3D* n : chain) n->tracked_ = true;
   }
   const Eigen::Isometry3d* above = top_parent != nullptr ? &top_parent->world_ : nullptr;

@@ -24,40 +24,18 @@ std::string name_of(const Node3D& n) { return "'" + n.name() + "' (id " + std::t
 
 }  // namespace
 
-SpatialView::SpatialView(SimState& state) : state_(state) {
-  connections_.push_back(state.on_property_changed(Node3D::static_meta(), true)
-                             .connect([this](SimStateInstance& inst, const MetaProperty& p) {
-                               // An attached or detached extension may be a Support.
-                               if (&p == &vsd::NamedModelInstance::vsd_prop_extensions()) {
-                                 rescan(static_cast<Node3D&>(inst));
-                                 return;
-                               }
-                               if (relations_.empty()) return;
-                               if (&p == &Node3D::vsd_prop_frame() || p.name() == "frame")
-                                 on_moved(static_cast<vsd::Node&>(inst));
-                             }));
-  connections_.push_back(state.on_property_changed(Support::static_meta(), true)
-                             .connect([this](SimStateInstance& i, const MetaProperty&) {
-                               if (auto* owner = static_cast<Support&>(i).owner())
-                                 if (auto* object = owner->as<Node3D>()) rescan(*object);
-                             }));
-  connections_.push_back(
-      state.index().on_deleted(Support::static_meta(), true).connect([this](SimStateInstance& i) {
-        auto& sup = static_cast<Support&>(i);
-        if (auto* owner = sup.owner())
-          if (auto* object = owner->as<Node3D>()) rescan(*object, &sup);
-      }));
-  // A re-parented node may have moved in the world (its frame is now relative to another parent). A move
-  // between parents attaches before it detaches, so the new parent is known only at the removal.
-  const auto reparented = [this](vsd::Node&, vsd::Node& child) {
-    if (!relations_.empty()) on_moved(child);
-  };
-  connections_.push_back(state.on_child_added().connect(reparented));
-  connections_.push_back(state.on_child_removed().connect(reparented));
-  connections_.push_back(
-      state.index().on_deleted(Node3D::static_meta(), true).connect([this](SimStateInstance& i) {
-        if (!relations_.empty()) drop(static_cast<vsd::Node&>(i));
-      }));
+SpatialView::SpatialView(SimState& state)
+    : state_(state),
+      watch_(state, [this](SimStateInstance& inst, const MetaProperty* p, Changes what) { heard(inst, p, what); }) {
+  // Node3D frames (what moves carried objects) and extensions (a Support attached or detached), any
+  // property of a Support, Supports and Node3Ds deleted, and nodes that change parent (a re-parented
+  // node may have moved in the world: its frame is now relative to another parent; a move between
+  // parents attaches before it detaches, so the new parent is known only at the removal).
+  watch_.properties(Node3D::static_meta(), {&Node3D::vsd_prop_frame(), &vsd::NamedModelInstance::vsd_prop_extensions()})
+      .all_properties(Support::static_meta())
+      .deleted(Support::static_meta())
+      .deleted(Node3D::static_meta())
+      .reparented(vsd::Node::static_meta());
   // What the SimState holds already (a loaded file, a copied replica). Supports carried by others are put
   // in force after theirs (by id, as a file or a replica orders them), which keeps the cycle check exact.
   std::vector<Support*> sups = state.index().all<Support>();
@@ -68,6 +46,23 @@ SpatialView::SpatialView(SimState& state) : state_(state) {
 }
 
 SpatialView::~SpatialView() = default;
+
+void SpatialView::heard(SimStateInstance& inst, const MetaProperty* p, Changes what) {
+  if (auto* sup = inst.as<Support>()) {
+    if (auto* owner = sup->owner())
+      if (auto* object = owner->as<Node3D>()) rescan(*object, what.has(Changes::deleted) ? sup : nullptr);
+    return;
+  }
+  if (what.has(Changes::deleted)) {
+    if (!relations_.empty()) drop(static_cast<vsd::Node&>(inst));
+  } else if (what.has(Changes::parent)) {
+    if (!relations_.empty()) on_moved(static_cast<vsd::Node&>(inst));
+  } else if (p == &vsd::NamedModelInstance::vsd_prop_extensions()) {
+    rescan(static_cast<Node3D&>(inst));
+  } else if (!relations_.empty()) {  // the frame
+    on_moved(static_cast<vsd::Node&>(inst));
+  }
+}
 
 std::string SpatialView::refusal(const Node3D& object, const Node3D& support) const {
   if (&object == &support) return name_of(object) + " cannot be its own support";

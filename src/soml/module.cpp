@@ -29,7 +29,7 @@ void Module::attach(vsd::Environment& env) {
       [this](const StepInfo&) {
         for (auto& p : programs_) p->run_until_quiet(step_limit);
       },
-      40);
+      Phase::nets);
   has_task_ = true;
 }
 

@@ -736,5 +736,50 @@ TEST_F(CollisionTest, ModuleKeepsOneWorldPerStateAndUpdatesItOnTheSchedulersStep
   EXPECT_EQ(begun, 1);
 }
 
+// Every state has its world: a replica answers queries and sees the contacts of the moves it is sent;
+// the scheduler's update runs on the stepped states only; worlds go with their states, in any order.
+TEST_F(CollisionTest, AReplicaHasItsOwnWorldAndTheTaskUpdatesSteppedStatesOnly) {
+  Environment env2;
+  auto& m = env2.use<Module>(0.01);
+  SimState& main = env2.main_state();
+  auto& g = main.create<Geometry>();
+  g.set_kind(GeometryKind::Sphere);
+  g.set_radius(0.5);
+  main.database().add_child(main.create<vsd::Node>());  // a plain node: no world needs it
+  std::vector<Hull*> hulls;
+  for (int i = 0; i < 2; ++i) {
+    auto& h = main.create<Hull>();
+    h.set_role(HullRole::Collision);
+    h.set_geometry(&g);
+    h.set_frame(at(3.0 * i));
+    main.database().add_child(h);
+    hulls.push_back(&h);
+  }
+  SimState& replica = env2.create_state("replica");
+  replica.copy_from(main);
+  EXPECT_EQ(env2.service(m, replica), Service::derived);
+  int main_begun = 0, replica_begun = 0;
+  auto c1 = m.world(main).on_contact_begin().connect([&](Hull&, Hull&) { ++main_begun; });
+  auto c2 = m.world(replica).on_contact_begin().connect([&](Hull&, Hull&) { ++replica_begun; });
+  main.start_recording();
+  hulls[1]->set_frame(at(0.8));
+  replica.apply(main.stop_recording());
+  env2.step();
+  EXPECT_EQ(main_begun, 1);
+  EXPECT_EQ(replica_begun, 0) << "a derived state's contacts are not computed by the task";
+  auto* r0 = replica.find<Hull>(hulls[0]->id());
+  auto* r1 = replica.find<Hull>(hulls[1]->id());
+  EXPECT_NEAR(m.world(replica).distance(*r0, *r1).distance, -0.2, 1e-9) << "queries answer on the replica";
+  env2.set_service<Module>(replica, Service::stepped);
+  env2.step();
+  EXPECT_EQ(replica_begun, 1);
+  SimState& late = env2.create_state("late");
+  late.copy_from(replica);
+  env2.remove_state(replica);
+  EXPECT_EQ(m.world(late).contacts().size(), 0u);
+  m.world(late).update();
+  EXPECT_EQ(m.world(late).contacts().size(), 1u);
+}
+
 }  // namespace
 }  // namespace vsd::collision

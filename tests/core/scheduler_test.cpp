@@ -26,17 +26,49 @@ TEST(Scheduler, RunsPeriodicTasksAtTheirRate) {
   EXPECT_EQ(s.steps(), 20u);
 }
 
-TEST(Scheduler, LowerPriorityRunsFirstThenInsertionOrder) {
+TEST(Scheduler, PhasesRunInOrderThenOrderNumberThenInsertionOrder) {
   vsd::Scheduler s;
   std::vector<std::string> order;
-  s.add_periodic(
-      "physics", 0.01, [&](const vsd::StepInfo&) { order.push_back("physics"); }, 10);
-  s.add_periodic(
-      "kinematics", 0.01, [&](const vsd::StepInfo&) { order.push_back("kinematics"); }, 0);
-  s.add_periodic(
-      "sensors", 0.01, [&](const vsd::StepInfo&) { order.push_back("sensors"); }, 10);
+  auto log = [&](const char* name) { return [&order, name](const vsd::StepInfo&) { order.push_back(name); }; };
+  s.add_periodic("sensors", 0.01, log("sensors"), vsd::Phase::sensors);
+  s.add_periodic("physics", 0.01, log("physics"), vsd::Phase::dynamics);
+  s.add_periodic("late physics", 0.01, log("late physics"), vsd::Phase::dynamics, 5);
+  s.add_periodic("early physics", 0.01, log("early physics"), vsd::Phase::dynamics, -5);
+  s.add_periodic("more physics", 0.01, log("more physics"), vsd::Phase::dynamics);
+  s.add_periodic("control", 0.01, log("control"), vsd::Phase::controllers);
+  s.add_periodic("input", 0.01, log("input"), vsd::Phase::inputs);
   s.step();
-  EXPECT_THAT(order, ElementsAre("kinematics", "physics", "sensors"));
+  EXPECT_THAT(order, ElementsAre("input", "control", "early physics", "physics", "more physics", "late physics",
+                                 "sensors"));
+  EXPECT_EQ(s.task_phase(1), vsd::Phase::sensors);
+  EXPECT_STREQ(vsd::phase_name(vsd::Phase::nets), "nets");
+}
+
+TEST(Scheduler, EventDrivenTasksRunByPhaseAfterThePeriodicOnes) {
+  vsd::Scheduler s;
+  std::vector<std::string> order;
+  const auto net = s.add_event_driven("net", [&](const vsd::StepInfo&) { order.push_back("net"); });
+  const auto ui = s.add_event_driven("ui", [&](const vsd::StepInfo&) { order.push_back("ui"); }, vsd::Phase::outputs);
+  s.add_periodic("plant", 0.01, [&](const vsd::StepInfo&) {
+    order.push_back("plant");
+    s.trigger(ui);
+    s.trigger(net);
+  }, vsd::Phase::dynamics);
+  s.step();
+  EXPECT_THAT(order, ElementsAre("plant", "net", "ui"));
+}
+
+TEST(Scheduler, RunForRefusesTimesItCannotStep) {
+  vsd::Scheduler s(0.001);
+  EXPECT_THROW(s.run_for(-1.0), vsd::Error);
+  EXPECT_THROW(s.run_for(std::numeric_limits<double>::quiet_NaN()), vsd::Error);
+  EXPECT_THROW(s.run_for(std::numeric_limits<double>::infinity()), vsd::Error);
+  EXPECT_THROW(s.run_for(1e17), vsd::Error);  // 1e20 steps: not countable, refused instead of looping
+  EXPECT_THROW(s.set_base_step(std::numeric_limits<double>::infinity()), vsd::Error);
+  EXPECT_THROW(s.add_periodic("p", std::numeric_limits<double>::infinity(), [](const vsd::StepInfo&) {}),
+               vsd::Error);
+  s.run_for(0.0105);
+  EXPECT_EQ(s.steps(), 11U);
 }
 
 TEST(Scheduler, EventDrivenTasksRunOnSignalsWithinTheStep) {

@@ -130,9 +130,9 @@ TEST_F(SimStateTest, DisconnectingStopsNotificationAndTheFastPathReturns) {
 TEST_F(SimStateTest, ListenersConnectedThroughAKeptSignalAreCalled) {
   auto& r = state.create<TRobot>();
   auto& other = state.create<TRobot>();
-  vsd::PropertySignal& own = r.on_changed();
-  vsd::PropertySignal& all = state.on_property_changed();
-  vsd::PropertySignal& robots = state.on_property_changed(TRobot::static_meta());
+  auto own = r.on_changed();
+  auto all = state.on_property_changed();
+  auto robots = state.on_property_changed(TRobot::static_meta());
   int first = 0;
   {
     auto c = own.connect([&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++first; });
@@ -236,6 +236,52 @@ TEST_F(SimStateTest, CopyFromNeedsAnEmptyState) {
   auto& a = env.create_state("a");
   state.create<vsd::Node>();
   EXPECT_THAT([&] { state.copy_from(a); }, testing::ThrowsMessage<vsd::Error>(HasSubstr("empty")));
+}
+
+// Derived changes: a module derives `axes` from `speed` (as robotics derives a link frame from its joint
+// value). The bundle carries the cause only; a state with the same module derives the rest itself, and
+// what listeners do in reaction to a derived change is recorded as usual.
+struct Deriver {
+  explicit Deriver(vsd::SimState& s) {
+    derive = s.on_property_changed(TRobot::static_meta()).connect([&s](vsd::SimStateInstance& i, const vsd::MetaProperty& p) {
+      if (&p != &TRobot::vsd_prop_speed()) return;
+      vsd::SimState::Deriving scope(s);
+      static_cast<TRobot&>(i).set_axes(static_cast<int>(static_cast<TRobot&>(i).speed() * 2));
+    });
+    react = s.on_property_changed(TRobot::static_meta()).connect([](vsd::SimStateInstance& i, const vsd::MetaProperty& p) {
+      if (&p == &TRobot::vsd_prop_axes()) static_cast<TRobot&>(i).set_joints(std::vector<double>(static_cast<std::size_t>(static_cast<TRobot&>(i).axes()), 0.5));
+    });
+  }
+  vsd::Connection derive, react;
+};
+
+TEST_F(SimStateTest, DerivedChangesAreSignalledButNotRecorded) {
+  auto& r = state.create<TRobot>();
+  auto& replica = env.create_state("replica");
+  replica.copy_from(state);
+  Deriver here(state), there(replica);
+  state.start_recording();
+  r.set_speed(3.5);
+  EXPECT_EQ(r.axes(), 7);
+  EXPECT_EQ(r.joints().size(), 7u);
+  const vsd::Transaction t = state.stop_recording();
+  ASSERT_EQ(t.size(), 2u) << "the speed and the reaction to the derived axes; not the axes themselves";
+  EXPECT_THAT(t.describe(), testing::Not(HasSubstr(".axes")));
+  replica.apply(t);
+  std::string diff;
+  EXPECT_TRUE(replica.equals(state, &diff)) << diff;
+}
+
+TEST_F(SimStateTest, RollingBackReDerives) {
+  auto& r = state.create<TRobot>();
+  Deriver d(state);
+  r.set_speed(2.0);
+  const auto sp = state.savepoint();
+  r.set_speed(5.0);
+  EXPECT_EQ(r.axes(), 10);
+  state.roll_back(sp);
+  EXPECT_EQ(r.speed(), 2.0);
+  EXPECT_EQ(r.axes(), 4) << "the undone speed derives the axes again";
 }
 
 }  // namespace

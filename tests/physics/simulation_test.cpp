@@ -538,5 +538,38 @@ TEST_F(SimulationTest, SecondAxisLimitsAndMotorsAreCheckedAndNameTheJoint) {
   EXPECT_EQ(sim().stats().joints, 1u);
 }
 
+// Physics runs where it is asked to: the main state by default; a replica only shows what it is sent; a
+// what-if copy simulates once it is stepped, on its own, and states come and go in any order.
+TEST_F(SimulationTest, OnlySteppedStatesAreSimulatedEachOnItsOwn) {
+  auto& box = hull(geometry(GeometryKind::Box, Eigen::Vector3d(1, 1, 1)), at(0, 0, 10));
+  body(box);
+  Module& m = *env.module<Module>();
+  SimState& replica = env.create_state("replica");
+  replica.copy_from(s);
+  SimState& what_if = env.create_state("what-if");
+  what_if.copy_from(s);
+  EXPECT_EQ(env.service(m, replica), Service::none);
+  EXPECT_THROW((void)m.simulation(replica), vsd::Error);
+  env.set_service(m, what_if, Service::stepped);
+  auto* w_box = what_if.find<scene::Hull>(box.id());
+  auto* w_body = w_box->find_extension<RigidBody>();
+  w_body->set_linear_velocity(Eigen::Vector3d(0, 0, 20));  // the copy throws the box up
+  s.start_recording();
+  env.run_for(0.1);
+  replica.apply(s.stop_recording());
+  std::string diff;
+  EXPECT_TRUE(replica.equals(s, &diff)) << diff;
+  EXPECT_LT(box.frame().translation().z(), 10.0);
+  EXPECT_GT(w_box->frame().translation().z(), 10.0) << "the copy simulated its own throw";
+  EXPECT_EQ(m.simulation(what_if).stats().bodies, 1u);
+  env.remove_state(replica);
+  env.set_service(m, what_if, Service::none);
+  const double z = w_box->frame().translation().z();
+  env.run_for(0.05);
+  EXPECT_EQ(w_box->frame().translation().z(), z) << "no longer simulated";
+  env.remove_state(what_if);
+  env.run_for(0.05);
+}
+
 }  // namespace
 }  // namespace vsd::physics::test

@@ -58,11 +58,12 @@ TEST(Kinematics, JointValueMovesLinkFramesAndSignalsFire) {
   EXPECT_EQ(frame_signals, 1);
   EXPECT_TRUE(l2.frame().isApprox(j2->origin() * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ())));
   EXPECT_GT((ee.world_frame().translation() - ee_before).norm(), 0.3);
-  // The URDF joint's position follows, and the other way round.
-  EXPECT_EQ(r.report.scene->find_joint("iiwa_joint_2")->position(), 0.5);
+  // One owner of the value: the URDF description's joint keeps the value it started with, and setting
+  // it moves nothing.
+  EXPECT_EQ(r.report.scene->find_joint("iiwa_joint_2")->position(), 0.0);
   r.report.scene->find_joint("iiwa_joint_2")->set_position(-0.25);
-  EXPECT_EQ(j2->position(), -0.25);
-  EXPECT_EQ(frame_signals, 2);
+  EXPECT_EQ(j2->position(), 0.5);
+  EXPECT_EQ(frame_signals, 1);
   // Through the generic path as well.
   j2->set("position", Value(0.0));
   EXPECT_TRUE(ee.world_frame().translation().isApprox(ee_before, 1e-12));
@@ -229,6 +230,69 @@ TEST(Kinematics, SceneJointWithoutChildIsAnError) {
   }
   auto& orphan = s.create<KinematicTree>();
   EXPECT_THROW((void)orphan.model(), vsd::Error);
+}
+
+// One owner of a joint's value: a joint set records the joint value only. The link frame and a mimic
+// follower's value are derived, and a replica (served by the module by default) derives them itself.
+TEST(Kinematics, AJointSetRecordsOnlyTheJointValue) {
+  Robot r("iiwa14.urdf");
+  SimState& main = r.env.main_state();
+  KinematicJoint& j1 = *r.tree->find_joint("iiwa_joint_1");
+  KinematicJoint& j3 = *r.tree->find_joint("iiwa_joint_3");
+  j3.set_mimic(&j1);
+  j3.set_mimic_multiplier(-0.5);
+  SimState& replica = r.env.create_state("replica");
+  replica.copy_from(main);
+  main.start_recording();
+  j1.set_position(0.8);
+  EXPECT_DOUBLE_EQ(j3.position(), -0.4);
+  const Transaction t = main.stop_recording();
+  EXPECT_EQ(t.size(), 1u) << t.describe();
+  EXPECT_EQ(t.describe().find("frame"), std::string::npos) << t.describe();
+  replica.apply(t);
+  std::string diff;
+  EXPECT_TRUE(replica.equals(main, &diff)) << diff;
+  auto* rj3 = replica.find<KinematicJoint>(j3.id());
+  EXPECT_DOUBLE_EQ(rj3->position(), -0.4);
+  auto* rl3 = static_cast<scene::Node3D*>(rj3->owner());
+  EXPECT_TRUE(rl3->world_frame().isApprox(r.link("iiwa_link_3").world_frame(), 1e-15));
+}
+
+TEST(Kinematics, UndoAndRollBackReDeriveTheLinkFrames) {
+  Robot r("iiwa14.urdf");
+  SimState& main = r.env.main_state();
+  KinematicJoint& j2 = *r.tree->find_joint("iiwa_joint_2");
+  const Eigen::Isometry3d before = r.link("iiwa_link_7").world_frame();
+  main.start_recording();
+  j2.set_position(0.9);
+  const Transaction t = main.stop_recording();
+  EXPECT_FALSE(r.link("iiwa_link_7").world_frame().isApprox(before, 1e-6));
+  main.apply(t.inverted());
+  EXPECT_DOUBLE_EQ(j2.position(), 0.0);
+  EXPECT_TRUE(r.link("iiwa_link_7").world_frame().isApprox(before, 1e-15));
+  const auto sp = main.savepoint();
+  j2.set_position(-0.7);
+  main.roll_back(sp);
+  EXPECT_TRUE(r.link("iiwa_link_7").world_frame().isApprox(before, 1e-15));
+}
+
+TEST(Kinematics, ControllersStepOnlyTheStatesServedStepped) {
+  Robot r("iiwa14.urdf");
+  SimState& main = r.env.main_state();
+  auto& c = main.create<JointController>();
+  r.report.scene->add_extension(c);
+  c.set_target(std::vector<double>(7, 0.3));
+  c.set_mode(ControlMode::Position);
+  SimState& copy = r.env.create_state("what-if");
+  copy.copy_from(main);
+  r.env.run_for(0.5);
+  const double moved = r.tree->find_joint("iiwa_joint_1")->position();
+  EXPECT_GT(moved, 0.0);
+  auto* copy_j1 = copy.find<KinematicJoint>(r.tree->find_joint("iiwa_joint_1")->id());
+  EXPECT_DOUBLE_EQ(copy_j1->position(), 0.0) << "a derived state is not stepped";
+  r.env.set_service<Module>(copy, Service::stepped);
+  r.env.run_for(0.5);
+  EXPECT_GT(copy_j1->position(), 0.0) << "the what-if copy is simulated once it is stepped";
 }
 
 }  // namespace

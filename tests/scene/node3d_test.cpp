@@ -260,5 +260,44 @@ TEST_F(Node3DTest, ReplicaKeepsItsWorldFramesCurrent) {
   EXPECT_TRUE(r5->world_frame().isApprox(expected_world(*r5), 1e-12));
 }
 
+// Every state of the environment keeps its world frames, whenever and however it was made, and states
+// come and go in any order (run under ASan in CI).
+TEST_F(Node3DTest, StatesMadeCopiedAndRemovedInAnyOrderKeepTheirWorldFrames) {
+  Chain c(s, 4);
+  SimState& a = env.create_state("a");
+  a.copy_from(s);
+  SimState& b = env.create_state("b");
+  b.copy_from(a);
+  auto* b3 = b.find(c.nodes[3]->id())->as<Node3D>();
+  EXPECT_TRUE(b3->world_frame().isApprox(c.nodes[3]->world_frame(), 1e-12));  // clean caches in b
+  s.start_recording();
+  c.nodes[0]->set_frame(step(2, 0.3));
+  const Transaction t = s.stop_recording();
+  env.remove_state(a);  // the older copy goes first, while b has clean caches
+  b.apply(t);
+  EXPECT_FALSE(b3->world_frame_clean()) << "b's own watch heard the applied bundle";
+  EXPECT_TRUE(b3->world_frame().isApprox(c.nodes[3]->world_frame(), 1e-12));
+  SimState& late = env.create_state("late");
+  late.copy_from(b);
+  env.remove_state(b);
+  auto* l3 = late.find(c.nodes[3]->id())->as<Node3D>();
+  EXPECT_TRUE(l3->world_frame().isApprox(c.nodes[3]->world_frame(), 1e-12));
+  late.find(c.nodes[1]->id())->as<Node3D>()->set_frame(step(-3, 1.0));
+  EXPECT_TRUE(l3->world_frame().isApprox(expected_world(*l3), 1e-12));
+}
+
+TEST_F(Node3DTest, WithoutTheModulesServiceCachesAreForgottenAndRebuiltOnRead) {
+  Chain c(s, 3);
+  Node3D& leaf = *c.nodes[2];
+  (void)leaf.world_frame();
+  EXPECT_TRUE(leaf.world_frame_clean());
+  env.set_service<Module>(s, Service::none);
+  EXPECT_FALSE(leaf.world_frame_clean()) << "no watch: no cache can be trusted";
+  c.nodes[0]->set_frame(step(4, 0.2));
+  EXPECT_TRUE(leaf.world_frame().isApprox(expected_world(leaf), 1e-12)) << "a read makes the watch again";
+  c.nodes[0]->set_frame(step(5, 0.1));
+  EXPECT_TRUE(leaf.world_frame().isApprox(expected_world(leaf), 1e-12));
+}
+
 }  // namespace
 }  // namespace vsd::scene

@@ -102,6 +102,7 @@ struct Options {
 class CollisionWorld {
  public:
   using PairSignal = Signal<void(scene::Hull& a, scene::Hull& b)>;
+  using PairSink = Sink<void(scene::Hull& a, scene::Hull& b)>;
 
   /// @brief A world over the hulls of @p state chosen by @p options, filled at once.
   /// @throws vsd::Error when options.root belongs to another SimState.
@@ -136,10 +137,10 @@ class CollisionWorld {
                                  double max_distance = std::numeric_limits<double>::infinity());
 
   /// @brief Emitted by update() for each pair that started touching (a has the smaller id).
-  PairSignal& on_contact_begin() noexcept;
+  [[nodiscard]] PairSink on_contact_begin() noexcept;
   /// @brief Emitted by update() for each pair that stopped touching, and at once for the pairs of a
   /// hull that is being deleted (while it is still whole).
-  PairSignal& on_contact_end() noexcept;
+  [[nodiscard]] PairSink on_contact_end() noexcept;
 
   /// @brief Number of hulls in the world (degenerate ones included).
   [[nodiscard]] std::size_t size() const noexcept;

@@ -1,10 +1,15 @@
 /** @file
- *  @brief vsd::collision::Module: uses vsd::scene and keeps one CollisionWorld per SimState on demand,
- *  optionally updated by the Scheduler at a fixed step.
+ *  @brief vsd::collision::Module: uses vsd::scene and keeps one CollisionWorld per SimState (in the
+ *  state's context, made on first use), optionally updated by the Scheduler at a fixed step.
+ *
+ *  Services: every state may have a world for queries (`derived`, the default for all states but the
+ *  main one: a replica answers distance and ray queries); the update task computes contacts and emits
+ *  their begin/end signals for the states served `stepped` (by default the main state). `none` drops the
+ *  state's world.
  *
  *  @code
  *  vsd::Environment env;
- *  auto& collision = env.use<vsd::collision::Module>(0.01);   // update the main state's world every 10 ms
+ *  auto& collision = env.use<vsd::collision::Module>(0.01);   // update the stepped states every 10 ms
  *  auto c = collision.world(env.main_state()).on_contact_begin().connect(...);
  *  @endcode
  */
@@ -12,7 +17,6 @@
 
 #include <memory>
 #include <string_view>
-#include <unordered_map>
 
 #include "vsd/collision/collision_world.hpp"
 #include "vsd/core/module.hpp"
@@ -21,7 +25,7 @@ namespace vsd::collision {
 
 class Module : public vsd::Module {
  public:
-  /// @brief A module whose main-state world the Scheduler updates every @p period seconds (never
+  /// @brief A module whose stepped states' worlds the Scheduler updates every @p period seconds (never
   /// when @p period is 0: the program calls CollisionWorld::update() itself).
   explicit Module(double period = 0) : period_(period) {}
   ~Module() override;
@@ -29,16 +33,20 @@ class Module : public vsd::Module {
   [[nodiscard]] std::string_view name() const override { return "collision"; }
   /// @brief Uses vsd::scene (whose classes the world reads) and adds the periodic update task.
   void attach(vsd::Environment& env) override;
-  /// @brief Drops every world (before the SimStates go).
+  /// @brief Removes the update task.
   void detach(vsd::Environment& env) override;
+  /// @brief Drops the state's world when its service becomes none.
+  void serve(SimState& state, Service from, Service to) override;
 
-  /// @brief The world over all collision hulls of @p state, made on first use with @p options (later
-  /// calls return the same world and ignore @p options).
+  /// @brief The world over all collision hulls of @p state (kept in the state's context, so it dies with
+  /// the state), made on first use with @p options (later calls return the same world and ignore
+  /// @p options).
   CollisionWorld& world(SimState& state, const Options& options = {});
 
  private:
   double period_;
-  std::unordered_map<const SimState*, std::unique_ptr<CollisionWorld>> worlds_;
+  std::uint32_t task_ = 0;
+  vsd::Environment* env_ = nullptr;
 };
 
 }  // namespace vsd::collision

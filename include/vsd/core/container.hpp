@@ -24,6 +24,7 @@ class SimState;
 class Container {
  public:
   using NodeSignal = Signal<void(Node&)>;
+  using NodeSink = Sink<void(Node&)>;
 
   Container() = default;
   Container(const Container&) = delete;
@@ -37,9 +38,9 @@ class Container {
   virtual void for_each(const std::function<void(Node&)>& fn) const = 0;
 
   /// @brief Emitted when a node enters the container.
-  NodeSignal& on_added() noexcept { return added_; }
+  [[nodiscard]] NodeSink on_added() noexcept { return NodeSink(added_); }
   /// @brief Emitted when a node leaves the container (while it is still whole).
-  NodeSignal& on_removed() noexcept { return removed_; }
+  [[nodiscard]] NodeSink on_removed() noexcept { return NodeSink(removed_); }
 
  protected:
   NodeSignal added_;

@@ -17,6 +17,7 @@ namespace vsd {
 class ElementIndex {
  public:
   using InstanceSignal = Signal<void(SimStateInstance&)>;
+  using InstanceSink = Sink<void(SimStateInstance&)>;
 
   /// @brief Instances of exactly class @p m (no subclasses), in no particular order.
   [[nodiscard]] std::span<SimStateInstance* const> exact(const MetaInstance& m) const noexcept;
@@ -45,9 +46,9 @@ class ElementIndex {
   }
 
   /// @brief Emitted when an instance of @p m (or, with @p include_subtypes, of a subclass) is created.
-  InstanceSignal& on_created(const MetaInstance& m, bool include_subtypes = true);
+  [[nodiscard]] InstanceSink on_created(const MetaInstance& m, bool include_subtypes = true);
   /// @brief Emitted when an instance of @p m (or a subclass) is about to be deleted.
-  InstanceSignal& on_deleted(const MetaInstance& m, bool include_subtypes = true);
+  [[nodiscard]] InstanceSink on_deleted(const MetaInstance& m, bool include_subtypes = true);
 
  private:
   friend class SimState;
@@ -75,7 +76,8 @@ class ElementIndex {
     auto& items = bucket(m).items;
     items.reserve(items.size() + count);
   }
-  std::vector<InstanceSignal*> listeners(const SimStateInstance& i, bool created);
+  template <class F>
+  void for_each_listener(const SimStateInstance& i, bool created, F&& fn);
   void emit_created(SimStateInstance& i);
   void emit_deleted(SimStateInstance& i);
 

@@ -34,11 +34,30 @@ class Environment : public Instance {
   [[nodiscard]] Registry& registry() const noexcept { return *registry_; }
   [[nodiscard]] std::uint16_t site() const noexcept { return site_; }
   /// @brief The first SimState, made with the environment.
-  [[nodiscard]] SimState& main_state() const noexcept { return *states_.front(); }
-  /// @brief Makes another SimState (for a loader thread, a replica, a what-if copy, ...).
+  [[nodiscard]] SimState& main_state() const noexcept { return *states_.front().state; }
+  /// @brief Makes another SimState (for a loader thread, a replica, a what-if copy, ...). Every module
+  /// in use starts to serve it at its default service (Module::default_service: `derived` for all but
+  /// the main state), before this returns. @throws what a module's serve() throws (nothing is left).
   SimState& create_state(std::string name);
-  /// @brief Deletes a SimState other than the main one.
+  /// @brief Deletes a SimState other than the main one (the modules stop serving it first).
   void remove_state(SimState& state);
+
+  /// @brief Changes what module @p module does for @p state (see Service). @throws vsd::Error when the
+  /// module is not used by this environment or the state is not one of its states, and what the
+  /// module's serve() throws (the service then stays as it was).
+  void set_service(Module& module, SimState& state, Service service);
+  /// @brief The same for module M. @throws vsd::Error when M is not used.
+  template <class M>
+  void set_service(SimState& state, Service service) {
+    set_service(static_cast<Module&>(required_module(typeid(M))), state, service);
+  }
+  /// @brief The same for every module in use, in the order they were used (none: in reverse).
+  void set_service(SimState& state, Service service);
+  /// @brief What @p module does for @p state (none for a module not in use).
+  [[nodiscard]] Service service(const Module& module, const SimState& state) const noexcept;
+  /// @brief The states that @p module serves at @p level or more, main state first, then in the order
+  /// they were made. A module's scheduler task steps `states_served(*this, Service::stepped)`.
+  [[nodiscard]] std::vector<SimState*> states_served(const Module& module, Service level) const;
   [[nodiscard]] std::vector<SimState*> states() const;
   /// @brief A fresh id, unique in this environment. Thread-safe.
   [[nodiscard]] Id next_id() noexcept;
@@ -81,14 +100,22 @@ class Environment : public Instance {
   VSD_METHOD(run_for)
 
  private:
+  struct StateEntry {
+    std::unique_ptr<SimState> state;
+    std::vector<Service> services;  // per module, in the order of modules_
+  };
   Module* find_module(std::type_index t) const noexcept;
+  Module& required_module(std::type_index t) const;
   void add_module(std::type_index t, std::unique_ptr<Module> m);
+  std::size_t module_position(const Module& m) const;
+  StateEntry& entry_of(const SimState& s);
+  void change_service(std::size_t module, StateEntry& entry, Service to);
 
   Registry* registry_;
   std::uint16_t site_;
   std::atomic<std::uint64_t> next_id_{2};  // 1 is every SimState's Database
   std::atomic<std::uint64_t> id_generation_{0};
-  std::vector<std::unique_ptr<SimState>> states_;
+  std::vector<StateEntry> states_;
   std::vector<std::pair<std::type_index, std::unique_ptr<Module>>> modules_;
   Scheduler scheduler_;
 };

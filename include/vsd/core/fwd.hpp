@@ -30,8 +30,14 @@ class Environment;
 class Module;
 class Scheduler;
 class Connection;
+class StateContext;
+class Watch;
+enum class Service : std::uint8_t;
+enum class Phase : int;
 template <class Signature>
 class Signal;
+template <class Signature>
+class Sink;
 template <class T>
 class Ref;
 template <class T>

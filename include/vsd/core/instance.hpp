@@ -133,8 +133,12 @@ class SimStateInstance : public Instance {
   /// deletes the element.
   void list_erase(const MetaProperty& p, std::size_t index);
 
-  /// @brief Signal emitted when any property of this instance changes.
-  PropertySignal& on_changed();
+  /// @brief True while a change of this instance is observed: someone listens to it (itself, its class,
+  /// its state) or its state records. Otherwise a typed set is a compare and a store. (The flag is
+  /// switched off lazily: the first change that finds nobody interested clears it.)
+  [[nodiscard]] bool observed() const noexcept { return watch_ != 0; }
+  /// @brief Listeners of every property change of this instance.
+  [[nodiscard]] Sink<void(SimStateInstance&, const MetaProperty&)> on_changed();
 
  protected:
   SimStateInstance() noexcept = default;
@@ -160,7 +164,8 @@ class SimStateInstance : public Instance {
   static constexpr std::uint8_t dying_bit = 1;
   static constexpr std::uint8_t floating_bit = 2;  // never held compositely by a property yet
   static constexpr std::uint8_t own_watch = 1;     // this instance has listeners
-  static constexpr std::uint8_t state_watch = 2;   // its SimState records or has listeners
+  static constexpr std::uint8_t state_watch = 2;   // its SimState records or has state-wide listeners
+  static constexpr std::uint8_t class_watch = 4;   // its class (or a base) has per-class listeners
 
   template <class T>
   void assign_at(T& field, const T& v, const MetaProperty& p) {

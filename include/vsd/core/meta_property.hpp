@@ -42,6 +42,9 @@ class MetaProperty {
   [[nodiscard]] bool has(PropertyFlags f) const noexcept { return flags_.has(f); }
   /// @brief The class that declares the property.
   [[nodiscard]] const MetaInstance& owner() const noexcept { return *owner_; }
+  /// @brief Position of the property in the property list of its class (MetaInstance::properties()),
+  /// inherited properties first: the same position in every subclass.
+  [[nodiscard]] std::size_t index() const noexcept { return index_; }
   /// @brief Byte offset of the value from the start of the instance.
   [[nodiscard]] std::size_t offset() const noexcept { return offset_; }
   /// @brief The value a new instance starts with.

@@ -7,6 +7,9 @@
  *  is blanked at once and swept away when the outermost emit returns; a slot connected during an emit
  *  waits aside and is first called by the next emit.
  *
+ *  Whoever owns a signal emits it; everybody else gets a Sink, which can connect but not emit
+ *  (`state.on_deleted()` returns one), so no listener can fake an event of the database.
+ *
  *  Lifetime: a Connection may outlive its Signal (disconnecting then does nothing) and a Signal may be
  *  destroyed from inside one of its own listeners. Signals and connections belong to one thread at a
  *  time, like the SimState they live in.
@@ -241,6 +244,36 @@ class Signal<void(Args...)> {
 
   detail::SignalCore* core_ = nullptr;
   void* live_ = nullptr;  // == core_ while at least one listener is connected
+};
+
+/// @brief The connecting side of a Signal: what an owner hands out so that others can listen but not emit
+/// (EnTT's sink). A Sink is a small handle; it must not outlive its signal.
+template <class Signature>
+class Sink;
+
+template <class... Args>
+class Sink<void(Args...)> {
+ public:
+  using SignalType = Signal<void(Args...)>;
+  explicit Sink(SignalType& signal) noexcept : signal_(&signal) {}
+
+  /// @brief Connects any callable (lambda, function object, function pointer); see Signal::connect.
+  template <class F>
+  Connection connect(F&& f) const {
+    return signal_->connect(std::forward<F>(f));
+  }
+  /// @brief Connects a member function of @p object without allocating: `sink.connect<&C::on_x>(obj)`.
+  template <auto Member, class C>
+  Connection connect(C& object) const {
+    return signal_->template connect<Member>(object);
+  }
+  /// @brief True when at least one listener is connected.
+  [[nodiscard]] bool has_listeners() const noexcept { return signal_->has_listeners(); }
+  /// @brief Number of connected listeners.
+  [[nodiscard]] std::size_t size() const noexcept { return signal_->size(); }
+
+ private:
+  SignalType* signal_;
 };
 
 }  // namespace vsd

@@ -30,6 +30,7 @@
 #include "vsd/core/detail/id_map.hpp"
 #include "vsd/core/detail/instance_pool.hpp"
 #include "vsd/core/element_index.hpp"
+#include "vsd/core/state_context.hpp"
 #include "vsd/core/transaction.hpp"
 
 namespace vsd {
@@ -46,6 +47,11 @@ class SimState : public Instance {
  public:
   using InstanceSignal = Signal<void(SimStateInstance&)>;
   using ChildSignal = Signal<void(Node& parent, Node& child)>;
+  using InstanceSink = Sink<void(SimStateInstance&)>;
+  using PropertySink = Sink<void(SimStateInstance&, const MetaProperty&)>;
+  using ChildSink = Sink<void(Node& parent, Node& child)>;
+  using ExtensionSignal = Signal<void(NamedModelInstance& owner, Extension& extension)>;
+  using ExtensionSink = Sink<void(NamedModelInstance& owner, Extension& extension)>;
 
   SimState(Environment& env, std::string name);
   ~SimState() override;
@@ -87,17 +93,33 @@ class SimState : public Instance {
   /// @brief All live instances, ordered by id.
   [[nodiscard]] std::vector<SimStateInstance*> instances() const;
 
-  // ---- signals ----
+  // ---- signals (sinks: anyone may listen, only the SimState emits) ----
   /// @brief Emitted after an instance is created and has its initial values.
-  InstanceSignal& on_created() noexcept { return created_; }
+  [[nodiscard]] InstanceSink on_created() noexcept { return InstanceSink(created_); }
   /// @brief Emitted when an instance starts being deleted, while it is still whole.
-  InstanceSignal& on_deleted() noexcept { return deleted_; }
-  /// @brief Emitted for every property change of every instance (reference lists included).
-  PropertySignal& on_property_changed();
-  /// @brief Emitted for property changes of instances of @p type (and subclasses, when asked).
-  PropertySignal& on_property_changed(const MetaInstance& type, bool include_subtypes = true);
-  ChildSignal& on_child_added() noexcept { return child_added_; }
-  ChildSignal& on_child_removed() noexcept { return child_removed_; }
+  [[nodiscard]] InstanceSink on_deleted() noexcept { return InstanceSink(deleted_); }
+  /// @brief Emitted for every property change of every instance (reference lists included). A listener
+  /// here sends every setter of the state down its slow path; prefer a per-class signal or a Watch.
+  [[nodiscard]] PropertySink on_property_changed() noexcept { return PropertySink(property_changed_); }
+  /// @brief Emitted for property changes of instances of @p type (and subclasses, when asked). Only the
+  /// setters of instances of those classes leave their fast path while the signal has listeners.
+  [[nodiscard]] PropertySink on_property_changed(const MetaInstance& type, bool include_subtypes = true);
+  [[nodiscard]] ChildSink on_child_added() noexcept { return ChildSink(child_added_); }
+  [[nodiscard]] ChildSink on_child_removed() noexcept { return ChildSink(child_removed_); }
+  /// @brief Emitted when an extension is attached to a node or another extension (its owner's
+  /// `extensions` list gains it), whether or not anybody watches the owner.
+  [[nodiscard]] ExtensionSink on_extension_added() noexcept { return ExtensionSink(extension_added_); }
+  /// @brief Emitted when an extension is detached from its owner (also when either is deleted).
+  [[nodiscard]] ExtensionSink on_extension_removed() noexcept { return ExtensionSink(extension_removed_); }
+
+  // ---- per-state data of modules ----
+  /// @brief Typed slots for data that belongs to this state alone (a module's collision world, ODE world,
+  /// compiled models, executors): created by the module when it starts to serve the state, destroyed
+  /// before the state's instances (see StateContext).
+  [[nodiscard]] StateContext& context() noexcept { return context_; }
+  [[nodiscard]] const StateContext& context() const noexcept { return context_; }
+  /// @brief True for the main state of its Environment.
+  [[nodiscard]] bool is_main() const noexcept { return main_; }
 
   // ---- transactions ----
   /// @brief Starts recording every change into a bundle (continues an ongoing recording).
@@ -130,6 +152,26 @@ class SimState : public Instance {
   /// not recorded, so they are not undone. @throws vsd::Error when the inverse does not apply (the
   /// state then records as before @p sp).
   void roll_back(const Savepoint& sp);
+  /// @brief Marks the changes that the code in its scope makes to the state as *derived*: they are
+  /// signalled like any change but not recorded, because every state derives them itself from what is
+  /// recorded (a link's frame from its joint value, a mimic joint's value from its master's). A bundle then
+  /// carries the cause once, and a replica or an undo re-derives the rest through the same module. What
+  /// listeners change in reaction to a derived change is recorded as usual (a box carried by a moving link
+  /// is a recorded move). Only property and list changes can be derived; creations and deletions are
+  /// always recorded. Scopes nest.
+  class Deriving {
+   public:
+    explicit Deriving(SimState& state) noexcept : state_(state), previous_(state.derive_depth_) {
+      state.derive_depth_ = state.dispatching_ + 1;  // the depth of the changes made right here
+    }
+    ~Deriving() { state_.derive_depth_ = previous_; }
+    Deriving(const Deriving&) = delete;
+    Deriving& operator=(const Deriving&) = delete;
+
+   private:
+    SimState& state_;
+    int previous_;
+  };
   /// @brief Applies a bundle. Everything is checked first (ids, classes, properties, values, list
   /// positions): a bundle that does not fit this state throws vsd::Error and changes nothing.
   void apply(const Transaction& t);
@@ -169,10 +211,17 @@ class SimState : public Instance {
   void enable_state_watch();
   static void watch_hook(void* state);
   bool state_watch_wanted() const noexcept;
+  struct TypeSignal;  // a per-class property signal and what its first listener switches on
+  void enable_class_watch(const MetaInstance& cls, bool subtypes);
+  bool class_watched(const MetaInstance& cls) noexcept;
+  [[nodiscard]] bool class_watched_slow(const MetaInstance& cls) const noexcept;
   void property_changed(SimStateInstance& inst, const MetaProperty& p, const void* old_value);
   void list_changed(SimStateInstance& holder, const MetaProperty& p, std::size_t index,
                     SimStateInstance& target, bool inserted);
   PropertySignal* type_signal(const MetaInstance& m, bool tree) const noexcept;
+  friend class Environment;
+  StateContext context_;  // cleared first thing in ~SimState, while every instance and signal is whole
+  bool main_ = false;
   void emit_property(SimStateInstance& inst, const MetaProperty& p);
   void free_graveyard() noexcept;
   struct Dispatch;
@@ -188,10 +237,14 @@ class SimState : public Instance {
   PropertySignal property_changed_;
   ChildSignal child_added_;
   ChildSignal child_removed_;
+  ExtensionSignal extension_added_;
+  ExtensionSignal extension_removed_;
   std::unordered_map<const SimStateInstance*, std::unique_ptr<PropertySignal>> instance_signals_;
-  std::vector<std::unique_ptr<PropertySignal>> type_exact_, type_tree_;
+  std::vector<std::unique_ptr<TypeSignal>> type_exact_, type_tree_;
+  std::vector<std::uint8_t> class_watch_;  // per class index: 0 not known yet, 1 unwatched, 2 watched
   std::vector<SimStateInstance*> graveyard_;  // deleted during a dispatch, freed when it ends
   int dispatching_ = 0;
+  int derive_depth_ = -1;  // dispatch depth of derived changes (see Deriving), -1 when none
   std::size_t type_signals_ = 0;
   std::vector<std::uint8_t> recorded_;
   std::size_t recorded_ops_ = 0;

@@ -13,6 +13,7 @@
  */
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string_view>
 #include <vector>
@@ -25,22 +26,24 @@ namespace vsd::dist {
 class Module : public vsd::Module {
  public:
   [[nodiscard]] std::string_view name() const override { return "dist"; }
-  /// @brief Adds the scheduler task "dist poll" (every base step, priority -1000: before the algorithms,
-  /// so they see the others' changes of the last step).
+  /// @brief Adds the scheduler task "dist poll" (every base step, phase inputs: before the algorithms,
+  /// so they see the others' changes of the last step). It polls every participant made by join(), on
+  /// whichever of the environment's states it was made.
   void attach(vsd::Environment& env) override;
-  /// @brief Leaves every domain (the participants are destroyed).
   void detach(vsd::Environment& env) override;
+  /// @brief A state's participants leave their domains when its service becomes none (when the state
+  /// is removed or the environment goes).
+  void serve(SimState& state, Service from, Service to) override;
 
   /// @brief Makes a participant for @p state (a SimState of this module's Environment) that the step
-  /// loop polls. @throws vsd::Error as Participant's constructor does.
+  /// loop polls. It lives in the state's context: it leaves its domain with the state.
+  /// @throws vsd::Error as Participant's constructor does, and when the module does not serve @p state.
   Participant& join(SimState& state, ParticipantOptions options);
-  /// @brief The participants made by join(), in order.
-  [[nodiscard]] const std::vector<std::unique_ptr<Participant>>& participants() const noexcept {
-    return participants_;
-  }
+  /// @brief The participants made by join() on every state, in the order of the states, then of joining.
+  [[nodiscard]] std::vector<Participant*> participants() const;
 
  private:
-  std::vector<std::unique_ptr<Participant>> participants_;
+  vsd::Environment* env_ = nullptr;
   std::uint32_t task_ = 0;
 };
 

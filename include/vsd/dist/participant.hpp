@@ -205,9 +205,9 @@ class Participant {
 
   /// @brief Emitted for every conflict this participant takes part in (writer, owner), and for conflicts
   /// it rejected as a receiver.
-  Signal<void(const Conflict&)>& on_conflict() noexcept;
+  [[nodiscard]] Sink<void(const Conflict&)> on_conflict() noexcept;
   /// @brief Emitted after a snapshot was installed (the first synchronisation and every resync).
-  Signal<void()>& on_synced() noexcept;
+  [[nodiscard]] Sink<void()> on_synced() noexcept;
   [[nodiscard]] const ParticipantStats& stats() const noexcept;
 
  private:

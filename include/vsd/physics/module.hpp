@@ -24,26 +24,34 @@ namespace vsd::physics {
 
 class Module : public vsd::Module {
  public:
-  /// @param priority the scheduler priority of the physics task (lower runs first).
-  explicit Module(int priority = 20) : priority_(priority) {}
+  /// @param phase the scheduler phase of the physics task.
+  explicit Module(vsd::Phase phase = vsd::Phase::dynamics) : phase_(phase) {}
   ~Module() override;
 
   [[nodiscard]] std::string_view name() const override { return "physics"; }
   /// @brief Registers RigidBody, World, Joint and their enums.
   void register_types(vsd::Registry& registry) override;
-  /// @brief Uses vsd::scene::Module, makes the Simulation of the main state and adds the task
-  /// "physics" that advances it by every scheduler step's dt.
+  /// @brief Uses vsd::scene::Module and adds the task "physics" that advances the Simulation of every
+  /// state served `stepped` by every scheduler step's dt.
   void attach(vsd::Environment& env) override;
   void detach(vsd::Environment& env) override;
+  /// @brief Physics runs only where it is asked to: `stepped` by default for the main state and `none`
+  /// for every other state (a replica shows the poses the simulating state sends; a what-if copy that
+  /// should simulate is switched to `stepped` with Environment::set_service). `stepped` makes the state's
+  /// Simulation (in the state's context), `none` drops it; `derived` keeps it without stepping it.
+  [[nodiscard]] vsd::Service default_service(const vsd::SimState& state) const override;
+  void serve(vsd::SimState& state, vsd::Service from, vsd::Service to) override;
 
-  /// @brief The simulation of the main state. @throws vsd::Error before attach().
+  /// @brief The simulation of the main state. @throws vsd::Error before attach() or when the main
+  /// state is not served.
   [[nodiscard]] Simulation& simulation() const;
+  /// @brief The simulation of @p state. @throws vsd::Error when the module does not serve it.
+  [[nodiscard]] Simulation& simulation(vsd::SimState& state) const;
 
  private:
-  int priority_;
-  std::unique_ptr<Simulation> simulation_;
+  vsd::Phase phase_;
   vsd::Environment* env_ = nullptr;
-  vsd::Scheduler::TaskId task_ = 0;
+  std::uint32_t task_ = 0;
 };
 
 }  // namespace vsd::physics

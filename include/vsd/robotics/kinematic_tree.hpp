@@ -56,10 +56,15 @@ class KinematicTree : public vsd::Extension {
   mutable std::uint64_t compilations_ = 0;
 };
 
-/// @brief Makes the listeners of @p state exist (joint values move link frames, mimics follow, topology
-/// versions count). The robotics Module does it for the states an Environment has when it is attached;
-/// every function of vsd::robotics that builds or compiles does it for its state. Idempotent.
+/// @brief Makes the robotics tracker of @p state exist (in its context): joint values move link frames,
+/// mimics follow, topology versions count. The link frames and mimic values it writes are derived changes
+/// (SimState::Deriving): signalled, not recorded, because every state the tracker serves derives them
+/// itself from the recorded joint values. The robotics Module makes it for every state it serves (all
+/// states by default: a replica needs it to see its links move); every function of vsd::robotics that
+/// builds or compiles makes it for its state. Idempotent.
 void track(SimState& state);
+/// @brief Drops the tracker of @p state (the robotics Module does so when it stops serving the state).
+void untrack(SimState& state) noexcept;
 /// @brief The topology version of @p state: it grows whenever anything a compiled model depends on changes.
 [[nodiscard]] std::uint64_t topology_version(SimState& state);
 

@@ -24,12 +24,16 @@ class Module : public vsd::Module {
   [[nodiscard]] std::string_view name() const override { return "robotics"; }
   /// @brief Registers KinematicJoint, KinematicTree, the controllers and their enums.
   void register_types(vsd::Registry& registry) override;
-  /// @brief Uses vsd::scene::Module, tracks every SimState the environment has now, and adds the periodic
-  /// task "robotics control" (every base step, priority 10) that steps every JointController of every
-  /// SimState of the environment, then cycles every HardwareBinding (send the commands, read the robots).
+  /// @brief Uses vsd::scene::Module and adds the periodic task "robotics control" (every base step, phase
+  /// controllers) that steps every JointController of every state the module serves `stepped` (by default
+  /// the main state), then cycles every HardwareBinding (send the commands, read the robots).
   void attach(vsd::Environment& env) override;
   /// @brief Removes the control task.
   void detach(vsd::Environment& env) override;
+  /// @brief `derived` (the default for every state but the main one): the state's robotics tracker
+  /// (track()) derives link frames and mimic values from joint values; `stepped` also steps its
+  /// controllers and hardware bindings; `none` drops the tracker.
+  void serve(SimState& state, Service from, Service to) override;
 
  private:
   std::uint32_t control_task_ = 0;

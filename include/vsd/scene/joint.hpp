@@ -43,7 +43,9 @@ class Joint : public vsd::NamedModelInstance {
   VSD_PROPERTY(vsd::SharedRef<Joint>, mimic, nullptr)
   VSD_PROPERTY(double, mimic_multiplier, 1.0)
   VSD_PROPERTY(double, mimic_offset, 0.0)
-  /// Current position (rad or m); the robotics module moves the child link from it.
+  /// The position (rad or m) the description starts in (a URDF has none: 0). vsd::robotics copies it into
+  /// the KinematicJoint it builds; from then on that KinematicJoint's `position` is the joint's value, the
+  /// one property a joint set writes (this one is not kept in step).
   VSD_PROPERTY(double, position, 0.0)
 };
 

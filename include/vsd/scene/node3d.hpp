@@ -30,6 +30,8 @@
 
 namespace vsd::scene {
 
+struct WorldFrameWatch;
+
 class Node3D : public vsd::Node {
   VSD_INSTANCE(Node3D, vsd::Node)
   /// Frame relative to the nearest Node3D ancestor (the world when there is none).
@@ -52,7 +54,7 @@ class Node3D : public vsd::Node {
   [[nodiscard]] std::uint64_t world_frame_updates() const noexcept { return world_updates_; }
 
   /// @brief Marks @p node (when it is a Node3D) and the clean Node3Ds below it dirty. Called by the
-  /// listeners; stops below nodes that are already dirty.
+  /// state's world-frame watch; stops below nodes that are already dirty.
   static void invalidate_below(vsd::Node& node);
 
  private:
@@ -61,7 +63,8 @@ class Node3D : public vsd::Node {
   mutable Eigen::Isometry3d world_ = Eigen::Isometry3d::Identity();
   mutable std::uint64_t world_updates_ = 0;
   mutable bool world_clean_ = false;
-  mutable bool tracked_ = false;  // the listeners of this node's SimState are known to exist
+  mutable bool tracked_ = false;  // the world-frame watch of this node's SimState is known to exist
+  friend struct WorldFrameWatch;
 };
 
 }  // namespace vsd::scene

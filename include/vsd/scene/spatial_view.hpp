@@ -47,6 +47,7 @@
 #include <vector>
 
 #include "vsd/core/container.hpp"
+#include "vsd/core/watch.hpp"
 #include "vsd/core/meta_type.hpp"
 #include "vsd/scene/namespace.hpp"
 #include "vsd/scene/support.hpp"
@@ -102,6 +103,7 @@ class SpatialView : public vsd::Container {
     Eigen::Isometry3d offset;  // object's world pose in the support's frame
   };
 
+  void heard(SimStateInstance& inst, const MetaProperty* p, Changes what);
   void on_moved(vsd::Node& node);
   void refresh_offsets() const;
   void drop(vsd::Node& node);
@@ -114,9 +116,9 @@ class SpatialView : public vsd::Container {
   SimState& state_;
   mutable std::unordered_map<Node3D*, Relation> relations_;  // by object
   mutable bool stale_ = false;  // a bundle moved things: offsets are recomputed from the poses
-  std::vector<Connection> connections_;
   int enforcing_ = 0;  // > 0 while the view itself moves objects
   std::vector<std::string> warnings_;
+  Watch watch_;  // last: destroyed first, so nothing is heard while the view is torn down
 };
 
 }  // namespace vsd::scene
