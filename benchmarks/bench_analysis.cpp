@@ -1,7 +1,7 @@
-// State-space exploration and the token game of vsd::soml_analysis.
+// State-space exploration and the token game of vsd::analysis.
 //
 //   BM_Explore_Mcc/<model>/<threads>  full exploration of one of the eight MCC nets
-//   (tests/soml_analysis/data) BM_Explore_Ring/<n>/<k>/<threads> the ring family (n places, k tokens):
+//   (tests/analysis/data) BM_Explore_Ring/<n>/<k>/<threads> the ring family (n places, k tokens):
 //   C(n+k-1, k) states and
 //                                     n*C(n+k-2, k-1) firings, checked against the closed form every run;
 //                                     25/8 has 10 518 300 states and 65 739 375 firings
@@ -18,11 +18,11 @@
 #include <map>
 #include <string>
 
-#include "vsd/soml_analysis.hpp"
+#include "vsd/analysis.hpp"
 
 namespace {
 
-namespace an = vsd::soml::analysis;
+namespace an = vsd::analysis;
 
 const char* const kModels[] = {
     "ResAllocation-PT-R002C002", "Eratosthenes-PT-010", "TokenRing-PT-005", "Philosophers-PT-000005",

@@ -8,11 +8,11 @@
 #include <string_view>
 
 #include "vsd/core/error.hpp"
-#include "vsd/soml_analysis.hpp"
+#include "vsd/analysis.hpp"
 
 namespace {
 
-namespace an = vsd::soml::analysis;
+namespace an = vsd::analysis;
 
 void require(bool ok) {
   if (!ok) std::abort();

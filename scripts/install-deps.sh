@@ -14,7 +14,7 @@ PACKAGES=(
   libeigen3-dev
   # compiler cache: the packaging tests' builds of vsd reuse the objects of .ci/run's Release tree
   ccache
-  # vsd::soml_analysis: the PNML reader's XML parser (the module is skipped without it)
+  # vsd::analysis: the PNML reader's XML parser (the module is skipped without it)
   libpugixml-dev
   # vsd::scene: URDF and mesh loading
   liburdfdom-dev

@@ -13,11 +13,11 @@
 #include "vsd/core/environment.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/soml.hpp"
-#include "vsd/soml_analysis.hpp"
+#include "vsd/analysis.hpp"
 
 namespace {
 
-namespace an = vsd::soml::analysis;
+namespace an = vsd::analysis;
 
 constexpr const char* kUsage =
     "Usage: vsd-soml analyze FILE [--json] [--threads N] [--limit-mem SIZE] [--progress | --no-progress]\n"

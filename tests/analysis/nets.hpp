@@ -1,11 +1,11 @@
-// Hand-made nets with known state spaces, shared by the soml_analysis tests.
+// Hand-made nets with known state spaces, shared by the analysis tests.
 #pragma once
 
 #include <string>
 
-#include "vsd/soml/analysis/pt_net.hpp"
+#include "vsd/analysis/pt_net.hpp"
 
-namespace vsd::soml::analysis::test {
+namespace vsd::analysis::test {
 
 /// A ring of n places p0..p{n-1} with k tokens on p0 and transitions t_i: p_i -> p_{(i+1) mod n}.
 /// Reachable markings: every way to put k tokens on n places, C(n+k-1, k); firings: n * C(n+k-2, k-1)
@@ -27,4 +27,4 @@ inline std::uint64_t binomial(std::uint64_t n, std::uint64_t k) {
   return r;
 }
 
-}  // namespace vsd::soml::analysis::test
+}  // namespace vsd::analysis::test

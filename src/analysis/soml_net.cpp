@@ -1,5 +1,5 @@
-// SOML++ scripts <-> P/T nets: see include/vsd/soml/analysis/soml_net.hpp for the rules.
-#include "vsd/soml/analysis/soml_net.hpp"
+// SOML++ scripts <-> P/T nets: see include/vsd/analysis/soml_net.hpp for the rules.
+#include "vsd/analysis/soml_net.hpp"
 
 #include <algorithm>
 #include <map>
@@ -12,9 +12,13 @@
 #include "vsd/soml/checker.hpp"
 #include "vsd/soml/module.hpp"
 
-namespace vsd::soml::analysis {
+namespace vsd::analysis {
 
 namespace {
+
+// The SOML++ front end's syntax tree and checker (vsd::soml); this module's own Place and Transition
+// (vsd::analysis) still win over vsd::soml's net classes of the same names.
+using namespace vsd::soml;
 
 // ---- does an action change a marking? --------------------------------------------------------------
 
@@ -421,4 +425,4 @@ soml::Program& import_net(soml::Module& soml, SimState& state, const PtNet& net,
   return soml.load(state, name + ".soml", write_soml(net, notes));
 }
 
-}  // namespace vsd::soml::analysis
+}  // namespace vsd::analysis

@@ -1,6 +1,6 @@
 // SOML++ scripts as P/T nets and back: state spaces of hand-made scripts, the MCC nets through SOML++
 // and back, and every construct outside black-token nets refused with its position.
-#include "vsd/soml/analysis/soml_net.hpp"
+#include "vsd/analysis/soml_net.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -9,15 +9,15 @@
 #include <string>
 
 #include "vsd/core/error.hpp"
-#include "vsd/soml/analysis/explorer.hpp"
-#include "vsd/soml/analysis/pnml.hpp"
+#include "vsd/analysis/explorer.hpp"
+#include "vsd/analysis/pnml.hpp"
 
-namespace an = vsd::soml::analysis;
+namespace an = vsd::analysis;
 using an::PtNet;
 
 namespace {
 
-const std::string kSomlNetData = VSD_SOML_TEST_DATA_DIR;
+const std::string kSomlNetData = VSD_ANALYSIS_TEST_DATA_DIR;
 
 std::string soml_net_error_of(const std::string& script) {
   try {

@@ -1,10 +1,10 @@
-#include "vsd/soml/analysis/pt_net.hpp"
+#include "vsd/analysis/pt_net.hpp"
 
 #include <gtest/gtest.h>
 
 #include "vsd/core/error.hpp"
 
-namespace an = vsd::soml::analysis;
+namespace an = vsd::analysis;
 using an::PtNet;
 
 namespace {

@@ -5,7 +5,7 @@
 
 #include "vsd/core/error.hpp"
 
-namespace vsd::soml::analysis::detail {
+namespace vsd::analysis::detail {
 
 std::string read_text_file(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -24,4 +24,4 @@ void write_text_file(const std::filesystem::path& path, std::string_view text) {
   if (!out) vsd::detail::throw_error(path.string() + ": write error");
 }
 
-}  // namespace vsd::soml::analysis::detail
+}  // namespace vsd::analysis::detail

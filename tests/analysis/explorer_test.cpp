@@ -1,6 +1,6 @@
 // State-space exploration: the eight MCC nets against the published figures, exactly, and hand-made nets
 // whose state spaces are known (closed forms, unbounded, inhibitor arcs, dead markings).
-#include "vsd/soml/analysis/explorer.hpp"
+#include "vsd/analysis/explorer.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,9 +10,9 @@
 
 #include "nets.hpp"
 #include "vsd/core/error.hpp"
-#include "vsd/soml/analysis/pnml.hpp"
+#include "vsd/analysis/pnml.hpp"
 
-namespace an = vsd::soml::analysis;
+namespace an = vsd::analysis;
 using an::ExploreOptions;
 using an::ExploreResult;
 using an::PtNet;
@@ -27,7 +27,7 @@ struct Expected {
 };
 
 std::vector<Expected> expected_rows() {
-  std::ifstream in(std::string(VSD_SOML_TEST_DATA_DIR) + "/expected.tsv");
+  std::ifstream in(std::string(VSD_ANALYSIS_TEST_DATA_DIR) + "/expected.tsv");
   std::vector<Expected> rows;
   std::string line;
   std::getline(in, line);  // header
@@ -88,7 +88,7 @@ TEST_P(MccNets, StatesEdgesDeadlockMatchThePublishedFiguresExactly) {
   const unsigned threads = GetParam();
   for (const Expected& e : expected_rows()) {
     SCOPED_TRACE(e.model + ", threads " + std::to_string(threads));
-    const auto imported = an::read_pnml_file(std::string(VSD_SOML_TEST_DATA_DIR) + "/" + e.model + ".pnml");
+    const auto imported = an::read_pnml_file(std::string(VSD_ANALYSIS_TEST_DATA_DIR) + "/" + e.model + ".pnml");
     const ExploreResult r = an::explore(imported.net, quiet(threads));
     ASSERT_TRUE(r.complete()) << r.message;
     EXPECT_EQ(r.states, e.states);
@@ -111,7 +111,7 @@ INSTANTIATE_TEST_SUITE_P(Threads, MccNets, ::testing::Values(1u, 2u, 3u));
 TEST(Explore, ResultsAreIdenticalForAnyThreadCount) {
   for (const Expected& e : expected_rows()) {
     SCOPED_TRACE(e.model);
-    const auto net = an::read_pnml_file(std::string(VSD_SOML_TEST_DATA_DIR) + "/" + e.model + ".pnml").net;
+    const auto net = an::read_pnml_file(std::string(VSD_ANALYSIS_TEST_DATA_DIR) + "/" + e.model + ".pnml").net;
     const ExploreResult one = an::explore(net, quiet(1));
     const ExploreResult two = an::explore(net, quiet(2));
     EXPECT_EQ(one.dead_trace, two.dead_trace);
@@ -125,7 +125,7 @@ TEST(Explore, ResultsAreIdenticalForAnyThreadCount) {
 TEST(Explore, SmallLevelsOnOneThreadByDefaultGiveTheSameResults) {
   for (const Expected& e : expected_rows()) {
     SCOPED_TRACE(e.model);
-    const auto net = an::read_pnml_file(std::string(VSD_SOML_TEST_DATA_DIR) + "/" + e.model + ".pnml").net;
+    const auto net = an::read_pnml_file(std::string(VSD_ANALYSIS_TEST_DATA_DIR) + "/" + e.model + ".pnml").net;
     ExploreOptions o = quiet(2);
     o.split_small_levels = false;
     const ExploreResult split = an::explore(net, quiet(2));
@@ -145,7 +145,7 @@ TEST(Explore, SmallMccNetsAgreeWithANaiveSearch) {
   for (const char* model :
        {"ResAllocation-PT-R002C002", "Eratosthenes-PT-010", "Philosophers-PT-000005", "FMS-PT-00002"}) {
     SCOPED_TRACE(model);
-    const auto net = an::read_pnml_file(std::string(VSD_SOML_TEST_DATA_DIR) + "/" + model + ".pnml").net;
+    const auto net = an::read_pnml_file(std::string(VSD_ANALYSIS_TEST_DATA_DIR) + "/" + model + ".pnml").net;
     const Naive n = naive(net);
     const ExploreResult r = an::explore(net, quiet());
     EXPECT_EQ(r.states, n.states);
@@ -156,11 +156,11 @@ TEST(Explore, SmallMccNetsAgreeWithANaiveSearch) {
 
 TEST(Explore, MccTokenBounds) {
   // FMS-PT-00002 starts with 2 tokens on several places and can gather 3 on one; the others are safe.
-  const auto fms = an::read_pnml_file(std::string(VSD_SOML_TEST_DATA_DIR) + "/FMS-PT-00002.pnml").net;
+  const auto fms = an::read_pnml_file(std::string(VSD_ANALYSIS_TEST_DATA_DIR) + "/FMS-PT-00002.pnml").net;
   const ExploreResult r = an::explore(fms, quiet());
   EXPECT_EQ(r.max_tokens_place, 3u);
   EXPECT_GE(r.max_tokens_marking, 12u);
-  const auto dekker = an::read_pnml_file(std::string(VSD_SOML_TEST_DATA_DIR) + "/Dekker-PT-010.pnml").net;
+  const auto dekker = an::read_pnml_file(std::string(VSD_ANALYSIS_TEST_DATA_DIR) + "/Dekker-PT-010.pnml").net;
   const ExploreResult d = an::explore(dekker, quiet());
   EXPECT_EQ(d.max_tokens_place, 1u);
   EXPECT_EQ(d.bits_per_place, 1u);  // a safe net is stored with one bit per place

@@ -21,9 +21,9 @@
 #include <string_view>
 #include <vector>
 
-#include "vsd/soml/analysis/pt_net.hpp"
+#include "vsd/analysis/pt_net.hpp"
 
-namespace vsd::soml::analysis {
+namespace vsd::analysis {
 
 /// @brief What read_pnml() returns: the net, and what was skipped (one human-readable line each).
 struct PnmlImport {
@@ -49,4 +49,4 @@ std::string write_pnml(const PtNet& net);
 /// @brief write_pnml() to a file. @throws vsd::Error when the file cannot be written.
 void write_pnml_file(const PtNet& net, const std::filesystem::path& path);
 
-}  // namespace vsd::soml::analysis
+}  // namespace vsd::analysis

@@ -6,7 +6,7 @@
 #include <string>
 #include <string_view>
 
-namespace vsd::soml::analysis::detail {
+namespace vsd::analysis::detail {
 
 /// @brief The bytes of @p path. @throws vsd::Error "<path>: cannot open the file for reading" / "read error".
 std::string read_text_file(const std::filesystem::path& path);
@@ -14,4 +14,4 @@ std::string read_text_file(const std::filesystem::path& path);
 /// @brief Replaces the content of @p path by @p text. @throws vsd::Error naming the file on failure.
 void write_text_file(const std::filesystem::path& path, std::string_view text);
 
-}  // namespace vsd::soml::analysis::detail
+}  // namespace vsd::analysis::detail

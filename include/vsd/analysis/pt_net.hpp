@@ -1,5 +1,5 @@
 /** @file
- *  @brief vsd::soml::analysis::PtNet, a place/transition net with weighted arcs and inhibitor arcs.
+ *  @brief vsd::analysis::PtNet, a place/transition net with weighted arcs and inhibitor arcs.
  *
  *  This is the net the analysis works on: places with an initial marking of black tokens, transitions,
  *  and for each transition its input, output and inhibitor arcs with positive integer weights. It is
@@ -22,9 +22,9 @@
 #include <unordered_map>
 #include <vector>
 
-#include "vsd/soml/analysis/fwd.hpp"
+#include "vsd/analysis/fwd.hpp"
 
-namespace vsd::soml::analysis {
+namespace vsd::analysis {
 
 /// @brief A place: id, name and initial number of black tokens.
 struct Place {
@@ -131,4 +131,4 @@ class PtNet {
   std::unordered_map<std::string, std::uint32_t> transition_index_;
 };
 
-}  // namespace vsd::soml::analysis
+}  // namespace vsd::analysis

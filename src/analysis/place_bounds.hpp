@@ -5,9 +5,9 @@
 #include <optional>
 #include <vector>
 
-#include "vsd/soml/analysis/pt_net.hpp"
+#include "vsd/analysis/pt_net.hpp"
 
-namespace vsd::soml::analysis::detail {
+namespace vsd::analysis::detail {
 
 /// A bound on every place valid in every reachable marking, when the net proves one: either no
 /// transition adds tokens in total (bound: the initial token count), or every place lies in the support
@@ -16,4 +16,4 @@ namespace vsd::soml::analysis::detail {
 /// cost stays small on any net. Inhibitor arcs move no tokens and change nothing here.
 std::optional<std::vector<std::uint64_t>> place_bounds(const PtNet& net);
 
-}  // namespace vsd::soml::analysis::detail
+}  // namespace vsd::analysis::detail

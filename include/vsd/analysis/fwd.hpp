@@ -1,9 +1,9 @@
 /** @file
- *  @brief Forward declarations of vsd::soml::analysis (P/T nets, PNML, state-space exploration).
+ *  @brief Forward declarations of vsd::analysis (P/T nets, PNML, state-space exploration).
  */
 #pragma once
 
-namespace vsd::soml::analysis {
+namespace vsd::analysis {
 
 struct Place;
 struct ArcRef;
@@ -14,4 +14,4 @@ struct ExploreOptions;
 struct ExploreResult;
 class TokenGame;
 
-}  // namespace vsd::soml::analysis
+}  // namespace vsd::analysis

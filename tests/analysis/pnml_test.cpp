@@ -1,5 +1,5 @@
 // PNML import and export: the MCC nets, round trips, and every kind of bad input with its line:col.
-#include "vsd/soml/analysis/pnml.hpp"
+#include "vsd/analysis/pnml.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -8,14 +8,14 @@
 #include <fstream>
 
 #include "vsd/core/error.hpp"
-#include "vsd/soml/analysis/explorer.hpp"
+#include "vsd/analysis/explorer.hpp"
 
-namespace an = vsd::soml::analysis;
+namespace an = vsd::analysis;
 using an::PtNet;
 
 namespace {
 
-const std::string kData = VSD_SOML_TEST_DATA_DIR;
+const std::string kData = VSD_ANALYSIS_TEST_DATA_DIR;
 const char* const kModels[] = {
     "ResAllocation-PT-R002C002", "Eratosthenes-PT-010", "TokenRing-PT-005", "Philosophers-PT-000005",
     "SharedMemory-PT-000005",    "FMS-PT-00002",        "Dekker-PT-010",    "Peterson-PT-2"};

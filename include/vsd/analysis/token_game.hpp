@@ -1,5 +1,5 @@
 /** @file
- *  @brief vsd::soml::analysis::TokenGame: plays a PtNet, one firing at a time, with an incrementally kept
+ *  @brief vsd::analysis::TokenGame: plays a PtNet, one firing at a time, with an incrementally kept
  *  set of enabled transitions.
  *
  *  The enabled transitions are kept as a bitset with counts per word and per block of words (for picking
@@ -19,9 +19,9 @@
 #include <memory>
 #include <vector>
 
-#include "vsd/soml/analysis/pt_net.hpp"
+#include "vsd/analysis/pt_net.hpp"
 
-namespace vsd::soml::analysis {
+namespace vsd::analysis {
 
 /// @brief The token game on a PtNet (see the file comment).
 class TokenGame {
@@ -81,4 +81,4 @@ class TokenGame {
   std::vector<std::uint32_t> unsatisfied_;  // general nets, per transition: arcs the marking does not satisfy
 };
 
-}  // namespace vsd::soml::analysis
+}  // namespace vsd::analysis

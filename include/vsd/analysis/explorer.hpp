@@ -7,7 +7,7 @@
  *  of firings, one per (reachable marking, transition enabled in it), so two transitions leading from one
  *  marking to the same marking count twice.
  *
- *  How (see docs/soml_analysis.md for the details):
+ *  How (see docs/analysis.md for the details):
  *  - Markings are stored packed, b bits per place with b in {1, 2, 4, 8, 16, 32}, in one arena of
  *    64-bit words. When the net proves bounds on its places (P-semiflows covering every place, or no
  *    transition adding tokens), b holds the largest bound; otherwise b starts from the initial marking
@@ -33,9 +33,9 @@
 #include <string>
 #include <vector>
 
-#include "vsd/soml/analysis/pt_net.hpp"
+#include "vsd/analysis/pt_net.hpp"
 
-namespace vsd::soml::analysis {
+namespace vsd::analysis {
 
 /// @brief Knobs of explore().
 struct ExploreOptions {
@@ -110,4 +110,4 @@ void write_json(std::ostream& out, const PtNet& net, const ExploreResult& r);
 /// @brief Writes a readable summary of @p r (several lines).
 void write_summary(std::ostream& out, const PtNet& net, const ExploreResult& r);
 
-}  // namespace vsd::soml::analysis
+}  // namespace vsd::analysis

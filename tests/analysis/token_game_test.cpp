@@ -1,4 +1,4 @@
-#include "vsd/soml/analysis/token_game.hpp"
+#include "vsd/analysis/token_game.hpp"
 
 #include <gtest/gtest.h>
 
@@ -6,9 +6,9 @@
 
 #include "nets.hpp"
 #include "vsd/core/error.hpp"
-#include "vsd/soml/analysis/pnml.hpp"
+#include "vsd/analysis/pnml.hpp"
 
-namespace an = vsd::soml::analysis;
+namespace an = vsd::analysis;
 
 namespace {
 
@@ -28,7 +28,7 @@ TEST(TokenGame, IncrementalEnabledSetMatchesBruteForceOnTheMccNets) {
   for (const char* model : {"Dekker-PT-010", "FMS-PT-00002", "Philosophers-PT-000005", "TokenRing-PT-005",
                             "Eratosthenes-PT-010"}) {
     SCOPED_TRACE(model);
-    const an::PtNet net = an::read_pnml_file(std::string(VSD_SOML_TEST_DATA_DIR) + "/" + model + ".pnml").net;
+    const an::PtNet net = an::read_pnml_file(std::string(VSD_ANALYSIS_TEST_DATA_DIR) + "/" + model + ".pnml").net;
     an::TokenGame game(net);
     auto m = net.initial_marking();
     for (int step = 0; step < 300; ++step) {
@@ -47,7 +47,7 @@ const char* const kAllModels[] = {
     "SharedMemory-PT-000005",    "FMS-PT-00002",        "Dekker-PT-010",    "Peterson-PT-2"};
 
 an::PtNet mcc(const char* model) {
-  return an::read_pnml_file(std::string(VSD_SOML_TEST_DATA_DIR) + "/" + model + ".pnml").net;
+  return an::read_pnml_file(std::string(VSD_ANALYSIS_TEST_DATA_DIR) + "/" + model + ".pnml").net;
 }
 
 // Plays the game one firing at a time through play(1, seed) and checks every firing against the net's own
@@ -218,7 +218,7 @@ TEST(TokenGame, PlayIsDeterministicAndPicksUniformly) {
 
 TEST(TokenGame, PlayCountsFiringsAndRestartsAtDeadMarkings) {
   const an::PtNet net =
-      an::read_pnml_file(std::string(VSD_SOML_TEST_DATA_DIR) + "/ResAllocation-PT-R002C002.pnml").net;
+      an::read_pnml_file(std::string(VSD_ANALYSIS_TEST_DATA_DIR) + "/ResAllocation-PT-R002C002.pnml").net;
   an::TokenGame game(net);
   EXPECT_EQ(game.play(10000, 42), 10000u);  // the net deadlocks quickly: many restarts
   EXPECT_EQ(sorted(game.enabled()), brute_enabled(net, game.marking()));

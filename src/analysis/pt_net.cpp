@@ -1,10 +1,10 @@
-#include "vsd/soml/analysis/pt_net.hpp"
+#include "vsd/analysis/pt_net.hpp"
 
 #include <algorithm>
 
 #include "vsd/core/error.hpp"
 
-namespace vsd::soml::analysis {
+namespace vsd::analysis {
 
 PtNet::PtNet(std::string id, std::string name) : id_(std::move(id)), name_(std::move(name)) {}
 
@@ -154,4 +154,4 @@ void PtNet::fire(std::uint32_t t, std::vector<std::uint32_t>& marking) const {
   }
 }
 
-}  // namespace vsd::soml::analysis
+}  // namespace vsd::analysis

@@ -1,7 +1,7 @@
 // PNML reader and writer on pugixml. The reader walks the DOM once to collect places, transitions,
 // reference nodes and arcs (in that order of need), then resolves arcs; positions for messages come from
 // pugixml's node offsets, turned into line:col by a table of line starts.
-#include "vsd/soml/analysis/pnml.hpp"
+#include "vsd/analysis/pnml.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -15,7 +15,7 @@
 #include "text_file.hpp"
 #include "vsd/core/error.hpp"
 
-namespace vsd::soml::analysis {
+namespace vsd::analysis {
 
 namespace {
 
@@ -388,4 +388,4 @@ void write_pnml_file(const PtNet& net, const std::filesystem::path& path) {
   detail::write_text_file(path, write_pnml(net));
 }
 
-}  // namespace vsd::soml::analysis
+}  // namespace vsd::analysis

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <numeric>
 
-namespace vsd::soml::analysis::detail {
+namespace vsd::analysis::detail {
 
 namespace {
 
@@ -140,4 +140,4 @@ std::optional<std::vector<std::uint64_t>> place_bounds(const PtNet& net) {
   return result();
 }
 
-}  // namespace vsd::soml::analysis::detail
+}  // namespace vsd::analysis::detail

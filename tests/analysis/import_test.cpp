@@ -8,17 +8,17 @@
 
 #include "vsd/core/environment.hpp"
 #include "vsd/core/error.hpp"
-#include "vsd/soml/analysis/pnml.hpp"
-#include "vsd/soml/analysis/soml_net.hpp"
+#include "vsd/analysis/pnml.hpp"
+#include "vsd/analysis/soml_net.hpp"
 #include "vsd/soml/module.hpp"
 #include "vsd/soml/net_classes.hpp"
 #include "vsd/soml/runtime.hpp"
 
-namespace an = vsd::soml::analysis;
+namespace an = vsd::analysis;
 
 namespace {
 
-const std::string kImportData = VSD_SOML_TEST_DATA_DIR;
+const std::string kImportData = VSD_ANALYSIS_TEST_DATA_DIR;
 
 class Import : public ::testing::TestWithParam<const char*> {};
 

@@ -9,7 +9,7 @@
 //   C (sequential): new markings get consecutive state indices in candidate order and are copied into
 //     the arena: numbering never depends on the thread count;
 //   D (parallel over shards): pending entries are rewritten to state indices.
-#include "vsd/soml/analysis/explorer.hpp"
+#include "vsd/analysis/explorer.hpp"
 
 #include <unistd.h>
 
@@ -35,7 +35,7 @@
 #include "place_bounds.hpp"
 #include "vsd/core/error.hpp"
 
-namespace vsd::soml::analysis {
+namespace vsd::analysis {
 
 namespace {
 
@@ -1194,4 +1194,4 @@ void write_summary(std::ostream& out, const PtNet& net, const ExploreResult& r) 
   out << buf;
 }
 
-}  // namespace vsd::soml::analysis
+}  // namespace vsd::analysis

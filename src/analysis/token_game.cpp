@@ -1,4 +1,4 @@
-#include "vsd/soml/analysis/token_game.hpp"
+#include "vsd/analysis/token_game.hpp"
 
 #include <algorithm>
 #include <array>
@@ -9,7 +9,7 @@
 #include "place_bounds.hpp"
 #include "vsd/core/error.hpp"
 
-namespace vsd::soml::analysis {
+namespace vsd::analysis {
 
 // Two representations of the marking; the constructor picks one and the game never mixes them. Both keep,
 // per transition, the number of its arcs that the marking does not satisfy (input arcs short of tokens,
@@ -411,4 +411,4 @@ std::uint64_t TokenGame::play(std::uint64_t steps, std::uint64_t seed) {
   }
 }
 
-}  // namespace vsd::soml::analysis
+}  // namespace vsd::analysis

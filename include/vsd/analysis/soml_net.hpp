@@ -31,7 +31,7 @@
 #include <vector>
 
 #include "vsd/core/fwd.hpp"
-#include "vsd/soml/analysis/pt_net.hpp"
+#include "vsd/analysis/pt_net.hpp"
 
 namespace vsd::soml {
 struct CheckResult;
@@ -39,7 +39,7 @@ class Module;
 class Program;
 }
 
-namespace vsd::soml::analysis {
+namespace vsd::analysis {
 
 /// @brief What read_soml_net() returns: the net, and notes on what was ignored.
 struct SomlNetImport {
@@ -71,4 +71,4 @@ void write_soml_file(const PtNet& net, const std::filesystem::path& path, std::v
 soml::Program& import_net(soml::Module& soml, SimState& state, const PtNet& net,
                           std::vector<std::string>* notes = nullptr);
 
-}  // namespace vsd::soml::analysis
+}  // namespace vsd::analysis

@@ -5,9 +5,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "vsd/soml/analysis/pt_net.hpp"
+#include "vsd/analysis/pt_net.hpp"
 
-namespace vsd::soml::analysis::detail {
+namespace vsd::analysis::detail {
 
 struct Compiled {
   std::uint32_t places = 0;
@@ -102,4 +102,4 @@ struct Compiled {
   }
 };
 
-}  // namespace vsd::soml::analysis::detail
+}  // namespace vsd::analysis::detail
