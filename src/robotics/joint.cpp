@@ -87,6 +87,51 @@ Eigen::Isometry3d KinematicJoint::motion_frame(double q1, double q2) const {
   return f;
 }
 
+namespace {
+
+// The angle of the rotation @p r about the unit axis @p a: the rotation of a vector perpendicular to the
+// axis, projected onto the plane perpendicular to it (exact for a rotation about @p a).
+double angle_about(const Eigen::Matrix3d& r, const Eigen::Vector3d& a) {
+  Eigen::Vector3d b = a.unitOrthogonal();
+  const Eigen::Vector3d c = a.cross(b);
+  const Eigen::Vector3d rb = r * b;
+  return std::atan2(c.dot(rb), b.dot(rb));
+}
+
+// @p q moved by whole turns to the one nearest @p near.
+double nearest_turn(double q, double near) {
+  if (!std::isfinite(near)) return q;
+  constexpr double turn = 2.0 * 3.14159265358979323846;
+  return q + turn * std::round((near - q) / turn);
+}
+
+}  // namespace
+
+std::pair<double, double> KinematicJoint::values_of(const Eigen::Isometry3d& frame) const {
+  const JointPlacement p = placement();
+  if (type() == KinematicJointType::Fixed || p.axis.norm() == 0.0) return {position(), position2()};
+  const Eigen::Isometry3d m = p.pre.inverse() * frame * p.post.inverse();
+  const Eigen::Vector3d a = p.axis.normalized();
+  switch (type()) {
+    case KinematicJointType::Prismatic:
+      return {a.dot(m.translation()), position2()};
+    case KinematicJointType::Universal: {
+      if (axis2().norm() == 0.0 || a.cross(axis2().normalized()).norm() < 1e-12)
+        return {nearest_turn(angle_about(m.linear(), a), position()), 0.0};
+      // R = Rot(a, q1) Rot(a2, q2) turns a2 like Rot(a, q1) does: q1 from where a2 went, then q2.
+      const Eigen::Vector3d a2 = axis2().normalized();
+      const Eigen::Vector3d b = (a2 - a * a.dot(a2)).normalized();
+      const Eigen::Vector3d c = a.cross(b);
+      const Eigen::Vector3d ra2 = m.linear() * a2;
+      const double q1 = nearest_turn(std::atan2(c.dot(ra2), b.dot(ra2)), position());
+      const Eigen::Matrix3d rest = Eigen::AngleAxisd(q1, a).toRotationMatrix().transpose() * m.linear();
+      return {q1, nearest_turn(angle_about(rest, a2), position2())};
+    }
+    default:
+      return {nearest_turn(angle_about(m.linear(), a), position()), position2()};
+  }
+}
+
 void KinematicJoint::set_dh_parameters(DhConvention convention, const DhParameters& p) {
   set_dh(convention);
   set_dh_a(p.a);

@@ -24,33 +24,65 @@ namespace {
 // A joint value is the one recorded property of a joint set. The owner's `frame` and a mimic follower's
 // value are derived (SimState::Deriving): signalled, so world frames, collision and carried objects follow,
 // but not recorded — every state that this module serves derives them itself from the recorded value.
+// The other way round, when someone else moves a jointed link (physics writes the poses of a robot's
+// bodies), the joint values follow the link's frame (KinematicJoint::values_of), derived as well: FK,
+// Jacobians and controllers see the joints where the bodies are.
 struct Tracker {
   explicit Tracker(SimState& s);
   void heard(SimStateInstance& inst, const MetaProperty* p, Changes what);
   void joint_changed(KinematicJoint& j, const MetaProperty& p);
   void node_changed(scene::Node3D& node, const MetaProperty& p);
+  void sync_owner_frame(KinematicJoint& j);
+  void sync_mimic(KinematicJoint& f);
+  void follow_frame(const scene::Node3D& node, KinematicJoint& j);
   const std::vector<KinematicJoint*>& followers_of(const KinematicJoint& j);
 
   SimState& state;
   std::uint64_t version = 1;
   std::uint64_t followers_version = 0;
   std::unordered_map<const KinematicJoint*, std::vector<KinematicJoint*>> followers;
-  int depth = 0;  // nested updates (mimic chains); a cycle stops here instead of recursing forever
-  Watch watch;    // last: goes first
+  int depth = 0;            // nested updates (mimic chains); a cycle stops here instead of recursing forever
+  int syncing = 0;          // > 0 while the tracker sets a link frame itself
+  bool from_frame = false;  // the joint values being set follow a frame someone else set
+  Watch watch;              // last: goes first
 };
 
-void sync_owner_frame(KinematicJoint& j) {
+// Sets a flag for the length of a scope.
+struct Raise {
+  explicit Raise(int& c) : counter(&c) { ++*counter; }
+  ~Raise() { --*counter; }
+  Raise(const Raise&) = delete;
+  Raise& operator=(const Raise&) = delete;
+  int* counter;
+};
+
+void Tracker::sync_owner_frame(KinematicJoint& j) {
   if (auto* owner = j.owner(); owner != nullptr)
     if (auto* node = owner->as<scene::Node3D>()) {
-      SimState::Deriving derived(j.state());
+      Raise own(syncing);
+      SimState::Deriving derived(state);
       node->set_frame(j.motion_frame());
     }
 }
 
-void sync_mimic(KinematicJoint& f) {
+void Tracker::sync_mimic(KinematicJoint& f) {
   if (f.mimic().get() == nullptr) return;
-  SimState::Deriving derived(f.state());
+  SimState::Deriving derived(state);
   f.set_position(f.mimic_multiplier() * f.mimic()->position() + f.mimic_offset());
+}
+
+void Tracker::follow_frame(const scene::Node3D& node, KinematicJoint& j) {
+  const Eigen::Isometry3d& f = node.frame();
+  if (!f.matrix().allFinite() || f.matrix() == j.motion_frame().matrix()) return;  // nothing to follow
+  const auto [q1, q2] = j.values_of(f);
+  SimState::Deriving derived(state);
+  from_frame = true;
+  struct Reset {
+    bool& b;
+    ~Reset() { b = false; }
+  } reset{from_frame};
+  j.set_position(q1);
+  if (j.dof() == 2) j.set_position2(q2);
 }
 
 Tracker::Tracker(SimState& s)
@@ -97,6 +129,7 @@ const std::vector<KinematicJoint*>& Tracker::followers_of(const KinematicJoint& 
 }
 
 void Tracker::joint_changed(KinematicJoint& j, const MetaProperty& p) {
+  if (from_frame) return;  // the values follow the link's frame: nothing to derive from them
   if (depth > 64) return;  // a mimic cycle (compile() rejects it); do not recurse without end
   ++depth;
   struct Leave {
@@ -129,12 +162,14 @@ void Tracker::joint_changed(KinematicJoint& j, const MetaProperty& p) {
 }
 
 void Tracker::node_changed(scene::Node3D& node, const MetaProperty& p) {
+  KinematicJoint* j = node.find_extension<KinematicJoint>();
   if (&p == &vsd::NamedModelInstance::vsd_prop_extensions()) {
     ++version;
-    if (auto* j = node.find_extension<KinematicJoint>()) sync_owner_frame(*j);
-  } else if (node.find_extension<KinematicJoint>() == nullptr) {
-    // The frame of a node moved by a joint is derived; any other node's frame is part of the model.
-    ++version;
+    if (j != nullptr) sync_owner_frame(*j);
+  } else if (j == nullptr) {
+    ++version;  // the frame of a node without a joint is part of the model
+  } else if (syncing == 0) {
+    follow_frame(node, *j);  // someone else moved a jointed link: its values follow
   }
 }
 

@@ -20,6 +20,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <utility>
 #include <cstdint>
 #include <limits>
 
@@ -111,6 +112,12 @@ class KinematicJoint : public vsd::Extension {
   [[nodiscard]] Eigen::Isometry3d motion_frame(double q1, double q2 = 0.0) const;
   /// @brief The child frame for the current values.
   [[nodiscard]] Eigen::Isometry3d motion_frame() const { return motion_frame(position(), position2()); }
+  /// @brief The joint values whose motion frame comes closest to @p frame (the child frame relative to
+  /// the parent): the inverse of motion_frame() where @p frame is one of its values, otherwise the
+  /// projection onto the joint's motion (the rotation about the axis, the translation along it). A
+  /// rotary value is taken in the turn nearest the current position (continuous joints keep counting).
+  /// For a fixed joint the current values.
+  [[nodiscard]] std::pair<double, double> values_of(const Eigen::Isometry3d& frame) const;
   /// @brief Sets the DH convention and parameters at once.
   void set_dh_parameters(DhConvention convention, const DhParameters& p);
   /// @brief True when @p q is within the limits (always, without limits).
