@@ -456,6 +456,7 @@ Transaction SimState::take_recording() {
   recorded_.clear();
   recorded_ops_ = 0;
   if (recording_) detail::write_tx_header(recorded_);
+  if (t.size() != 0) bundle_.emit(t);
   return t;
 }
 

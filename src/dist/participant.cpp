@@ -246,6 +246,10 @@ struct Participant::Impl {
   ParticipantStats stats;
   Signal<void(const Conflict&)> conflict_signal;
   Signal<void()> synced_signal;
+  std::deque<Transaction> local;  // bundles of local changes not published yet (see hear_bundle)
+  int ignoring = 0;               // > 0 while this participant cuts the recording to drop it
+  bool owns_recording = false;    // recording was started by this participant (and is stopped by it)
+  Connection bundle_listener;
   dds_entity_t participant = 0, topic = 0, writer = 0, reader = 0, waitset = 0, readcond = 0;
   bool domain_acquired = false;
 
@@ -532,9 +536,34 @@ struct Participant::Impl {
     return out;
   }
 
+  // The state's recording is shared through SimState::on_bundle(): whoever cuts it (this participant at
+  // each poll, or another reader such as the web inspector at the end of a step), every bundle of local
+  // changes reaches `local` once, in order. What this participant cuts itself to drop it (changes made by
+  // applying others' bundles, an undone conflict) it ignores.
+  void hear_bundle(const Transaction& t) {
+    if (ignoring == 0) local.push_back(t);
+  }
+  void discard_recording() {
+    ++ignoring;
+    struct Leave {
+      int& n;
+      ~Leave() { --n; }
+    } leave{ignoring};
+    if (state.recording()) (void)state.take_recording();
+  }
+
   bool publish() {
-    if (!state.recording()) return false;
-    Transaction t = state.take_recording();
+    if (state.recording()) (void)state.take_recording();  // the step's changes, to every reader
+    bool any = false;
+    while (!local.empty()) {
+      Transaction t = std::move(local.front());
+      local.pop_front();
+      any = publish_one(std::move(t)) || any;
+    }
+    return any;
+  }
+
+  bool publish_one(Transaction t) {
     if (t.empty()) return false;
     if (!synced) {
       ++stats.dropped_unsynced;
@@ -544,7 +573,7 @@ struct Participant::Impl {
     if (std::optional<Conflict> c; !claims.empty() && (c = find_conflict(ops_of(t), id))) {
       // Undo the whole bundle here: a write to what another participant owns is never half-applied.
       state.apply(t.inverted());
-      (void)state.take_recording();
+      discard_recording();
       report(*c, true);
       return false;
     }
@@ -694,9 +723,6 @@ struct Participant::Impl {
   }
 
   // ---- receiving ----
-  void discard_recording() {
-    if (state.recording()) (void)state.take_recording();
-  }
 
   void resync(const std::string& reason, const Message* pending, std::uint64_t from = 0) {
     log(reason + "; resynchronising from a snapshot" + (from != 0 ? " of " + who(from) : std::string()));
@@ -1477,10 +1503,18 @@ struct Participant::Impl {
 
 Participant::Participant(SimState& state, ParticipantOptions options)
     : impl_(std::make_unique<Impl>(state, std::move(options))) {
-  if (state.recording()) throw Error("dist: SimState '" + state.name() + "' is already recording");
   impl_->open();
   impl_->names[impl_->id] = impl_->opt.name;
-  state.start_recording();
+  // A state that records already (for another reader) shares its recording: what was changed before
+  // joining is not this participant's to publish.
+  if (state.recording()) {
+    impl_->discard_recording();
+  } else {
+    state.start_recording();
+    impl_->owns_recording = true;
+  }
+  Impl* impl = impl_.get();
+  impl_->bundle_listener = state.on_bundle().connect([impl](const Transaction& t) { impl->hear_bundle(t); });
   if (impl_->opt.seed) {
     impl_->synced = impl_->ever_synced = true;
   } else {
@@ -1491,7 +1525,8 @@ Participant::Participant(SimState& state, ParticipantOptions options)
 
 Participant::~Participant() {
   impl_->flush();
-  if (impl_->state.recording()) (void)impl_->state.stop_recording();
+  impl_->bundle_listener.disconnect();
+  if (impl_->owns_recording && impl_->state.recording()) (void)impl_->state.stop_recording();
   impl_->close();
 }
 

@@ -110,15 +110,40 @@ TEST_F(SyncTest, ModuleStepsPublishAndApply) {
   EXPECT_GE(pa.stats().bundles_sent, 1u);
 }
 
-TEST(ParticipantErrors, BadDomainAndRecordingStateAreErrors) {
+TEST(ParticipantErrors, BadDomainIsAnError) {
   vsd::Environment env{3};
   auto o = options("x", 231);
   EXPECT_THAT([&] { vsd::dist::Participant p(env.main_state(), o); },
               testing::ThrowsMessage<vsd::Error>(HasSubstr("domain id 231 is out of range")));
-  env.main_state().start_recording();
-  EXPECT_THAT(
-      [&] { vsd::dist::Participant p(env.main_state(), options("x", vsd_dist_test::fresh_domain())); },
-      testing::ThrowsMessage<vsd::Error>(HasSubstr("already recording")));
+}
+
+// A state that records already for another reader (the web inspector's timeline) shares its recording:
+// the participant publishes what changes after it joined, the other reader still sees every bundle, and
+// leaving does not stop the other reader's recording.
+TEST(Participant, SharesTheRecordingOfAStateWithOtherReaders) {
+  const std::uint32_t domain = vsd_dist_test::fresh_domain();
+  vsd::Environment ea{1}, eb{2};
+  vsd::SimState& a = ea.main_state();
+  vsd::SimState& b = eb.main_state();
+  auto& node = a.create<vsd::Node>();
+  a.database().add_child(node);
+  a.start_recording();
+  std::vector<std::size_t> seen;
+  auto reader = a.on_bundle().connect([&](const vsd::Transaction& t) { seen.push_back(t.size()); });
+  node.set_name("before joining");
+  {
+    vsd::dist::Participant pa(a, options("robot", domain, true));
+    vsd::dist::Participant pb(b, options("ui", domain));
+    ASSERT_TRUE(poll_all({&pa, &pb}, [&] { return pb.synced(); }));
+    node.set_name("after joining");
+    (void)a.take_recording();  // the other reader cuts at the end of its step: the participant still gets it
+    ASSERT_TRUE(poll_all({&pa, &pb}, [&] {
+      auto* n = b.find<vsd::Node>(node.id());
+      return n != nullptr && n->name() == "after joining";
+    }));
+  }
+  EXPECT_TRUE(a.recording()) << "the participant did not start the recording, so it does not stop it";
+  EXPECT_GE(seen.size(), 2u) << "the other reader saw the bundle before joining and the one after";
 }
 
 TEST(ParticipantErrors, BadConfigurationIsAnError) {

@@ -130,8 +130,16 @@ class SimState : public Instance {
   /// changes of their own from what they hear (e.g. vsd::scene::SpatialView) hold back, since the
   /// bundle carries those changes already.
   [[nodiscard]] bool applying() const noexcept { return applying_ > 0; }
-  /// @brief The changes recorded so far; recording goes on with an empty bundle.
+  /// @brief The changes recorded so far; recording goes on with an empty bundle. A bundle that is not
+  /// empty is also handed to the on_bundle() listeners.
   Transaction take_recording();
+  /// @brief Listeners of every bundle the recording hands out (take_recording(), stop_recording()),
+  /// whoever takes it: one reader cuts the recording (vsd::dist at each poll, or the web inspector at
+  /// the end of a step), and every other reader still sees every recorded change once, in order.
+  /// Listeners must not change the state.
+  [[nodiscard]] Sink<void(const Transaction&)> on_bundle() noexcept {
+    return Sink<void(const Transaction&)>(bundle_);
+  }
   /// @brief Stops recording and returns what was recorded.
   Transaction stop_recording();
   /// @brief A point in the changes of this state that roll_back() returns to (see savepoint()).
@@ -239,6 +247,7 @@ class SimState : public Instance {
   ChildSignal child_removed_;
   ExtensionSignal extension_added_;
   ExtensionSignal extension_removed_;
+  Signal<void(const Transaction&)> bundle_;
   std::unordered_map<const SimStateInstance*, std::unique_ptr<PropertySignal>> instance_signals_;
   std::vector<std::unique_ptr<TypeSignal>> type_exact_, type_tree_;
   std::vector<std::uint8_t> class_watch_;  // per class index: 0 not known yet, 1 unwatched, 2 watched
