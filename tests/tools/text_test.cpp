@@ -25,15 +25,16 @@ TEST(ToolText, ControlCharactersBecomeQuestionMarks) {
 TEST(ToolText, JsonStringsAreAlwaysValidJson) {
   EXPECT_EQ(json_string("plain"), "\"plain\"");
   EXPECT_EQ(json_string("q\"b\\s/"), "\"q\\\"b\\\\s/\"");
-  EXPECT_EQ(json_string("\n\t\r\b\f"), "\"\\n\\t\\r\\b\\f\"");
-  EXPECT_EQ(json_string(std::string("\x01\x1f\x7f", 3)), "\"\\u0001\\u001f\\u007f\"");
+  EXPECT_EQ(json_string("\n\t\r\b\f"), "\"\\n\\t\\r\\u0008\\u000c\"");
+  EXPECT_EQ(json_string(std::string("\x01\x1f\x7f", 3)), "\"\\u0001\\u001f\x7f\"");  // DEL is valid JSON
   EXPECT_EQ(json_string(std::string(1, '\0')), "\"\\u0000\"");
   EXPECT_EQ(json_string("ü日本😀"), "\"ü日本😀\"");
-  // Bytes that are not UTF-8: the replacement character, never the raw byte.
-  EXPECT_EQ(json_string("a\xff" "b"), "\"a\\ufffdb\"");
-  EXPECT_EQ(json_string("\xc3"), "\"\\ufffd\"");                 // a cut sequence
-  EXPECT_EQ(json_string("\xc0\xaf"), "\"\\ufffd\\ufffd\"");      // an overlong '/'
-  EXPECT_EQ(json_string("\xed\xa0\x80"), "\"\\ufffd\\ufffd\\ufffd\"");  // a surrogate
+  // Bytes that are not UTF-8: the replacement character U+FFFD, never the raw byte.
+  const std::string fffd = "\xEF\xBF\xBD";
+  EXPECT_EQ(json_string("a\xff" "b"), "\"a" + fffd + "b\"");
+  EXPECT_EQ(json_string("\xc3"), "\"" + fffd + "\"");                        // a cut sequence
+  EXPECT_EQ(json_string("\xc0\xaf"), "\"" + fffd + fffd + "\"");              // an overlong '/'
+  EXPECT_EQ(json_string("\xed\xa0\x80"), "\"" + fffd + fffd + fffd + "\"");  // a surrogate
 }
 
 }  // namespace

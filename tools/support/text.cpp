@@ -1,7 +1,7 @@
 // Printable names and messages, JSON strings (see vsd_tool/text.hpp).
 #include "vsd_tool/text.hpp"
 
-#include <cstdio>
+#include "vsd/core/text.hpp"
 
 namespace vsd::tool {
 
@@ -63,53 +63,22 @@ std::string printable(std::string_view s) { return printable_impl(s, false); }
 std::string printable_lines(std::string_view s) { return printable_impl(s, true); }
 
 std::string json_string(std::string_view s) {
-  std::string out = "\"";
+  // Bytes that are not UTF-8 become U+FFFD; the JSON escapes are the core's (write_quoted).
+  std::string utf8;
+  utf8.reserve(s.size());
   for (std::size_t i = 0; i < s.size();) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\b':
-        out += "\\b";
-        break;
-      case '\f':
-        out += "\\f";
-        break;
-      default:
-        if (c < 0x20 || c == 0x7f) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
-          out += buf;
-        } else if (c >= 0x80) {
-          const std::size_t n = utf8_length(s, i);
-          if (n == 0) {
-            out += "\\ufffd";
-            ++i;
-            continue;
-          }
-          out.append(s.substr(i, n));
-          i += n;
-          continue;
-        } else {
-          out += static_cast<char>(c);
-        }
+    const std::size_t n = utf8_length(s, i);
+    if (n == 0) {
+      utf8 += "\xEF\xBF\xBD";
+      ++i;
+    } else {
+      utf8.append(s.substr(i, n));
+      i += n;
     }
-    ++i;
   }
-  return out + "\"";
+  std::string out;
+  write_quoted(out, utf8);
+  return out;
 }
 
 }  // namespace vsd::tool

@@ -16,9 +16,9 @@ std::string printable(std::string_view s);
 /// line and caret).
 std::string printable_lines(std::string_view s);
 
-/// @brief @p s as a JSON string literal, quotes included: '"' and '\\' escaped, control characters as
-/// \\n, \\t, ... or \\u00XX, DEL as \\u007f; valid UTF-8 is kept, a byte that is not valid UTF-8 becomes
-/// U+FFFD. The result is always valid JSON (RFC 8259) and valid UTF-8.
+/// @brief @p s as a JSON string literal, quotes included, escaped as vsd::write_quoted() does ('"' and
+/// '\\', control characters as \\n, \\t, \\r or \\u00XX); valid UTF-8 is kept, a byte that is not valid
+/// UTF-8 becomes U+FFFD. The result is always valid JSON (RFC 8259) and valid UTF-8.
 std::string json_string(std::string_view s);
 
 }  // namespace vsd::tool
