@@ -226,6 +226,26 @@ TEST_F(VsdIo, AFailedWriteLeavesTheOldFileWhole) {
   EXPECT_EQ(TempDir::read(target), old);
 }
 
+// A deep tree prints in linear output and without recursion: levels below 48 say their level instead of
+// being indented further.
+TEST_F(VsdIo, ADeepTreePrintsFlat) {
+  vsd::Environment env;
+  vsd::Node* parent = &env.main_state().database();
+  for (int i = 0; i < 200; ++i) {
+    auto& n = env.main_state().create<vsd::Node>();
+    n.set_name("n" + std::to_string(i));
+    parent->add_child(n);
+    parent = &n;
+  }
+  vsd::io::save(env.main_state(), path("deep.json"));
+  const ToolRun r = tool({"tree", path("deep.json")});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("└─ #49 Node \"n47\"\n"));
+  EXPECT_THAT(r.out, HasSubstr("… level 49: #50 Node \"n48\"\n"));
+  EXPECT_THAT(r.out, HasSubstr("… level 200: #201 Node \"n199\"\n"));
+  EXPECT_LT(r.out.size(), std::size_t{200} * 200);
+}
+
 TEST_F(VsdIo, ControlCharactersInNamesAndArgumentsAreNotEchoed) {
   // A class name with an escape sequence in a file: shown with '?' in the tree and in messages.
   const std::string text = TempDir::read(golden("runtime.json"));
