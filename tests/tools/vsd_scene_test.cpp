@@ -1,6 +1,8 @@
 // vsd-scene, run in-process: URDF and saved scenes, usage errors, bad files, standard input, deep trees.
 #include "vsd-scene/tool.hpp"
 
+#include "vsd-io/tool.hpp"
+
 #include <gtest/gtest.h>
 
 #include <string>
@@ -47,6 +49,17 @@ TEST(VsdScene, SavedSceneRoundTripsThroughJson) {
   const ToolRun piped = vsd_tool_test::run_tool_with_stdin(vsd::tool::vsd_scene::run, {"-"}, json.out);
   EXPECT_EQ(piped.code, 0) << piped.err;
   EXPECT_EQ(piped.out, tree.out);
+}
+
+// Every tool knows the classes of every module that was built: vsd-io reads what vsd-scene writes.
+TEST(VsdScene, VsdIoReadsWhatItWrites) {
+  const ToolRun json = run({data_dir + "/ur5_robot.urdf", "--no-meshes", "--json"});
+  ASSERT_EQ(json.code, 0) << json.err;
+  const TempDir tmp("vsd_scene_to_io");
+  const ToolRun tree = vsd_tool_test::run_tool(vsd::tool::vsd_io::run, {"tree", tmp.write("ur5.json", json.out)});
+  ASSERT_EQ(tree.code, 0) << tree.err;
+  EXPECT_NE(tree.out.find("scene::Link \"upper_arm_link\""), std::string::npos) << tree.out;
+  EXPECT_EQ(tree.err.find("not known"), std::string::npos) << tree.err;  // no stand-ins
 }
 
 TEST(VsdScene, UsageAndFileErrors) {
