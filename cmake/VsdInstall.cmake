@@ -1,29 +1,20 @@
 # Install rules and CMake package files for vsd (included by the top level when VSD_INSTALL is ON).
 #
 # Produces
-#   <prefix>/lib/libvsd_core.a, <prefix>/include/vsd/...
-#   <prefix>/lib/cmake/vsd/{vsdConfig,vsdConfigVersion,vsdTargets*}.cmake   -> find_package(vsd CONFIG)
-#   <build>/{vsdConfig,vsdConfigVersion,vsdTargets}.cmake                     -> -Dvsd_DIR=<build> also works
-# and the imported targets vsd::<EXPORT_NAME>, e.g. vsd::core.
+#   <prefix>/lib/libvsd_<module>.a, <prefix>/include/vsd/...
+#   <prefix>/lib/cmake/vsd/vsdConfig.cmake, vsdConfigVersion.cmake       -> find_package(vsd CONFIG)
+#   <prefix>/lib/cmake/vsd/vsd-<module>-targets*.cmake                   one export set per module
+#   <build>/vsdConfig.cmake, vsd-<module>-targets.cmake                   -> -Dvsd_DIR=<build> also works
+# and the imported targets vsd::<module> (vsd::core, vsd::io, ...) and vsd::vsd (all of them).
 #
-# Adding a library module to the package
-# ---------------------------------------
-# This file is included *after* add_subdirectory(src), so a module's CMakeLists.txt cannot call a
-# function defined here. Modules therefore register themselves through a GLOBAL property, which is
-# order-independent and crosses directory scopes:
-#
-#     set_property(GLOBAL APPEND PROPERTY VSD_INSTALL_TARGETS vsd_foo)      # next to add_library(vsd_foo)
-#     set_target_properties(vsd_foo PROPERTIES EXPORT_NAME foo)             # -> vsd::foo for consumers
-#
-# and, if the module links a package's imported target beyond Eigen3/Threads, a find_dependency() line
-# for vsdConfig.cmake. Note that vsd's libraries are STATIC, so even PRIVATE link dependencies end up in
-# the exported interface (as $<LINK_ONLY:...>) and need this line:
-#
-#     set_property(GLOBAL APPEND PROPERTY VSD_INSTALL_DEPENDENCIES "Boost 1.74")  # args of find_dependency
-#
-# vsd_core is always installed. Every registered target goes into the single export set `vsdTargets`.
-# For code that runs after this file (rare), vsd_install_target(<tgt>) does the same registration and
-# installs the target immediately.
+# Components: every module is a component of the package, with its own export set, so that
+#   find_package(vsd CONFIG REQUIRED COMPONENTS core)    finds Eigen and Threads and nothing else,
+#   find_package(vsd CONFIG REQUIRED COMPONENTS scene)   also urdfdom and assimp (and vsd::core),
+#   find_package(vsd CONFIG REQUIRED)                     every installed module and vsd::vsd.
+# A module registers itself through vsd_add_module() (cmake/VsdModule.cmake): the vsd modules it links and
+# the packages behind its imported link targets (static libraries: even PRIVATE ones reach a consumer's
+# link line, as $<LINK_ONLY:...>, so a consumer must find them). Only imported targets are linked, never a
+# library path, so the exported files name no path of the machine that built vsd.
 
 include_guard(GLOBAL)
 include(CMakePackageConfigHelpers)
@@ -32,38 +23,51 @@ set(VSD_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/vsd"
     CACHE STRING "Install directory (relative to the prefix) of vsd's CMake package files")
 mark_as_advanced(VSD_INSTALL_CMAKEDIR)
 
-# install(TARGETS) for one target into the vsdTargets export set.
-function(_vsd_install_one tgt)
-  if(NOT TARGET ${tgt})
-    message(FATAL_ERROR "vsd install: '${tgt}' was registered for installation but is not a target")
-  endif()
+# install(TARGETS) of one target into export set @p set, and that set's targets file (install and build tree).
+function(_vsd_install_export tgt set)
   install(TARGETS ${tgt}
-    EXPORT vsdTargets
+    EXPORT ${set}
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT vsd_development
     LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT vsd_runtime
             NAMELINK_COMPONENT vsd_development
     RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT vsd_runtime
     INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  install(EXPORT ${set}
+    NAMESPACE vsd::
+    FILE ${set}.cmake
+    DESTINATION ${VSD_INSTALL_CMAKEDIR}
+    COMPONENT vsd_development)
+  export(EXPORT ${set} NAMESPACE vsd:: FILE "${PROJECT_BINARY_DIR}/${set}.cmake")
 endfunction()
 
-# Late registration, for targets created after this file was included.
-function(vsd_install_target tgt)
-  get_property(registered GLOBAL PROPERTY VSD_INSTALL_TARGETS)
-  if(tgt STREQUAL "vsd_core" OR tgt IN_LIST registered)
-    return()  # already installed
-  endif()
-  set_property(GLOBAL APPEND PROPERTY VSD_INSTALL_TARGETS ${tgt})
-  _vsd_install_one(${tgt})
+# A CMake list as the arguments of set(): each element quoted.
+function(_vsd_quoted_list out)
+  set(s "")
+  foreach(e IN LISTS ARGN)
+    string(APPEND s " \"${e}\"")
+  endforeach()
+  set(${out} "${s}" PARENT_SCOPE)
 endfunction()
 
-# --- targets -------------------------------------------------------------------------------------------
-get_property(_vsd_install_targets GLOBAL PROPERTY VSD_INSTALL_TARGETS)
-list(PREPEND _vsd_install_targets vsd_core)
-list(REMOVE_DUPLICATES _vsd_install_targets)
-foreach(_vsd_tgt IN LISTS _vsd_install_targets)
-  _vsd_install_one(${_vsd_tgt})
+# --- targets and what each component needs ----------------------------------------------------------
+get_property(_vsd_modules GLOBAL PROPERTY VSD_MODULES)
+set(VSD_CONFIG_COMPONENTS "")
+foreach(_vsd_m IN LISTS _vsd_modules)
+  _vsd_install_export(vsd_${_vsd_m} vsd-${_vsd_m}-targets)
+  get_property(_vsd_needs GLOBAL PROPERTY VSD_MODULE_${_vsd_m}_MODULES)
+  get_property(_vsd_packages GLOBAL PROPERTY VSD_MODULE_${_vsd_m}_PACKAGES)
+  get_property(_vsd_pkg_config GLOBAL PROPERTY VSD_MODULE_${_vsd_m}_PKG_CONFIG)
+  _vsd_quoted_list(_vsd_q_needs ${_vsd_needs})
+  _vsd_quoted_list(_vsd_q_packages ${_vsd_packages})
+  _vsd_quoted_list(_vsd_q_pkg_config ${_vsd_pkg_config})
+  string(APPEND VSD_CONFIG_COMPONENTS
+    "set(_vsd_${_vsd_m}_modules${_vsd_q_needs})\n"
+    "set(_vsd_${_vsd_m}_packages${_vsd_q_packages})\n"
+    "set(_vsd_${_vsd_m}_pkg_config${_vsd_q_pkg_config})\n")
 endforeach()
-message(STATUS "vsd: installing targets ${_vsd_install_targets}")
+_vsd_install_export(vsd_vsd vsd-vsd-targets)   # the umbrella: the component `vsd`
+_vsd_quoted_list(VSD_CONFIG_MODULES ${_vsd_modules})
+message(STATUS "vsd: installing the modules${VSD_CONFIG_MODULES} and vsd::vsd")
 
 # --- headers -------------------------------------------------------------------------------------------
 install(DIRECTORY "${PROJECT_SOURCE_DIR}/include/"
@@ -71,27 +75,8 @@ install(DIRECTORY "${PROJECT_SOURCE_DIR}/include/"
   COMPONENT vsd_development
   FILES_MATCHING PATTERN "*.hpp" PATTERN "*.h" PATTERN "*.inl" PATTERN "*.ipp")
 
-# --- export set: install tree and build tree ----------------------------------------------------------
-install(EXPORT vsdTargets
-  NAMESPACE vsd::
-  FILE vsdTargets.cmake
-  DESTINATION ${VSD_INSTALL_CMAKEDIR}
-  COMPONENT vsd_development)
-
-export(EXPORT vsdTargets
-  NAMESPACE vsd::
-  FILE "${PROJECT_BINARY_DIR}/vsdTargets.cmake")
-
 # --- vsdConfig.cmake / vsdConfigVersion.cmake --------------------------------------------------------
-# Extra find_dependency() lines registered by modules (see the top of this file).
-get_property(_vsd_extra_deps GLOBAL PROPERTY VSD_INSTALL_DEPENDENCIES)
-list(REMOVE_DUPLICATES _vsd_extra_deps)
-set(VSD_CONFIG_EXTRA_DEPENDENCIES "")
-foreach(_vsd_dep IN LISTS _vsd_extra_deps)
-  string(APPEND VSD_CONFIG_EXTRA_DEPENDENCIES "find_dependency(${_vsd_dep})\n")
-endforeach()
-
-# One config file serves both trees: it only includes vsdTargets.cmake from its own directory.
+# One config file serves both trees: it only includes the targets files from its own directory.
 configure_package_config_file(
   "${CMAKE_CURRENT_LIST_DIR}/vsdConfig.cmake.in"
   "${PROJECT_BINARY_DIR}/vsdConfig.cmake"
@@ -114,7 +99,11 @@ if(EXISTS "${PROJECT_SOURCE_DIR}/LICENSE")
     COMPONENT vsd_development)
 endif()
 
-unset(_vsd_install_targets)
-unset(_vsd_extra_deps)
-unset(_vsd_tgt)
-unset(_vsd_dep)
+unset(_vsd_modules)
+unset(_vsd_m)
+unset(_vsd_needs)
+unset(_vsd_packages)
+unset(_vsd_pkg_config)
+unset(_vsd_q_needs)
+unset(_vsd_q_packages)
+unset(_vsd_q_pkg_config)

@@ -5,14 +5,21 @@
 #   bash scripts/demo.sh            the work cell (writes workcell.csv, and workcell.png with gnuplot,
 #                                   into build/examples/workcell)
 #   bash scripts/demo.sh --tour     the core-only tour (examples/demo); further arguments go to it
+# It installs only what it runs (scripts/install-deps.sh, groups): the work cell needs the core, vsd::scene
+# (urdfdom, assimp), vsd::collision (FCL, libccd) and vsd::physics (ODE); the tour the core only. gnuplot
+# (for the PNG) is not installed: the work cell writes its CSV without it. The tests are not configured.
 # Environment: BUILD_DIR (default build), VSD_SKIP_DEPS=1 to skip the dependency check.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
 BUILD_DIR="${BUILD_DIR:-build}"
 
-bash scripts/install-deps.sh
-cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release
+if [[ "${1:-}" == "--tour" ]]; then
+  bash scripts/install-deps.sh core
+else
+  bash scripts/install-deps.sh core scene collision physics
+fi
+cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DVSD_BUILD_TESTS=OFF
 
 tour() {
   cmake --build "$BUILD_DIR" --target vsd_demo --parallel 2

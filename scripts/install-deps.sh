@@ -1,67 +1,85 @@
 #!/usr/bin/env bash
-# Installs the Debian packages vsd needs to build, test and benchmark. Idempotent: when every package
-# is already installed, apt is not touched at all. Uses sudo only when not running as root.
+# Installs the Debian packages of the groups named on the command line, and says what it installs.
+# Idempotent: when every package is already installed, apt is not touched at all. Uses sudo only when
+# not running as root.
+#
+#   bash scripts/install-deps.sh GROUP...     e.g. `core scene physics`; `all` is every group
+#
+# Groups:
+#   core        the toolchain, CMake and Eigen: all vsd::core (and vsd::io, vsd::soml, vsd::robotics) need
+#   analysis    vsd::analysis: pugixml (the PNML reader's XML parser)
+#   scene       vsd::scene: urdfdom (URDF) and assimp (meshes); vsd::robotics needs nothing more
+#   dist        vsd::dist: Cyclone DDS (C API) and its IDL compiler idlc
+#   collision   vsd::collision: FCL 0.7 and libccd
+#   physics     vsd::physics: ODE 0.16 (through pkg-config)
+#   modules     all of the five above
+#   tests       GoogleTest and GoogleMock; Orocos KDL (the robotics tests' reference), gnuplot (the
+#               examples' plots), python3 (the docs' C++ blocks are compiled by a test), ccache (the
+#               packaging tests' builds reuse the Release tree's objects)
+#   benchmarks  Google Benchmark and the peers the benchmarks compare with: RTTR, Qt 5, Boost.Signals2,
+#               libsigc++ 3, Lua 5.4
+#   fuzzing     clang and libFuzzer's runtime
+# A module whose packages are missing is skipped at configure time with a message, not the build; on a
+# system without apt, install the same libraries with its package manager (README.md lists them per
+# module) and set VSD_SKIP_DEPS=1.
 #
 # Set VSD_SKIP_DEPS=1 to skip this step (e.g. on a machine whose dependencies are managed otherwise).
 set -euo pipefail
 
-# The one list of packages.
-PACKAGES=(
-  # toolchain and core dependencies
-  build-essential
-  cmake
-  g++
-  libeigen3-dev
-  # compiler cache: the packaging tests' builds of vsd reuse the objects of .ci/run's Release tree
-  ccache
-  # vsd::analysis: the PNML reader's XML parser (the module is skipped without it)
-  libpugixml-dev
-  # vsd::scene: URDF and mesh loading
-  liburdfdom-dev
-  libassimp-dev
-  # vsd::dist: Cyclone DDS (C API) and its IDL compiler idlc
-  cyclonedds-dev
-  cyclonedds-tools
-  # vsd::collision: FCL 0.7 (narrow and broad phase) and libccd (its GJK/EPA for convex pairs)
-  libfcl-dev
-  libccd-dev
-  # vsd::robotics: Orocos KDL, the independent library its tests and benchmarks compare against (not a
-  # dependency of the module itself)
-  liborocos-kdl-dev
-  # vsd::physics: rigid-body dynamics (ODE 0.16, double precision)
-  libode-dev
-  # examples/physics/falling_objects draws its PNG with gnuplot (skipped with a message without it)
-  gnuplot-nox
-  # tests and benchmarks
-  libgtest-dev
-  libgmock-dev
-  libbenchmark-dev
-  # peers the benchmarks compare against
-  librttr-dev
-  qtbase5-dev
-  libboost-dev
-  libsigc++-3.0-dev
-  # the SOML++ VM benchmarks run the same functions in Lua 5.4, embedded (skipped without it)
-  liblua5.4-dev
-  # fuzzing (libFuzzer comes with clang's runtime)
-  clang
-  libclang-rt-14-dev
-)
+declare -A GROUP
+GROUP[core]="build-essential cmake g++ libeigen3-dev"
+GROUP[analysis]="libpugixml-dev"
+GROUP[scene]="liburdfdom-dev libassimp-dev"
+GROUP[dist]="cyclonedds-dev cyclonedds-tools"
+GROUP[collision]="libfcl-dev libccd-dev"
+GROUP[physics]="libode-dev pkg-config"
+GROUP[tests]="libgtest-dev libgmock-dev liborocos-kdl-dev gnuplot-nox python3 ccache"
+GROUP[benchmarks]="libbenchmark-dev librttr-dev qtbase5-dev libboost-dev libsigc++-3.0-dev liblua5.4-dev"
+GROUP[fuzzing]="clang libclang-rt-14-dev"
+MODULES="analysis scene dist collision physics"
+ALL="core $MODULES tests benchmarks fuzzing"
 
 if [[ "${VSD_SKIP_DEPS:-0}" == "1" ]]; then
   echo "install-deps: VSD_SKIP_DEPS=1, skipping"
   exit 0
 fi
+if [[ $# -eq 0 ]]; then
+  echo "usage: install-deps.sh GROUP... (core analysis scene dist collision physics modules tests benchmarks fuzzing all)" >&2
+  exit 2
+fi
+
+groups=()
+for g in "$@"; do
+  case "$g" in
+    all) read -r -a more <<<"$ALL"; groups+=("${more[@]}") ;;
+    modules) read -r -a more <<<"$MODULES"; groups+=("${more[@]}") ;;
+    *)
+      if [[ -z "${GROUP[$g]+x}" ]]; then
+        echo "install-deps: unknown group '$g'" >&2
+        exit 2
+      fi
+      groups+=("$g")
+      ;;
+  esac
+done
+
+packages=()
+for g in "${groups[@]}"; do
+  read -r -a more <<<"${GROUP[$g]}"
+  packages+=("${more[@]}")
+done
+mapfile -t packages < <(printf '%s\n' "${packages[@]}" | awk '!seen[$0]++')
 
 missing=()
-for pkg in "${PACKAGES[@]}"; do
+for pkg in "${packages[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q '^install ok installed$'; then
     missing+=("$pkg")
   fi
 done
 
+echo "install-deps: groups ${groups[*]}: ${#packages[@]} packages (${packages[*]})"
 if [[ ${#missing[@]} -eq 0 ]]; then
-  echo "install-deps: all ${#PACKAGES[@]} packages already installed"
+  echo "install-deps: all already installed"
   exit 0
 fi
 

@@ -5,4 +5,3 @@
 
 #include "vsd/io/file.hpp"
 #include "vsd/io/snapshot.hpp"
-#include "vsd/io/tool.hpp"

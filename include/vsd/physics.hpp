@@ -9,6 +9,5 @@
 #include "vsd/physics/module.hpp"
 #include "vsd/physics/rigid_body.hpp"
 #include "vsd/physics/simulation.hpp"
-#include "vsd/physics/tool.hpp"
 #include "vsd/physics/world.hpp"
 #include "vsd/scene.hpp"

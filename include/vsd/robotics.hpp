@@ -1,7 +1,7 @@
 /** @file
  *  @brief vsd::robotics: kinematic chains and trees as database extensions of 3D nodes, the compiled
- *  model (forward kinematics, Jacobians), inverse kinematics, controllers, hardware adapters (UDP, fieldbus)
- *  and the vsd-robot tool (link vsd::robotics).
+ *  model (forward kinematics, Jacobians), inverse kinematics, controllers and hardware adapters (UDP,
+ *  fieldbus) (link vsd::robotics).
  */
 #pragma once
 
@@ -16,7 +16,6 @@
 #include "vsd/robotics/kinematic_tree.hpp"
 #include "vsd/robotics/model.hpp"
 #include "vsd/robotics/module.hpp"
-#include "vsd/robotics/tool.hpp"
 #include "vsd/robotics/trajectory.hpp"
 #include "vsd/robotics/udp_adapter.hpp"
 #include "vsd/scene.hpp"

@@ -18,5 +18,4 @@
 #include "vsd/scene/spatial_view.hpp"
 #include "vsd/scene/support.hpp"
 #include "vsd/scene/texture_map.hpp"
-#include "vsd/scene/tool.hpp"
 #include "vsd/scene/urdf_loader.hpp"

@@ -75,8 +75,9 @@ void write_type(ByteWriter& w, const MetaType& t) {
 
 class BinaryReader final : public LoadModel {
  public:
-  BinaryReader(Registry& registry, std::span<const std::uint8_t> bytes, std::string_view origin)
-      : LoadModel(registry, origin), in_(bytes.data(), bytes.size()) {}
+  BinaryReader(Registry& registry, std::span<const std::uint8_t> bytes, std::string_view origin,
+               const LoadOptions& options)
+      : LoadModel(registry, origin, options), in_(bytes.data(), bytes.size()) {}
 
   void read() {
     try {
@@ -182,15 +183,18 @@ class BinaryReader final : public LoadModel {
         def.properties.push_back({std::move(prop), &type, flags, std::move(value)});
       }
     }
-    ClassEntry& entry = classes_.emplace_back();
-    entry.cls = &resolve_class(at, name, runtime ? &def : nullptr);
+    // The saved properties first: a class nobody defines may become a stand-in made from them.
     const std::size_t nsaved = in_.size_prefix(2);
-    entry.slots.reserve(nsaved);
-    for (std::size_t i = 0; i < nsaved; ++i) {
-      const std::string prop = in_.string();
-      const std::size_t type_at = in_.position();
-      entry.slots.push_back(make_slot(type_at, *entry.cls, prop, in_.string_view()));
+    std::vector<SavedProperty> saved(nsaved);
+    for (SavedProperty& p : saved) {
+      p.name = in_.string_view();
+      p.at = in_.position();
+      p.type = in_.string_view();
     }
+    ClassEntry& entry = classes_.emplace_back();
+    entry.cls = &resolve_class(at, name, runtime ? &def : nullptr, saved);
+    entry.slots.reserve(nsaved);
+    for (const SavedProperty& p : saved) entry.slots.push_back(make_slot(p.at, *entry.cls, p.name, p.type));
   }
 
   std::span<const std::uint8_t> read_frame() {
@@ -341,8 +345,8 @@ std::vector<std::uint8_t> write_binary(SaveSet& set) {
 }
 
 std::unique_ptr<LoadModel> read_binary(Registry& registry, std::span<const std::uint8_t> bytes,
-                                       std::string_view origin) {
-  auto reader = std::make_unique<BinaryReader>(registry, bytes, origin);
+                                       std::string_view origin, const LoadOptions& options) {
+  auto reader = std::make_unique<BinaryReader>(registry, bytes, origin, options);
   reader->read();
   return reader;
 }

@@ -59,8 +59,8 @@ std::vector<std::uint8_t> write_text(SaveSet& set);
 /// Reads and checks a file of the format into a model (then apply() it, or only look at it).
 /// @p bytes must outlive the model: values point into them.
 std::unique_ptr<LoadModel> read_binary(Registry& registry, std::span<const std::uint8_t> bytes,
-                                       std::string_view origin);
+                                       std::string_view origin, const LoadOptions& options = {});
 std::unique_ptr<LoadModel> read_text(Registry& registry, std::span<const std::uint8_t> bytes,
-                                     std::string_view origin);
+                                     std::string_view origin, const LoadOptions& options = {});
 
 }  // namespace vsd::io::detail

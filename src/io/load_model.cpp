@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <optional>
+#include <tuple>
+#include <unordered_map>
 
 #include "vsd/core/bytes.hpp"
 #include "vsd/core/detail/state_builder.hpp"
@@ -89,7 +91,7 @@ const MetaType& LoadModel::type_named(std::size_t at, std::string_view name) {
 }
 
 const MetaInstance& LoadModel::resolve_class(std::size_t at, const std::string& name,
-                                             const ClassDefinition* def) {
+                                             const ClassDefinition* def, std::span<const SavedProperty> saved) {
   // Files carry full names. A class the file defines is found by that name only; one it merely uses may
   // be given by its short name (hand-written files), unless that is ambiguous.
   const MetaInstance* known = nullptr;
@@ -99,7 +101,11 @@ const MetaInstance& LoadModel::resolve_class(std::size_t at, const std::string& 
     fail_at(at, e.what());
   }
   if (known != nullptr) return *known;
-  if (def == nullptr) fail_at(at, "unknown class '" + name + "' (and the file does not define it)");
+  if (def == nullptr) {
+    if (options_.unknown_classes == UnknownClasses::Placeholder && !saved.empty())
+      return make_placeholder(at, name, saved);
+    fail_at(at, "unknown class '" + name + "' (and the file does not define it)");
+  }
   const MetaInstance* base = nullptr;
   try {
     base = registry_.find_class(def->base);
@@ -119,10 +125,110 @@ const MetaInstance& LoadModel::resolve_class(std::size_t at, const std::string& 
   }
 }
 
+namespace {
+
+// "ref<X>", "shared<X>", "list<X>", "shared_list<X>": the kind and X; nullopt for other type names.
+std::optional<std::pair<TypeKind, std::string_view>> reference_type_name(std::string_view type) {
+  static constexpr std::pair<std::string_view, TypeKind> kinds[] = {{"ref<", TypeKind::Ref},
+                                                                     {"shared<", TypeKind::SharedRef},
+                                                                     {"list<", TypeKind::RefList},
+                                                                     {"shared_list<", TypeKind::SharedRefList}};
+  if (!type.ends_with('>')) return std::nullopt;
+  for (const auto& [prefix, kind] : kinds)
+    if (type.starts_with(prefix))
+      return std::pair{kind, type.substr(prefix.size(), type.size() - prefix.size() - 1)};
+  return std::nullopt;
+}
+
+}  // namespace
+
+// A stand-in for a class nobody defines, from the saved properties the file lists. Its base: the class of
+// this program whose saved properties the list starts with — same names, same types, same order, as a save
+// writes a class's properties, its bases' first (a user's Robot derived from Node lists name, extensions
+// and children first: its stand-in is a Node). The longest such prefix wins; of classes that fit equally
+// well, vsd's core classes (Node, Extension, ...) come before a module's (whose listeners would take the
+// stand-in for one of theirs), then the more derived class (an Extension, not a NamedModelInstance), then
+// the first name. The Database is never a base: a state has one.
+const MetaInstance& LoadModel::make_placeholder(std::size_t at, const std::string& name,
+                                                std::span<const SavedProperty> saved) {
+  auto depth = [](const MetaInstance* c) {
+    std::size_t d = 0;
+    for (; c != nullptr; c = c->base()) ++d;
+    return d;
+  };
+  auto is_core = [](const MetaInstance* c) { return !c->is_runtime() && c->name().find("::") == std::string::npos; };
+  auto rank = [&](const MetaInstance* c, std::size_t prefix) { return std::tuple(prefix, is_core(c), depth(c)); };
+  const MetaInstance* base = &SimStateInstance::static_meta();
+  std::size_t base_saved = 0;
+  for (const MetaInstance* c : registry_.classes()) {
+    if (!c->is_a(SimStateInstance::static_meta()) || c->is_a(Database::static_meta())) continue;
+    std::size_t n = 0;
+    bool fits = true;
+    for (const MetaProperty* p : c->properties()) {
+      if (!is_saved(*p)) continue;
+      if (n >= saved.size() || saved[n].name != p->name() || saved[n].type != p->type().name()) {
+        fits = false;
+        break;
+      }
+      ++n;
+    }
+    if (!fits) continue;
+    const auto mine = rank(c, n), theirs = rank(base, base_saved);
+    if (mine > theirs || (mine == theirs && c->name() < base->name())) {
+      base = c;
+      base_saved = n;
+    }
+  }
+  std::vector<std::string> left_out;
+  try {
+    ClassBuilder builder(name, *base);
+    for (const SavedProperty& p : saved) {
+      if (base->find_property(p.name) != nullptr) continue;
+      const MetaType* type = nullptr;
+      if (const auto ref = reference_type_name(p.type)) {
+        // A reference to a class this program knows keeps its type; to one it does not, it holds any
+        // instance (the target's stand-in may not be made yet).
+        const MetaInstance* target = nullptr;
+        try {
+          target = registry_.find_class(ref->second);
+        } catch (const Error&) {  // an ambiguous short name: any instance
+        }
+        type = &registry_.reference_type(ref->first, target != nullptr ? *target : SimStateInstance::static_meta());
+      } else {
+        try {
+          type = &registry_.get_type(p.type);
+        } catch (const Error&) {
+          left_out.push_back(std::string(p.name) + " (of unknown type " + std::string(p.type) + ")");
+          continue;
+        }
+      }
+      builder.property(std::string(p.name), *type);
+    }
+    const MetaInstance& cls = builder.define(registry_);
+    defined_.push_back(&cls);
+    placeholders_.push_back(&cls);
+    std::string what = "class '" + name + "' is not known to this program: its instances are shown through a "
+                       "stand-in derived from " + base->name() + " with the file's saved values";
+    if (!left_out.empty()) {
+      what += "; left out:";
+      for (const std::string& l : left_out) what += " " + l;
+    }
+    warnings_.push_back(what);
+    return cls;
+  } catch (const Error& e) {  // a property name that is not an identifier, say
+    fail_at(at, "unknown class '" + name + "', and no stand-in can be made for it: " + e.what());
+  }
+}
+
 Slot LoadModel::make_slot(std::size_t at, const MetaInstance& cls, std::string_view prop,
                           std::string_view type_name) {
   Slot s;
   s.prop = cls.find_property(prop);
+  const bool placeholder = std::find(placeholders_.begin(), placeholders_.end(), &cls) != placeholders_.end();
+  if (placeholder) {  // made from this very list: the file's types are its types (or it was left out)
+    if (s.prop != nullptr) s.file_type = &s.prop->type();
+    return s;
+  }
   if (s.prop == nullptr) {
     warnings_.push_back("class '" + cls.name() + "' has no property '" + std::string(prop) +
                         "' any more: its saved values are dropped");
@@ -300,7 +406,10 @@ LoadReport LoadModel::summary() const {
   LoadReport report;
   report.subtree = kind_ == kind_subtree;
   report.instances = instances_.size() - (file_root_ != nullptr ? 1 : 0);  // the Database is not added
-  for (const MetaInstance* c : defined_) report.defined_classes.push_back(c->name());
+  for (const MetaInstance* c : defined_)
+    if (std::find(placeholders_.begin(), placeholders_.end(), c) == placeholders_.end())
+      report.defined_classes.push_back(c->name());
+  for (const MetaInstance* c : placeholders_) report.placeholder_classes.push_back(c->name());
   for (const MetaType* t : defined_types_) report.defined_types.push_back(t->name());
   report.version = version_;
   report.warnings = warnings_;
@@ -454,7 +563,10 @@ LoadReport LoadModel::apply(SimState& state, Node* parent) {
   for (Id id : roots_)
     if (SimStateInstance* n = made[index_of(id)]; !n->is_being_deleted())
       report.roots.push_back(n->as<Node>());
-  for (const MetaInstance* c : defined_) report.defined_classes.push_back(c->name());
+  for (const MetaInstance* c : defined_)
+    if (std::find(placeholders_.begin(), placeholders_.end(), c) == placeholders_.end())
+      report.defined_classes.push_back(c->name());
+  for (const MetaInstance* c : placeholders_) report.placeholder_classes.push_back(c->name());
   for (const MetaType* t : defined_types_) report.defined_types.push_back(t->name());
   report.version = version_;
   report.warnings = warnings_;

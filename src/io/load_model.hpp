@@ -77,6 +77,14 @@ struct ClassDefinition {
   std::vector<Property> properties;
 };
 
+/// A saved property of a class as the file lists it (name, type name, where the type is written): what a
+/// stand-in for a class the program does not know is made from (LoadOptions::unknown_classes).
+struct SavedProperty {
+  std::string_view name;
+  std::string_view type;
+  std::size_t at = 0;
+};
+
 /// A run-time value type (enum, flags or struct) as a file carries it.
 struct TypeDefinition {
   std::string name;
@@ -88,7 +96,8 @@ struct TypeDefinition {
 
 class LoadModel {
  public:
-  LoadModel(Registry& registry, std::string_view origin) : registry_(registry), origin_(origin) {}
+  LoadModel(Registry& registry, std::string_view origin, const LoadOptions& options = {})
+      : registry_(registry), origin_(origin), options_(options) {}
   LoadModel(const LoadModel&) = delete;
   LoadModel& operator=(const LoadModel&) = delete;
   /// A load that did not commit leaves no class it defined behind.
@@ -112,7 +121,10 @@ class LoadModel {
   /// error at @p at.
   const MetaType& resolve_type(std::size_t at, const TypeDefinition& def);
   /// The class named @p name, defined from @p def when this program does not know it (def may be null).
-  const MetaInstance& resolve_class(std::size_t at, const std::string& name, const ClassDefinition* def);
+  /// A class that neither the program nor the file defines is an error, or with
+  /// UnknownClasses::Placeholder a stand-in made from its @p saved properties (make_placeholder()).
+  const MetaInstance& resolve_class(std::size_t at, const std::string& name, const ClassDefinition* def,
+                                    std::span<const SavedProperty> saved = {});
   /// How a saved property @p prop of type @p type_name (empty: unknown) of @p cls maps to today's class;
   /// schema differences are reported in warnings_.
   Slot make_slot(std::size_t at, const MetaInstance& cls, std::string_view prop, std::string_view type_name);
@@ -162,6 +174,7 @@ class LoadModel {
 
   Registry& registry_;
   std::string_view origin_;
+  LoadOptions options_;
   std::uint8_t kind_ = kind_state;
   int version_ = 1;
   std::deque<ClassEntry> classes_;  // a deque: entries never move while instances point at them
@@ -181,6 +194,8 @@ class LoadModel {
 
  private:
   void check_composite_cycles() const;
+  const MetaInstance& make_placeholder(std::size_t at, const std::string& name,
+                                       std::span<const SavedProperty> saved);
 
   std::deque<std::vector<std::uint8_t>> arena_;  // chunks that are filled, never grown
   [[nodiscard]] const SavedInstance* find(Id id) const {
@@ -196,6 +211,7 @@ class LoadModel {
   // else "top". A load attaches them (or, as a whole state with a Database, restores them as its children).
   std::vector<Id> roots_;
   std::vector<const MetaInstance*> defined_;
+  std::vector<const MetaInstance*> placeholders_;  // stand-ins (also in defined_, which removes them)
   std::vector<const MetaType*> defined_types_;
   bool committed_ = false;
 };

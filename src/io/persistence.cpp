@@ -88,14 +88,14 @@ std::vector<std::uint8_t> write(detail::SaveSet& set, Format format) {
 }
 
 std::unique_ptr<detail::LoadModel> read(Registry& registry, std::span<const std::uint8_t> bytes,
-                                        std::string_view origin) {
-  return format_of(bytes, origin) == Format::Text ? detail::read_text(registry, bytes, origin)
-                                                  : detail::read_binary(registry, bytes, origin);
+                                        std::string_view origin, const LoadOptions& options) {
+  return format_of(bytes, origin) == Format::Text ? detail::read_text(registry, bytes, origin, options)
+                                                  : detail::read_binary(registry, bytes, origin, options);
 }
 
 LoadReport load_into(SimState& state, Node* parent, std::span<const std::uint8_t> bytes,
-                     std::string_view origin) {
-  LoadReport report = read(state.environment().registry(), bytes, origin)->apply(state, parent);
+                     std::string_view origin, const LoadOptions& options = {}) {
+  LoadReport report = read(state.environment().registry(), bytes, origin, options)->apply(state, parent);
   report.format = format_of(bytes, origin);
   return report;
 }
@@ -138,8 +138,9 @@ std::vector<std::uint8_t> save_bytes(const Node& root, Format format, SaveReport
   return write(set, format);
 }
 
-LoadReport check_bytes(std::span<const std::uint8_t> bytes, std::string_view origin, Registry& registry) {
-  LoadReport report = read(registry, bytes, origin)->summary();
+LoadReport check_bytes(std::span<const std::uint8_t> bytes, std::string_view origin, Registry& registry,
+                       const LoadOptions& options) {
+  LoadReport report = read(registry, bytes, origin, options)->summary();
   report.format = format_of(bytes, origin);
   return report;
 }
@@ -150,6 +151,16 @@ LoadReport load_bytes(SimState& state, std::span<const std::uint8_t> bytes, std:
 
 LoadReport load_bytes(Node& parent, std::span<const std::uint8_t> bytes, std::string_view origin) {
   return load_into(parent.state(), &parent, bytes, origin);
+}
+
+LoadReport load_bytes(SimState& state, std::span<const std::uint8_t> bytes, std::string_view origin,
+                      const LoadOptions& options) {
+  return load_into(state, nullptr, bytes, origin, options);
+}
+
+LoadReport load_bytes(Node& parent, std::span<const std::uint8_t> bytes, std::string_view origin,
+                      const LoadOptions& options) {
+  return load_into(parent.state(), &parent, bytes, origin, options);
 }
 
 SaveReport save(const SimState& state, const std::filesystem::path& path, Format format) {
@@ -178,6 +189,14 @@ LoadReport load(SimState& state, const std::filesystem::path& path) {
 
 LoadReport load(Node& parent, const std::filesystem::path& path) {
   return load_bytes(parent, read_file(path), path.string());
+}
+
+LoadReport load(SimState& state, const std::filesystem::path& path, const LoadOptions& options) {
+  return load_bytes(state, read_file(path), path.string(), options);
+}
+
+LoadReport load(Node& parent, const std::filesystem::path& path, const LoadOptions& options) {
+  return load_bytes(parent, read_file(path), path.string(), options);
 }
 
 }  // namespace vsd::io

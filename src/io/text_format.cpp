@@ -230,8 +230,9 @@ std::string_view as_text(std::span<const std::uint8_t> bytes) {
 
 class TextSnapshotReader final : public LoadModel {
  public:
-  TextSnapshotReader(Registry& registry, std::span<const std::uint8_t> bytes, std::string_view origin)
-      : LoadModel(registry, origin), in_(as_text(bytes), origin) {
+  TextSnapshotReader(Registry& registry, std::span<const std::uint8_t> bytes, std::string_view origin,
+                     const LoadOptions& options)
+      : LoadModel(registry, origin, options), in_(as_text(bytes), origin) {
     // A UTF-8 byte order mark is allowed before the JSON text.
     if (as_text(bytes).substr(0, 3) == "\xEF\xBB\xBF") in_.seek(3);
   }
@@ -543,7 +544,9 @@ class TextSnapshotReader final : public LoadModel {
       if (def->base.empty()) fail_at(at, "run-time class '" + *name + "' needs a \"base\"");
     }
     if (by_name_.count(*name) != 0) fail_at(at, "class '" + *name + "' is listed twice");
-    TextClass& tc = text_class(at, *name, def ? &*def : nullptr);
+    std::vector<SavedProperty> listed(saved.size());
+    for (std::size_t i = 0; i < saved.size(); ++i) listed[i] = {saved[i].first, saved[i].second, saved_at[i]};
+    TextClass& tc = text_class(at, *name, def ? &*def : nullptr, listed);
     for (std::size_t i = 0; i < saved.size(); ++i) {
       if (!tc.file_types.emplace(saved[i].first, i).second)
         fail_at(saved_at[i], "property '" + saved[i].first + "' is listed twice");
@@ -588,10 +591,11 @@ class TextSnapshotReader final : public LoadModel {
     return {std::move(*name), type, flags, std::move(value)};
   }
 
-  TextClass& text_class(std::size_t at, const std::string& name, const ClassDefinition* def) {
+  TextClass& text_class(std::size_t at, const std::string& name, const ClassDefinition* def,
+                        std::span<const SavedProperty> saved = {}) {
     if (auto it = by_name_.find(name); it != by_name_.end()) return it->second;
     ClassEntry& entry = classes_.emplace_back();
-    entry.cls = &resolve_class(at, name, def);
+    entry.cls = &resolve_class(at, name, def, saved);
     return by_name_.emplace(name, TextClass{&entry, {}, {}, {}, {}, {}, {}, {}, {}}).first->second;
   }
 
@@ -746,8 +750,8 @@ class TextSnapshotReader final : public LoadModel {
 }  // namespace
 
 std::unique_ptr<LoadModel> read_text(Registry& registry, std::span<const std::uint8_t> bytes,
-                                     std::string_view origin) {
-  auto reader = std::make_unique<TextSnapshotReader>(registry, bytes, origin);
+                                     std::string_view origin, const LoadOptions& options) {
+  auto reader = std::make_unique<TextSnapshotReader>(registry, bytes, origin, options);
   reader->read();
   return reader;
 }

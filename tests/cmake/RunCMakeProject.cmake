@@ -4,13 +4,20 @@
 #   cmake -DACTION=consumer -DSOURCE_DIR=<consumer> -DBINARY_DIR=<dir> [-DVSD_PREFIX=<prefix>]
 #         [-DVSD_SOURCE_DIR=<vsd>] [common] -P RunCMakeProject.cmake
 #
-# common: -DGENERATOR= -DMAKE_PROGRAM= -DCXX_COMPILER= -DCTEST_COMMAND= -DEIGEN3_DIR= -DVSD_WERROR=
+#   cmake -DACTION=configure -DSOURCE_DIR=<consumer> -DBINARY_DIR=<dir> [-DVSD_DIR=<dir>]
+#         [-DEXPECT_ERROR=<regex>] [common] -P RunCMakeProject.cmake
 #
-# install : fresh Release build of vsd (no tests/examples/benchmarks), then `cmake --install` into
-#           VSD_PREFIX (wiped first, so nothing stale can hide a missing install rule).
-# consumer: Release build of a consumer project, then its own ctest (which runs the consumer binary).
-#           With VSD_PREFIX the project must find vsd there via find_package; with VSD_SOURCE_DIR it
-#           gets the vsd source tree.
+# common: -DGENERATOR= -DMAKE_PROGRAM= -DCXX_COMPILER= -DCTEST_COMMAND= -DEIGEN3_DIR= -DVSD_WERROR=
+#         -DEXTRA_ARGS=<-D...>|<-D...>  further configure arguments, separated by '|'
+#
+# install  : fresh Release build of vsd (no tests/examples/benchmarks/tools; the modules EXTRA_ARGS leaves
+#            on), then `cmake --install` into VSD_PREFIX (wiped first, so nothing stale can hide a missing
+#            install rule).
+# consumer : Release build of a consumer project, then its own ctest (which runs the consumer binary).
+#            With VSD_PREFIX the project must find vsd there via find_package; with VSD_SOURCE_DIR it
+#            gets the vsd source tree.
+# configure: configure (and generate) a consumer project only, against the package in VSD_DIR (a build
+#            tree's); with EXPECT_ERROR the configure must fail with output matching it.
 # Build trees are kept between runs, so re-runs are incremental.
 cmake_minimum_required(VERSION 3.21)
 
@@ -51,13 +58,17 @@ endif()
 if(EIGEN3_DIR)
   list(APPEND configure_args "-DEigen3_DIR=${EIGEN3_DIR}")
 endif()
+if(EXTRA_ARGS)
+  string(REPLACE "|" ";" extra "${EXTRA_ARGS}")
+  list(APPEND configure_args ${extra})
+endif()
 
 if(ACTION STREQUAL "install")
   if(NOT VSD_PREFIX)
     message(FATAL_ERROR "RunCMakeProject.cmake: ACTION=install needs VSD_PREFIX")
   endif()
   list(APPEND configure_args -DVSD_BUILD_TESTS=OFF -DVSD_BUILD_EXAMPLES=OFF -DVSD_BUILD_BENCHMARKS=OFF
-                             -DVSD_INSTALL=ON "-DCMAKE_INSTALL_PREFIX=${VSD_PREFIX}")
+                             -DVSD_BUILD_TOOLS=OFF -DVSD_INSTALL=ON "-DCMAKE_INSTALL_PREFIX=${VSD_PREFIX}")
   if(DEFINED VSD_WERROR AND NOT VSD_WERROR STREQUAL "")
     list(APPEND configure_args "-DVSD_WERROR=${VSD_WERROR}")
   endif()
@@ -88,6 +99,24 @@ elseif(ACTION STREQUAL "consumer")
   run_step("build consumer" "${CMAKE_COMMAND}" --build "${BINARY_DIR}" --config ${config} --parallel ${jobs})
   run_step("run consumer" "${CTEST_COMMAND}" --test-dir "${BINARY_DIR}" -C ${config}
            --output-on-failure --no-tests=error)
+elseif(ACTION STREQUAL "configure")
+  if(VSD_DIR)
+    list(APPEND configure_args "-Dvsd_DIR=${VSD_DIR}")
+  endif()
+  if(NOT EXPECT_ERROR)
+    run_step("configure consumer" "${CMAKE_COMMAND}" ${configure_args})
+  else()
+    message(STATUS "---- configure consumer (must fail)")
+    execute_process(COMMAND "${CMAKE_COMMAND}" ${configure_args} RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                    ERROR_VARIABLE err)
+    if(rc EQUAL 0)
+      message(FATAL_ERROR "the configure succeeded; it should have failed with: ${EXPECT_ERROR}")
+    endif()
+    if(NOT "${out}${err}" MATCHES "${EXPECT_ERROR}")
+      message(FATAL_ERROR "the configure failed, but without '${EXPECT_ERROR}':\n${out}${err}")
+    endif()
+    message(STATUS "failed as expected: ${EXPECT_ERROR}")
+  endif()
 else()
   message(FATAL_ERROR "RunCMakeProject.cmake: unknown ACTION '${ACTION}'")
 endif()

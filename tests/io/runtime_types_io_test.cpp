@@ -1,14 +1,12 @@
 // Files carry the run-time types (enums, flags, structs) their classes use, and qualified class names.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <random>
 
 #include "io_model.hpp"
 #include "vsd/io/file.hpp"
 #include "vsd/io/snapshot.hpp"
-#include "vsd/io/tool.hpp"
 
 using testing::ElementsAre;
 using testing::HasSubstr;
@@ -332,36 +330,6 @@ TEST(RunTimeTypeText, BadDefinitionsSayWhereAndWhat) {
       load_error(
           "{\"type\": \"IoRtBad\", \"kind\": \"struct\", \"fields\": [[\"a\", \"int32\"]], \"values\": []}"),
       "t.json:3:77: struct 'IoRtBad' has fields, not values");
-}
-
-// A program that never defined the types (the stock tool) inspects the file and converts it unchanged.
-TEST(RunTimeTypeTool, TreeAndConvert) {
-  const Written w = write_with_types(Format::Text);
-  const auto dir = std::filesystem::temp_directory_path() / ("vsd_rt_tool_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  vsd::io::write_file_atomically(dir / "in.json", w.bytes);
-  auto run = [](std::vector<std::string> args, std::string* out) {
-    std::vector<std::string_view> views(args.begin(), args.end());
-    std::ostringstream o, e;
-    const int status = vsd::io::run_tool(views, o, e);
-    *out = o.str() + e.str();
-    return status;
-  };
-  std::string out;
-  ASSERT_EQ(run({"tree", (dir / "in.json").string(), "--values"}, &out), 0) << out;
-  EXPECT_THAT(out, HasSubstr("main: {\"label\": \"first\", \"color\": \"Red\", \"at\": [1, 2, 3]}"));
-  EXPECT_THAT(out, HasSubstr("access: \"Read|Write\""));
-  undefine_all();
-  ASSERT_EQ(run({"info", (dir / "in.json").string()}, &out), 0) << out;
-  EXPECT_THAT(out, HasSubstr("format:    text (vsd-text 2)"));
-  EXPECT_THAT(out, HasSubstr("run-time types defined by the file: IoRtColor IoRtTag IoRtAccess"));
-  undefine_all();
-  ASSERT_EQ(run({"convert", (dir / "in.json").string(), (dir / "out.vsds").string()}, &out), 0) << out;
-  undefine_all();
-  ASSERT_EQ(run({"convert", (dir / "out.vsds").string(), (dir / "back.json").string()}, &out), 0) << out;
-  EXPECT_EQ(vsd::io::read_file(dir / "back.json"), w.bytes) << "text -> binary -> text: byte-identical";
-  undefine_all();
-  std::filesystem::remove_all(dir);
 }
 
 INSTANTIATE_TEST_SUITE_P(Formats, Files, testing::Values(Format::Binary, Format::Text),

@@ -306,36 +306,6 @@ TEST_F(SimulationTest, BodiesSaveAndLoadThroughVsdIoAndGoOnIdentically) {
   EXPECT_TRUE(bodies[0]->linear_velocity().isApprox(rb.linear_velocity(), 1e-12));
 }
 
-TEST_F(SimulationTest, ToolSimulatesASavedSceneAndReportsErrors) {
-  auto& box = hull(geometry(GeometryKind::Box, Eigen::Vector3d(0.2, 0.2, 0.2)), at(1, 2, 3), nullptr, nullptr,
-                   "crate");
-  body(box);
-  ground();
-  const auto path = std::filesystem::temp_directory_path() / "vsd_physics_tool_test.json";
-  vsd::io::save(s, path, vsd::io::Format::Text);
-  std::ostringstream out;
-  std::ostringstream err;
-  const std::string file = path.string();
-  const std::vector<std::string_view> args{file, "--steps", "2000", "--dt", "0.001"};
-  EXPECT_EQ(run_tool(args, out, err), 0) << err.str();
-  EXPECT_THAT(out.str(), HasSubstr("simulated 2 s (2000 steps of 0.001 s): 1 bodies"));
-  EXPECT_THAT(out.str(),
-              HasSubstr("/scene/crate: position 1.000000 2.000000 0.09"));  // resting on the ground
-  // A body without mass in the file: the error, exit code 1.
-  auto& n = s.create<scene::Node3D>();
-  n.set_name("ghost");
-  scene_root().add_child(n);
-  n.add_extension(s.create<RigidBody>());
-  vsd::io::save(s, path, vsd::io::Format::Text);
-  std::ostringstream out2;
-  std::ostringstream err2;
-  EXPECT_EQ(run_tool(args, out2, err2), 1);
-  EXPECT_THAT(err2.str(), HasSubstr("/scene/ghost"));
-  const std::vector<std::string_view> bad{"--steps", "x"};
-  EXPECT_EQ(run_tool(bad, out2, err2), 2);
-  std::filesystem::remove(path);
-}
-
 std::string two_link_urdf(const char* type) {
   return std::string(R"(<robot name="r">
   <link name="base"><inertial><mass value="2"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>

@@ -1,5 +1,5 @@
-// vsd-io: the command-line tool for vsd files (`vsd-io --help`). All of it lives in vsd::io::run_tool, so
-// a program that links its own classes can offer the same tool for its files with this one line.
-#include "vsd/io/tool.hpp"
+// vsd-io (`vsd-io --help`): all of it is vsd::tool::vsd_io::run (tool.hpp), so the tests run it in-process.
+#include "tool.hpp"
+#include "vsd_tool/runner.hpp"
 
-int main(int argc, char** argv) { return vsd::io::run_tool(argc, argv); }
+int main(int argc, char** argv) { return vsd::tool::main(argc, argv, vsd::tool::vsd_io::run); }

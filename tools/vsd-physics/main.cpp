@@ -1,12 +1,5 @@
-// vsd-physics: simulate a URDF or a saved scene and print the final poses (`vsd-physics --help`); all of
-// it is vsd::physics::run_tool.
-#include <iostream>
-#include <string_view>
-#include <vector>
+// vsd-physics (`vsd-physics --help`): all of it is vsd::tool::vsd_physics::run (tool.hpp), so the tests run it in-process.
+#include "tool.hpp"
+#include "vsd_tool/runner.hpp"
 
-#include "vsd/physics/tool.hpp"
-
-int main(int argc, char** argv) {
-  std::vector<std::string_view> args(argv + 1, argv + argc);
-  return vsd::physics::run_tool(args, std::cout, std::cerr);
-}
+int main(int argc, char** argv) { return vsd::tool::main(argc, argv, vsd::tool::vsd_physics::run); }

@@ -1,11 +1,5 @@
-// vsd-robot: kinematics of a robot description (`vsd-robot --help`); all of it is vsd::robotics::run_tool.
-#include <iostream>
-#include <string_view>
-#include <vector>
+// vsd-robot (`vsd-robot --help`): all of it is vsd::tool::vsd_robot::run (tool.hpp), so the tests run it in-process.
+#include "tool.hpp"
+#include "vsd_tool/runner.hpp"
 
-#include "vsd/robotics/tool.hpp"
-
-int main(int argc, char** argv) {
-  std::vector<std::string_view> args(argv + 1, argv + argc);
-  return vsd::robotics::run_tool(args, std::cout, std::cerr);
-}
+int main(int argc, char** argv) { return vsd::tool::main(argc, argv, vsd::tool::vsd_robot::run); }

@@ -1,12 +1,5 @@
-// vsd-scene: print the tree of a URDF or a saved scene (`vsd-scene --help`); all of it is
-// vsd::scene::run_tool.
-#include <iostream>
-#include <string_view>
-#include <vector>
+// vsd-scene (`vsd-scene --help`): all of it is vsd::tool::vsd_scene::run (tool.hpp), so the tests run it in-process.
+#include "tool.hpp"
+#include "vsd_tool/runner.hpp"
 
-#include "vsd/scene/tool.hpp"
-
-int main(int argc, char** argv) {
-  std::vector<std::string_view> args(argv + 1, argv + argc);
-  return vsd::scene::run_tool(args, std::cout, std::cerr);
-}
+int main(int argc, char** argv) { return vsd::tool::main(argc, argv, vsd::tool::vsd_scene::run); }

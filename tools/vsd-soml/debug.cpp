@@ -6,10 +6,9 @@
 #include <unistd.h>
 
 #include <charconv>
-#include <fstream>
-#include <iostream>
+#include <istream>
+#include <ostream>
 #include <sstream>
-#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -17,10 +16,14 @@
 #include "vsd/core/error.hpp"
 #include "vsd/core/node.hpp"
 #include "vsd/soml.hpp"
+#include "vsd_tool/arguments.hpp"
+#include "vsd_tool/input.hpp"
+#include "vsd_tool/models.hpp"
+#include "vsd_tool/text.hpp"
+
+namespace vsd::tool::vsd_soml {
 
 namespace {
-
-namespace soml = vsd::soml;
 
 constexpr const char* kHelp =
     "Commands (a word may be shortened to its first letter where shown):\n"
@@ -62,10 +65,10 @@ std::string firing_text(const soml::Firing& f) {
 
 class Session {
  public:
-  Session(soml::Program& p, std::string file, std::uint64_t limit)
-      : program_(p), dbg_(p), file_(std::move(file)), limit_(limit), echo_(isatty(0) == 0) {
+  Session(soml::Program& p, std::string file, std::uint64_t limit, std::istream& in, std::ostream& out)
+      : in_(in), out_(out), program_(p), dbg_(p), file_(std::move(file)), limit_(limit), echo_(isatty(0) == 0) {
     dbg_.on_firing([this](const soml::Firing& f) {
-      if (trace_) std::cout << firing_text(f) << "\n";
+      if (trace_) out_ << firing_text(f) << "\n";
     });
     dbg_.on_stop([this](soml::Debugger&, const soml::Stop& s) { return stopped(s); });
   }
@@ -76,15 +79,15 @@ class Session {
                           what.find_first_not_of("0123456789") == std::string_view::npos);
     if (is_line) {
       const int id = dbg_.break_at(what);
-      std::cout << "breakpoint " << id << " at " << file_ << ":" << dbg_.breakpoints().back().line << "\n";
+      out_ << "breakpoint " << id << " at " << file_ << ":" << dbg_.breakpoints().back().line << "\n";
     } else {
       const int id = dbg_.break_on_transition(what);
-      std::cout << "breakpoint " << id << " on transition " << what << "\n";
+      out_ << "breakpoint " << id << " on transition " << what << "\n";
     }
   }
   void add_transition_break(std::string_view what) {
     const int id = dbg_.break_on_transition(what);
-    std::cout << "breakpoint " << id << " on transition " << what << "\n";
+    out_ << "breakpoint " << id << " on transition " << what << "\n";
   }
 
   // The top level: between firings.
@@ -100,9 +103,9 @@ class Session {
         } else if (cmd == "n" || cmd == "next") {
           run(1, false);
         } else if (cmd == "finish") {
-          std::cout << "finish: no function is running (continue runs the net)\n";
+          out_ << "finish: no function is running (continue runs the net)\n";
         } else if (cmd == "bt" || cmd == "locals" || cmd == "frame") {
-          std::cout << cmd << ": no code is running (the program is between firings)\n";
+          out_ << cmd << ": no code is running (the program is between firings)\n";
         } else if (!common(cmd, rest)) {
           return 0;
         }
@@ -129,18 +132,18 @@ class Session {
   }
 
   bool read(std::string& line) {
-    std::cout << "(soml) " << std::flush;
-    if (!std::getline(std::cin, line)) {
-      std::cout << (echo_ ? "end of input\n" : "\n");
+    out_ << "(soml) " << std::flush;
+    if (!std::getline(in_, line)) {
+      out_ << (echo_ ? "end of input\n" : "\n");
       return false;
     }
-    if (echo_) std::cout << line << "\n";
+    if (echo_) out_ << line << "\n";
     return true;
   }
 
   void run(std::uint64_t n, bool step_into) {
     if (n == 0) {
-      std::cout << "the firing limit (" << limit_ << ") is reached\n";
+      out_ << "the firing limit (" << limit_ << ") is reached\n";
       return;
     }
     // Stepping ends when control comes back here: the next command starts afresh.
@@ -150,16 +153,16 @@ class Session {
       fired = program_.step(n);
     } catch (const vsd::Error& e) {
       dbg_.step_into_next(false);
-      std::cout << e.what() << "\n";
+      out_ << e.what() << "\n";
       return;
     }
     dbg_.step_into_next(false);
     if (fired == 0) {
-      std::cout << "no transition is enabled: the net is quiet\n";
+      out_ << "no transition is enabled: the net is quiet\n";
       return;
     }
     // step(n) ends early only when no transition is enabled.
-    std::cout << fired << (fired == 1 ? " firing" : " firings") << (fired < n ? ", quiet" : "") << "\n";
+    out_ << fired << (fired == 1 ? " firing" : " firings") << (fired < n ? ", quiet" : "") << "\n";
   }
 
   // Commands that work everywhere. False: quit.
@@ -167,49 +170,49 @@ class Session {
     try {
       if (cmd == "b" || cmd == "break") {
         if (rest.empty())
-          std::cout << "break needs LINE, FILE:LINE or a transition name\n";
+          out_ << "break needs LINE, FILE:LINE or a transition name\n";
         else
           add_break(rest);
       } else if (cmd == "d" || cmd == "delete") {
         int id = 0;
         const auto r = std::from_chars(rest.data(), rest.data() + rest.size(), id);
         if (rest.empty() || r.ec != std::errc() || r.ptr != rest.data() + rest.size())
-          std::cout << "delete needs a breakpoint number\n";
+          out_ << "delete needs a breakpoint number\n";
         else if (dbg_.remove(id))
-          std::cout << "deleted breakpoint " << id << "\n";
+          out_ << "deleted breakpoint " << id << "\n";
         else
-          std::cout << "no breakpoint " << id << "\n";
+          out_ << "no breakpoint " << id << "\n";
       } else if (cmd == "breaks") {
-        if (dbg_.breakpoints().empty()) std::cout << "no breakpoints\n";
+        if (dbg_.breakpoints().empty()) out_ << "no breakpoints\n";
         for (const soml::Breakpoint& b : dbg_.breakpoints())
-          std::cout << "  " << b.id << ": "
+          out_ << "  " << b.id << ": "
                     << (b.line != 0 ? file_ + ":" + std::to_string(b.line) : "transition " + b.transition)
                     << ", " << b.hits << (b.hits == 1 ? " hit" : " hits") << "\n";
       } else if (cmd == "p" || cmd == "print") {
         if (rest.empty())
-          std::cout << "print needs a name\n";
+          out_ << "print needs a name\n";
         else
-          std::cout << dbg_.print(rest, frame_) << "\n";
+          out_ << dbg_.print(rest, frame_) << "\n";
       } else if (cmd == "m" || cmd == "marking") {
-        std::cout << dbg_.marking();
+        out_ << dbg_.marking();
       } else if (cmd == "trace") {
         if (rest == "on" || rest == "off") {
           trace_ = rest == "on";
-          std::cout << "trace " << rest << "\n";
+          out_ << "trace " << rest << "\n";
         } else {
-          std::cout << "trace takes on or off\n";
+          out_ << "trace takes on or off\n";
         }
       } else if (cmd == "h" || cmd == "help") {
-        std::cout << kHelp;
+        out_ << kHelp;
       } else if (cmd == "q" || cmd == "quit") {
         throw Quit{};
       } else {
-        std::cout << "unknown command '" << cmd << "' (help lists the commands)\n";
+        out_ << "unknown command '" << cmd << "' (help lists the commands)\n";
       }
     } catch (const vsd::Error& e) {
       std::string m = e.what();
       if (m.rfind("SOML++ debugger: ", 0) == 0) m = m.substr(17);
-      std::cout << m << "\n";
+      out_ << m << "\n";
     }
     return true;
   }
@@ -217,13 +220,13 @@ class Session {
   soml::Resume stopped(const soml::Stop& s) {
     frame_ = 0;
     if (s.reason == soml::StopReason::Transition) {
-      std::cout << "stopped before " << soml::net_node_label(s.transition) << " fires";
-      if (s.mark != 0) std::cout << ", mark " << label(s.mark);
-      std::cout << " (breakpoint " << s.breakpoint << ")\n";
+      out_ << "stopped before " << soml::net_node_label(s.transition) << " fires";
+      if (s.mark != 0) out_ << ", mark " << label(s.mark);
+      out_ << " (breakpoint " << s.breakpoint << ")\n";
     } else {
-      std::cout << "stopped at " << file_ << ":" << s.line << " in " << s.function;
-      if (s.breakpoint != 0) std::cout << " (breakpoint " << s.breakpoint << ")";
-      std::cout << "\n" << s.line << "\t" << source_line(s.line) << "\n";
+      out_ << "stopped at " << file_ << ":" << s.line << " in " << s.function;
+      if (s.breakpoint != 0) out_ << " (breakpoint " << s.breakpoint << ")";
+      out_ << "\n" << s.line << "\t" << source_line(s.line) << "\n";
     }
     for (std::string line; read(line);) {
       auto [cmd, rest] = split_command(line);
@@ -234,32 +237,32 @@ class Session {
       if (cmd == "finish") return soml::Resume::Finish;
       if (cmd == "bt") {
         const auto stack = dbg_.call_stack();
-        if (stack.empty()) std::cout << "no code is running (a transition is about to fire)\n";
+        if (stack.empty()) out_ << "no code is running (a transition is about to fire)\n";
         for (std::size_t i = 0; i < stack.size(); ++i) {
-          std::cout << (i == frame_ ? "* " : "  ") << "#" << i << " " << stack[i].function << " ("
+          out_ << (i == frame_ ? "* " : "  ") << "#" << i << " " << stack[i].function << " ("
                     << stack[i].file << ":" << stack[i].line << ")";
-          if (stack[i].mark != 0) std::cout << " mark " << label(stack[i].mark);
-          std::cout << "\n";
+          if (stack[i].mark != 0) out_ << " mark " << label(stack[i].mark);
+          out_ << "\n";
         }
       } else if (cmd == "frame") {
         std::size_t k = 0;
         const auto r = std::from_chars(rest.data(), rest.data() + rest.size(), k);
         const std::size_t depth = dbg_.call_stack().size();
         if (rest.empty() || r.ec != std::errc() || r.ptr != rest.data() + rest.size() || k >= depth) {
-          std::cout << "frame needs a number from 0 to " << (depth == 0 ? 0 : depth - 1) << "\n";
+          out_ << "frame needs a number from 0 to " << (depth == 0 ? 0 : depth - 1) << "\n";
         } else {
           frame_ = k;
           const auto f = dbg_.call_stack()[k];
-          std::cout << "#" << k << " " << f.function << " (" << f.file << ":" << f.line << ")\n";
+          out_ << "#" << k << " " << f.function << " (" << f.file << ":" << f.line << ")\n";
         }
       } else if (cmd == "locals") {
         if (dbg_.call_stack().empty()) {
-          std::cout << "no code is running (a transition is about to fire)\n";
+          out_ << "no code is running (a transition is about to fire)\n";
           continue;
         }
         const auto vars = dbg_.locals(frame_);
-        if (vars.empty()) std::cout << "no locals\n";
-        for (const auto& v : vars) std::cout << "  " << v.type << " " << v.name << " = " << v.value << "\n";
+        if (vars.empty()) out_ << "no locals\n";
+        for (const auto& v : vars) out_ << "  " << v.type << " " << v.name << " = " << v.value << "\n";
       } else if (!common(cmd, rest)) {
         throw Quit{};
       }
@@ -285,6 +288,8 @@ class Session {
   std::string text_;
 
  private:
+  std::istream& in_;
+  std::ostream& out_;
   soml::Program& program_;
   soml::Debugger dbg_;
   std::string file_;
@@ -296,68 +301,41 @@ class Session {
 
 }  // namespace
 
-int debug_command(const std::vector<std::string_view>& args) {
-  std::string file;
-  std::vector<std::string> breaks, tbreaks;
-  std::uint64_t limit = 1'000'000;
+int debug_command(std::span<const std::string_view> args, std::istream& in, std::ostream& out, std::ostream& err) {
+  const Arguments a(args, {repeated("--break"), repeated("--break-transition"), with_value("--seed"),
+                           with_value("--steps")});
+  a.expect_positional(1, 1, "one FILE");
+  const std::string_view path = a.positional()[0];
+  if (path == "-") throw UsageError("debug reads its commands from standard input: give the script as a file");
   soml::RunOptions options;
-  auto number = [](std::string_view v, const char* what) {
-    std::uint64_t n = 0;
-    const auto r = std::from_chars(v.data(), v.data() + v.size(), n);
-    if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size())
-      throw std::invalid_argument(std::string(what) + " needs a number, not '" + std::string(v) + "'");
-    return n;
-  };
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    auto value = [&]() {
-      if (i + 1 >= args.size()) throw std::invalid_argument(std::string(args[i]) + " needs a value");
-      return args[++i];
-    };
-    if (args[i] == "--break") {
-      breaks.emplace_back(value());
-    } else if (args[i] == "--break-transition") {
-      tbreaks.emplace_back(value());
-    } else if (args[i] == "--seed") {
-      options.seed = number(value(), "--seed");
-    } else if (args[i] == "--steps") {
-      limit = number(value(), "--steps");
-    } else if (!args[i].empty() && args[i][0] == '-') {
-      throw std::invalid_argument("unknown option '" + std::string(args[i]) + "'");
-    } else if (file.empty()) {
-      file = std::string(args[i]);
-    } else {
-      throw std::invalid_argument("debug takes one FILE");
-    }
-  }
-  if (file.empty()) throw std::invalid_argument("debug needs a FILE");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) {
-    std::cerr << "vsd-soml: cannot read '" << file << "'\n";
-    return 1;
-  }
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  vsd::Registry registry;
-  vsd::Environment env(0, registry);
-  auto& module = env.use<soml::Module>();
+  options.seed = a.unsigned_integer("--seed", options.seed, UINT64_MAX);
+  const std::uint64_t limit = a.unsigned_integer("--steps", 1'000'000, UINT64_MAX);
+  const std::string file(path);
+  const std::string text = read_text_input(path);
+  Workspace ws;
+  auto& module = ws.env().use<soml::Module>();
   soml::Program* p = nullptr;
   try {
-    p = &module.load(env.main_state(), file, text, options);
+    p = &module.load(ws.state(), file, text, options);
   } catch (const vsd::Error& e) {
-    std::cerr << e.what() << (std::string(e.what()).ends_with("\n") ? "" : "\n");
+    const std::string m = printable_lines(e.what());
+    err << m << (m.ends_with("\n") ? "" : "\n");
     return 1;
   }
-  Session session(*p, file, limit);
+  Session session(*p, file, limit, in, out);
   session.text_ = text;
-  std::cout << "vsd-soml debug: " << file << " loaded, " << p->places().size()
-            << " places; help lists the commands\n";
+  out << "vsd-soml debug: " << printable(file) << " loaded, " << p->places().size()
+      << " places; help lists the commands\n";
   try {
-    for (const auto& b : breaks) session.add_break(b);
-    for (const auto& b : tbreaks) session.add_transition_break(b);
+    for (const std::string_view b : a.values("--break")) session.add_break(b);
+    for (const std::string_view b : a.values("--break-transition")) session.add_transition_break(b);
   } catch (const vsd::Error& e) {
     std::string m = e.what();
     if (m.rfind("SOML++ debugger: ", 0) == 0) m = m.substr(17);
-    std::cerr << "vsd-soml: " << m << "\n";
+    err << "vsd-soml: " << printable(m) << "\n";
     return 2;
   }
   return session.loop();
 }
+
+}  // namespace vsd::tool::vsd_soml

@@ -1,8 +1,13 @@
 // `vsd-soml debug FILE [--break FILE:LINE]... [--break-transition NAME]... [--seed S] [--steps N]`: the
-// interactive debugger (commands on stdin). Throws std::invalid_argument for a usage error.
+// interactive debugger (commands from @p in, one per line). Throws vsd::tool::UsageError for a usage error.
 #pragma once
 
+#include <iosfwd>
+#include <span>
 #include <string_view>
-#include <vector>
 
-int debug_command(const std::vector<std::string_view>& args);
+namespace vsd::tool::vsd_soml {
+
+int debug_command(std::span<const std::string_view> args, std::istream& in, std::ostream& out, std::ostream& err);
+
+}  // namespace vsd::tool::vsd_soml

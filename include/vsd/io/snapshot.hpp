@@ -50,6 +50,25 @@ Format format_for(const std::filesystem::path& path);
 /// @brief The format of a file's content (by its first bytes). @throws vsd::Error when it is neither.
 Format format_of(std::span<const std::uint8_t> bytes, std::string_view origin = "file");
 
+/// @brief What a load does with a class that neither this program nor the file defines (an instance of a
+/// C++ class of another program, say).
+enum class UnknownClasses : std::uint8_t {
+  Refuse,      ///< the load fails with an error naming the class (the default)
+  /// A stand-in run-time class of that name is defined from what the file says: its base is the class of
+  /// this program whose saved properties the file lists first, with the same names, types and order (as a
+  /// save writes them, bases first: Node, say; vsd's core classes before a module's, the Database never),
+  /// its own properties are the other saved ones. References to classes nobody knows become references
+  /// to any instance; a property of a value type this program does not know is left out. The instances
+  /// load with their saved values, LoadReport::placeholder_classes names the stand-ins and a warning each
+  /// says what was made. A text file needs its "classes" table for this (it names the saved types).
+  Placeholder
+};
+
+/// @brief How a load treats what this program does not know.
+struct LoadOptions {
+  UnknownClasses unknown_classes = UnknownClasses::Refuse;
+};
+
 /// @brief What a save wrote.
 struct SaveReport {
   std::size_t instances = 0;
@@ -73,6 +92,8 @@ struct LoadReport {
   std::vector<std::string> defined_classes;
   /// Run-time value types (enums, flags, structs) the file defined that this program did not know.
   std::vector<std::string> defined_types;
+  /// Stand-ins made for classes neither this program nor the file defined (UnknownClasses::Placeholder).
+  std::vector<std::string> placeholder_classes;
   /// Schema differences found and handled: unknown properties, changed types.
   std::vector<std::string> warnings;
 };
@@ -92,12 +113,17 @@ LoadReport load_bytes(SimState& state, std::span<const std::uint8_t> bytes,
 /// @p parent, and its own values are not copied.
 LoadReport load_bytes(Node& parent, std::span<const std::uint8_t> bytes,
                       std::string_view origin = "snapshot");
+/// @brief load_bytes() with @p options (what to do with classes nobody defines).
+LoadReport load_bytes(SimState& state, std::span<const std::uint8_t> bytes, std::string_view origin,
+                      const LoadOptions& options);
+LoadReport load_bytes(Node& parent, std::span<const std::uint8_t> bytes, std::string_view origin,
+                      const LoadOptions& options);
 
 /// @brief Reads and checks a file (either format) as a load would, without loading it: what a load
 /// would report (LoadReport::roots stays empty). Run-time classes the file defines are defined while it
 /// is checked and removed again. @throws vsd::Error as a load would.
 LoadReport check_bytes(std::span<const std::uint8_t> bytes, std::string_view origin = "file",
-                       Registry& registry = Registry::global());
+                       Registry& registry = Registry::global(), const LoadOptions& options = {});
 
 /// @brief save_bytes() written with write_file_atomically(), in the format the file name asks for.
 SaveReport save(const SimState& state, const std::filesystem::path& path);
@@ -107,5 +133,7 @@ SaveReport save(const Node& root, const std::filesystem::path& path, Format form
 /// @brief load_bytes() of a file; errors name the file.
 LoadReport load(SimState& state, const std::filesystem::path& path);
 LoadReport load(Node& parent, const std::filesystem::path& path);
+LoadReport load(SimState& state, const std::filesystem::path& path, const LoadOptions& options);
+LoadReport load(Node& parent, const std::filesystem::path& path, const LoadOptions& options);
 
 }  // namespace vsd::io

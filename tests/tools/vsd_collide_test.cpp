@@ -1,37 +1,34 @@
-// vsd-collide (vsd::collision::run_tool): contacts and distances of a URDF and of a saved scene; usage
-// and file errors.
-#include "vsd/collision/tool.hpp"
+// vsd-collide, run in-process: contacts and distances of a URDF and of a saved scene; usage and file
+// errors.
+#include "vsd-collide/tool.hpp"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "tool_run.hpp"
 #include "vsd/collision.hpp"
 #include "vsd/core.hpp"
 #include "vsd/io.hpp"
 
-namespace vsd::collision {
+namespace vsd_collide_tool_test {
 namespace {
 
-const std::string data_dir = VSD_COLLISION_TEST_DATA_DIR;
+using vsd_tool_test::has;
+using vsd_tool_test::ToolRun;
+namespace collision = vsd::collision;
+namespace scene = vsd::scene;
+namespace io = vsd::io;
+using vsd::Environment;
+using vsd::SimState;
 
-struct ToolRun {
-  int code;
-  std::string out, err;
-};
+const std::string data_dir = VSD_TOOLS_COLLISION_DATA_DIR;
 
-ToolRun run(std::vector<std::string_view> args) {
-  std::ostringstream out, err;
-  const int code = run_tool(args, out, err);
-  return {code, out.str(), err.str()};
-}
+ToolRun run(const std::vector<std::string>& args) { return vsd_tool_test::run_tool(vsd::tool::vsd_collide::run, args); }
 
-bool has(const std::string& text, const std::string& piece) { return text.find(piece) != std::string::npos; }
-
-TEST(CollideTool, ListsTheContactsOfAUrdf) {
+TEST(VsdCollide, ListsTheContactsOfAUrdf) {
   const std::string file = data_dir + "/table_and_arm.urdf";
   ToolRun r = run({file});
   ASSERT_EQ(r.code, 0) << r.err;
@@ -46,7 +43,7 @@ TEST(CollideTool, ListsTheContactsOfAUrdf) {
   EXPECT_TRUE(has(r.err, "its mesh has no vertices")) << r.err;
 }
 
-TEST(CollideTool, OptionsSelectSameLinkPairsVisualHullsAndDistances) {
+TEST(VsdCollide, OptionsSelectSameLinkPairsVisualHullsAndDistances) {
   const std::string file = data_dir + "/table_and_arm.urdf";
   ToolRun r = run({file, "--same-link"});
   ASSERT_EQ(r.code, 0) << r.err;
@@ -75,11 +72,11 @@ TEST(CollideTool, OptionsSelectSameLinkPairsVisualHullsAndDistances) {
   EXPECT_TRUE(has(r.out, "distance table/top - block/body: -")) << r.out;  // overlapping: negative
 }
 
-TEST(CollideTool, ReadsASavedScene) {
+TEST(VsdCollide, ReadsASavedScene) {
   const auto file = std::filesystem::temp_directory_path() / "vsd_collide_tool_test.json";
   {
     Environment env;
-    env.use<Module>();
+    env.use<collision::Module>();
     SimState& s = env.main_state();
     auto& g = s.create<scene::Geometry>();
     g.set_kind(scene::GeometryKind::Sphere);
@@ -108,7 +105,7 @@ TEST(CollideTool, ReadsASavedScene) {
   EXPECT_FALSE(has(r.out, "ball2")) << r.out;
 }
 
-TEST(CollideTool, UsageAndFileErrors) {
+TEST(VsdCollide, UsageAndFileErrors) {
   EXPECT_EQ(run({}).code, 2);
   EXPECT_EQ(run({"--frobnicate", "x.urdf"}).code, 2);
   EXPECT_EQ(run({"a.urdf", "b.urdf"}).code, 2);
@@ -123,5 +120,15 @@ TEST(CollideTool, UsageAndFileErrors) {
   EXPECT_EQ(bad.code, 1);
 }
 
+TEST(VsdCollide, ReadsStandardInputAndSaysADirectoryIsOne) {
+  const std::string urdf = vsd_tool_test::TempDir::read(data_dir + "/table_and_arm.urdf");
+  const ToolRun r = vsd_tool_test::run_tool_with_stdin(vsd::tool::vsd_collide::run, {"-"}, urdf);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "1 pairs in contact")) << r.out;
+  const ToolRun dir = run({data_dir});
+  EXPECT_EQ(dir.code, 1);
+  EXPECT_TRUE(has(dir.err, "is a directory")) << dir.err;
+}
+
 }  // namespace
-}  // namespace vsd::collision
+}  // namespace vsd_collide_tool_test

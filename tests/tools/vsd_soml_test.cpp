@@ -1,0 +1,97 @@
+// vsd-soml, run in-process: scripts that need their C++ host, atomic conversion, standard input,
+// directories and bad numbers. (The run and debugger goldens drive the executable: tests/tools/CMakeLists.txt.)
+#include "vsd-soml/tool.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tool_run.hpp"
+
+namespace vsd_soml_tool_test {
+namespace {
+
+using testing::HasSubstr;
+using vsd_tool_test::TempDir;
+using vsd_tool_test::ToolRun;
+
+int entry(std::span<const std::string_view> args, std::ostream& out, std::ostream& err) {
+  std::istringstream no_commands;
+  return vsd::tool::vsd_soml::run(args, no_commands, out, err);
+}
+
+ToolRun run(const std::vector<std::string>& args) { return vsd_tool_test::run_tool(entry, args); }
+
+const std::string nets = VSD_TOOLS_ANALYSIS_DATA_DIR;
+const std::string examples = VSD_TOOLS_EXAMPLES_DIR;
+
+TEST(VsdSoml, AScriptOfCppClassesSaysItNeedsItsHost) {
+  const ToolRun r = run({"run", examples + "/soml/supervisor.soml"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_THAT(r.err, HasSubstr("undefined class 'Tank'"));
+  EXPECT_THAT(r.err, HasSubstr("note: vsd-soml knows vsd's own classes, not Tank: a script that uses the C++ "
+                               "classes of its program runs in that program"));
+  EXPECT_THAT(r.err, HasSubstr("examples/soml/supervisor.cpp"));
+  // vsd's own module classes are known (a script may use the scene's).
+  const TempDir tmp("vsd_soml_scene");
+  const ToolRun scene = run({"run", tmp.write("s.soml", "shared<scene::Node3D> n;\nplace p = 1;\n")});
+  EXPECT_EQ(scene.code, 0) << scene.err;
+}
+
+TEST(VsdSoml, ConvertWritesAtomically) {
+  const TempDir tmp("vsd_soml_convert");
+  const std::string out = tmp.write("net.soml", "old\n");
+  ToolRun r;
+  {
+    const vsd_tool_test::FileSizeLimit full(64);
+    r = run({"convert", nets + "/Philosophers-PT-000005.pnml", out});
+  }
+  EXPECT_EQ(r.code, 1);
+  EXPECT_THAT(r.err, HasSubstr("net.soml"));
+  EXPECT_EQ(TempDir::read(out), "old\n") << "a failed write leaves the old file whole";
+  r = run({"convert", nets + "/Philosophers-PT-000005.pnml", out});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(TempDir::read(out), HasSubstr("place"));
+  // To standard output.
+  r = run({"convert", out, "-"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("place"));
+}
+
+TEST(VsdSoml, StandardInputAndDirectories) {
+  const std::string pnml = TempDir::read(nets + "/Philosophers-PT-000005.pnml");
+  const ToolRun r = vsd_tool_test::run_tool_with_stdin(entry, {"analyze", "-", "--json"}, pnml);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("\"states\": 243"));
+  const ToolRun script = vsd_tool_test::run_tool_with_stdin(entry, {"run", "-", "--steps", "1"},
+                                                             "place a = 1;\nplace b;\ntransition t;\narrow a -> t;\narrow t -> b;\n");
+  EXPECT_EQ(script.code, 0) << script.err;
+  EXPECT_THAT(script.out, HasSubstr("1 firing"));
+  for (const char* cmd : {"analyze", "run", "convert"}) {
+    std::vector<std::string> args{cmd, nets};
+    if (std::string(cmd) == "convert") args.push_back("/tmp/never-written.soml");
+    const ToolRun d = run(args);
+    EXPECT_EQ(d.code, 1) << cmd;
+    EXPECT_THAT(d.err, HasSubstr("analysis/data: is a directory")) << cmd;
+  }
+  EXPECT_EQ(run({"debug", "-"}).code, 2);  // debug reads its commands there
+}
+
+TEST(VsdSoml, NumbersAreStrict) {
+  const std::string net = nets + "/Philosophers-PT-000005.pnml";
+  for (const std::vector<std::string>& bad :
+       {std::vector<std::string>{"run", net, "--steps", "x"}, {"run", net, "--steps", "-1"},
+        {"run", net, "--seed", "1.5"}, {"run", net, "--steps", "99999999999999999999999"},
+        {"analyze", net, "--threads", "abc"}, {"analyze", net, "--threads", "2000"},
+        {"analyze", net, "--limit-mem", "lots"}, {"debug", net, "--steps", "1e3"}}) {
+    const ToolRun r = run(bad);
+    EXPECT_EQ(r.code, 2) << bad[2] << " " << bad[3];
+    EXPECT_THAT(r.err, HasSubstr("Try 'vsd-soml --help'."));
+  }
+}
+
+}  // namespace
+}  // namespace vsd_soml_tool_test
