@@ -37,6 +37,23 @@ TEST(IdMap, AgreesWithAStandardMapUnderRandomInsertsAndErases) {
   EXPECT_EQ(map.find(999999999), nullptr);
 }
 
+// Dense ids fill one long run of the table, each at its home slot. Erasing them in the order they were
+// made used to scan the rest of the run each time (a deep tree deleted from the top: quadratic).
+TEST(IdMap, ErasingDenseIdsInOrderIsQuick) {
+  constexpr vsd::Id n = 300'000;
+  vsd::detail::IdMap map;
+  for (vsd::Id id = 1; id <= n; ++id) map.insert(id, fake(id));
+  for (vsd::Id id = 1; id <= n / 2; ++id) map.erase(id);
+  ASSERT_EQ(map.size(), n - n / 2);
+  for (vsd::Id id = n; id > n / 2; id -= 7) ASSERT_EQ(map.find(id), fake(id));
+  EXPECT_EQ(map.find(n / 2), nullptr);
+  // Still right where entries are displaced: a second site's ids landing in the same run.
+  for (vsd::Id id = 1; id <= 1000; ++id) map.insert(vsd::Id{3} << 48 | id, fake(id));
+  for (vsd::Id id = n / 2 + 1; id <= n; ++id) map.erase(id);
+  for (vsd::Id id = 1; id <= 1000; ++id) ASSERT_EQ(map.find(vsd::Id{3} << 48 | id), fake(id)) << id;
+  EXPECT_EQ(map.size(), 1000u);
+}
+
 TEST(IdMap, EraseOfAMissingIdChangesNothing) {
   vsd::detail::IdMap map;
   map.erase(5);

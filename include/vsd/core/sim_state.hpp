@@ -191,6 +191,7 @@ class SimState : public Instance {
   std::unordered_map<const SimStateInstance*, std::unique_ptr<PropertySignal>> instance_signals_;
   std::vector<std::unique_ptr<PropertySignal>> type_exact_, type_tree_;
   std::vector<SimStateInstance*> graveyard_;  // deleted during a dispatch, freed when it ends
+  std::vector<SimStateInstance*>* cascade_ = nullptr;  // released instances still to delete (released())
   int dispatching_ = 0;
   std::size_t type_signals_ = 0;
   std::vector<std::uint8_t> recorded_;

@@ -47,6 +47,7 @@ class FlatIdMap {
       if (e.id == null_id) {
         e = Entry{id, value};
         ++size_;
+        note_reach(id, i);
         return true;
       }
       if (e.id == id) return false;
@@ -62,6 +63,7 @@ class FlatIdMap {
       if (e.id == null_id) {
         e = Entry{id, V{}};
         ++size_;
+        note_reach(id, i);
         return &e.value;
       }
       if (e.id == id) return nullptr;
@@ -88,11 +90,13 @@ class FlatIdMap {
     std::size_t i = slot(id);
     while (table_[i].id != null_id && table_[i].id != id) i = (i + 1) & mask_;
     if (table_[i].id == null_id) return;
-    // Backward-shift deletion: pull later entries of the probe run into the hole.
-    for (std::size_t j = (i + 1) & mask_; table_[j].id != null_id; j = (j + 1) & mask_) {
-      const std::size_t home = slot(table_[j].id);
-      const bool movable = i <= j ? (home <= i || home > j) : (home <= i && home > j);
-      if (movable) {
+    // Backward-shift deletion: pull later entries of the probe run into the hole. An entry can fill it
+    // when it sits at least as far from its home slot as from the hole; none sits farther than reach_,
+    // so the scan ends reach_ slots past the hole. (Dense ids fill one long run, each entry at home: a
+    // scan to the end of the run made erasing them in order quadratic.)
+    for (std::size_t j = (i + 1) & mask_; table_[j].id != null_id && ((j - i) & mask_) <= reach_;
+         j = (j + 1) & mask_) {
+      if (((j - slot(table_[j].id)) & mask_) >= ((j - i) & mask_)) {
         table_[i] = table_[j];
         i = j;
       }
@@ -105,6 +109,7 @@ class FlatIdMap {
     table_.clear();
     mask_ = 0;
     size_ = 0;
+    reach_ = 0;
   }
 
   /// Calls @p fn(id, value) for every entry, in no particular order.
@@ -134,6 +139,12 @@ class FlatIdMap {
     const std::uint64_t site = id >> 48;
     return static_cast<std::size_t>(id ^ (site * 0x9E3779B97F4A7C15ULL)) & mask_;
   }
+  // Keeps reach_ at least the distance of every entry from its home slot (a backward shift only brings
+  // entries nearer home, so it stays a bound until the table is rebuilt).
+  void note_reach(Id id, std::size_t at) noexcept {
+    const std::size_t d = (at - slot(id)) & mask_;
+    if (d > reach_) reach_ = d;
+  }
   void grow() { rehash(table_.empty() ? 16 : table_.size() * 2); }
   void rehash(std::size_t capacity) {
     std::vector<Entry, HugeAllocator<Entry>> old;
@@ -141,6 +152,7 @@ class FlatIdMap {
     table_.assign(capacity, Entry{});
     mask_ = table_.size() - 1;
     size_ = 0;
+    reach_ = 0;
     for (const Entry& e : old)
       if (e.id != null_id) insert(e.id, e.value);
   }
@@ -149,6 +161,7 @@ class FlatIdMap {
   std::vector<Entry, HugeAllocator<Entry>> table_;
   std::size_t mask_ = 0;
   std::size_t size_ = 0;
+  std::size_t reach_ = 0;  // no entry sits farther than this from its home slot
 };
 
 /// Instances of a SimState by id.
