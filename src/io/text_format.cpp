@@ -330,9 +330,28 @@ class TextSnapshotReader final : public LoadModel {
   };
 
   [[nodiscard]] std::string where(std::size_t at) const override {
-    TextReader r = in_;
-    r.seek(at);
-    return std::string(origin_) + ":" + std::to_string(r.line()) + ":" + std::to_string(r.column());
+    // Counted on from the last position asked for: warnings come in file order, and a file with many of
+    // them must not be scanned from its start for each.
+    const std::string_view text = in_.text();
+    at = std::min(at, text.size());
+    if (at < where_.pos) where_ = {};
+    for (; where_.pos < at; ++where_.pos)
+      if (text[where_.pos] == '\n') {
+        ++where_.line;
+        where_.line_start = where_.pos + 1;
+      }
+    return std::string(origin_) + ":" + std::to_string(where_.line) + ":" +
+           std::to_string(at - where_.line_start + 1);
+  }
+  [[nodiscard]] std::size_t list_element_at(std::size_t value_at, std::size_t k) const override {
+    TextReader r = in_;  // the list was read before: it is well formed
+    r.seek(value_at);
+    r.expect('[');
+    for (std::size_t i = 0; i < k; ++i) {
+      r.skip_value();
+      r.expect(',');
+    }
+    return r.token_start();
   }
 
   template <class F>
@@ -738,6 +757,9 @@ class TextSnapshotReader final : public LoadModel {
   }
 
   TextReader in_;
+  mutable struct {
+    std::size_t pos = 0, line = 1, line_start = 0;
+  } where_;  // where() counted lines up to pos
   std::unordered_map<std::string, TextClass> by_name_;
   std::vector<std::size_t> seen_;
   std::vector<std::uint8_t> bytes_;
