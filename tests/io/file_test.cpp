@@ -15,7 +15,7 @@
 #include <random>
 #include <thread>
 
-#include "memory_cap.hpp"
+#include "../core/memory_cap.hpp"
 #include "vsd/core/error.hpp"
 
 namespace {

@@ -6,9 +6,9 @@
 #include <random>
 #include <string_view>
 
+#include "../core/memory_cap.hpp"
 #include "../core/random_model.hpp"
 #include "io_model.hpp"
-#include "memory_cap.hpp"
 #include "vsd/core/bytes.hpp"
 #include "vsd/io/file.hpp"
 
