@@ -68,6 +68,20 @@ TEST(TextFormat, GoldenFileIsStable) {
 
 // A file written by hand: members in another order, "@class" after properties, no class table, the
 // older value forms (bare enum names, unquoted struct keys, @ids), properties left out, a byte order mark.
+// A saved text file is a text file: it ends with a newline (and one without reads as well).
+TEST(TextFormat, SavedTextEndsWithANewline) {
+  vsd::Environment env;
+  build_golden_model(env.main_state());
+  std::string text = text_of(vsd::io::save_bytes(env.main_state(), Format::Text));
+  ASSERT_FALSE(text.empty());
+  EXPECT_EQ(text.back(), '\n');
+  EXPECT_NE(text[text.size() - 2], '\n') << "one newline";
+  text.pop_back();
+  vsd::Environment other;
+  vsd::io::load_bytes(other.main_state(), bytes_of(text));
+  EXPECT_EQ(diff_of(env.main_state(), other.main_state()), "");
+}
+
 TEST(TextFormat, HandWrittenFilesLoad) {
   vsd::Environment env;
   const auto report = vsd::io::load(env.main_state(), golden_path("handwritten.json"));
