@@ -37,39 +37,25 @@ void BM_Composite_AttachLeaf(benchmark::State& state) {
 }
 BENCHMARK(BM_Composite_AttachLeaf)->Apply(depths);
 
-// A subtree of 3 nodes moved to and fro between the bottoms of two chains of the same depth: the search up
-// from the new parent is as long as the chain, the one down from the subtree 3 nodes.
-void BM_Composite_MoveSmallSubtree(benchmark::State& state) {
+// A subtree moved to and fro between the bottoms of two chains of the argument's depth: the search up from
+// the new parent is as long as the chains, the one down from the subtree as big as the subtree. A small
+// subtree (3 nodes) costs the same at any depth; the worst case, a subtree as deep as the chains, costs
+// time linear in the depth.
+void BM_Composite_Move(benchmark::State& state, bool deep_subtree) {
   bench::World w;
   const auto depth = static_cast<std::size_t>(state.range(0));
   const auto left = chain(w.st, depth);
   const auto right = chain(w.st, depth);
-  const auto small = chain(w.st, 3, left.back());
+  const auto moved = chain(w.st, deep_subtree ? depth : 3, left.back());
   std::size_t i = 0;
   for (auto _ : state) {
     vsd::Node& to = ++i % 2 == 0 ? *left.back() : *right.back();
-    benchmark::DoNotOptimize(&to.add_child(*small.front()));
+    benchmark::DoNotOptimize(&to.add_child(*moved.front()));
   }
-  if (small.front()->parent() != (i % 2 == 0 ? left.back() : right.back())) state.SkipWithError("not moved");
+  if (moved.front()->parent() != (i % 2 == 0 ? left.back() : right.back())) state.SkipWithError("not moved");
 }
-BENCHMARK(BM_Composite_MoveSmallSubtree)->Apply(depths);
-
-// The worst case: a chain as deep as the others moved between their bottoms. Both searches are as long as
-// the chains: linear in the depth.
-void BM_Composite_MoveDeepSubtree(benchmark::State& state) {
-  bench::World w;
-  const auto depth = static_cast<std::size_t>(state.range(0));
-  const auto left = chain(w.st, depth);
-  const auto right = chain(w.st, depth);
-  const auto deep = chain(w.st, depth, left.back());
-  std::size_t i = 0;
-  for (auto _ : state) {
-    vsd::Node& to = ++i % 2 == 0 ? *left.back() : *right.back();
-    benchmark::DoNotOptimize(&to.add_child(*deep.front()));
-  }
-  if (deep.front()->parent() != (i % 2 == 0 ? left.back() : right.back())) state.SkipWithError("not moved");
-}
-BENCHMARK(BM_Composite_MoveDeepSubtree)->Apply(depths);
+BENCHMARK_CAPTURE(BM_Composite_Move, small_subtree, false)->Apply(depths);
+BENCHMARK_CAPTURE(BM_Composite_Move, deep_subtree, true)->Apply(depths);
 
 // A whole chain built by appending at the bottom, then deleted from the top (one release cascade through
 // all of it). Reported per node: flat when both are linear in the depth.
