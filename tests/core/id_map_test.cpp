@@ -54,6 +54,39 @@ TEST(IdMap, ErasingDenseIdsInOrderIsQuick) {
   EXPECT_EQ(map.size(), 1000u);
 }
 
+// Ids only grow. A long-lived dense run (a tree of 65,536 nodes) and a churn of new instances: once the
+// new ids wrap around the table they land on the run, and every insert walked it (an attach at depth
+// 65,536 took 18 us). The table switches to a mixing hash instead.
+TEST(IdMap, ChurnPastALongLivedDenseRunStaysQuick) {
+  constexpr vsd::Id kept = 65'536;
+  vsd::detail::IdMap map;
+  for (vsd::Id id = 1; id <= kept; ++id) map.insert(id, fake(id));
+  for (vsd::Id id = kept + 1; id <= kept + 400'000; ++id) {
+    vsd::SimStateInstance** slot = map.try_insert(id);
+    ASSERT_NE(slot, nullptr) << id;
+    *slot = fake(id);
+    ASSERT_EQ(map.find(id), fake(id)) << id;
+    map.erase(id);
+  }
+  EXPECT_EQ(map.size(), kept);
+  for (vsd::Id id = 1; id <= kept; ++id) ASSERT_EQ(map.find(id), fake(id)) << id;
+  // The mixed table still agrees with a standard map.
+  std::unordered_map<vsd::Id, vsd::SimStateInstance*> model;
+  map.for_each([&](vsd::Id k, vsd::SimStateInstance* v) { model.emplace(k, v); });
+  std::mt19937_64 rng(3);
+  for (int step = 0; step < 100'000; ++step) {
+    const vsd::Id id = rng() % (4 * kept) + 1;
+    if (rng() % 2 == 0) {
+      map.erase(id);
+      model.erase(id);
+    } else {
+      EXPECT_EQ(map.insert(id, fake(id)), model.emplace(id, fake(id)).second);
+    }
+  }
+  ASSERT_EQ(map.size(), model.size());
+  for (const auto& [k, v] : model) ASSERT_EQ(map.find(k), v) << k;
+}
+
 TEST(IdMap, EraseOfAMissingIdChangesNothing) {
   vsd::detail::IdMap map;
   map.erase(5);
