@@ -2,6 +2,7 @@
 #include "vsd/core/meta_instance.hpp"
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -90,7 +91,10 @@ void MetaInstance::unlink_from_base() noexcept {
   if (base_ == nullptr) return;
   std::lock_guard lock(detail::derived_mutex);
   auto& d = const_cast<MetaInstance*>(base_)->derived_;
-  d.erase(std::remove(d.begin(), d.end(), this), d.end());
+  // Searched from the back: classes mostly go in the reverse order they came (a registry's teardown, a
+  // failed load's definitions), so each is found at once however many subclasses the base has.
+  const auto it = std::find(d.rbegin(), d.rend(), this);
+  if (it != d.rend()) d.erase(std::next(it).base());
 }
 
 std::vector<const MetaInstance*> MetaInstance::derived() const {
@@ -99,12 +103,14 @@ std::vector<const MetaInstance*> MetaInstance::derived() const {
 }
 
 MetaProperty& MetaInstance::add_property(std::unique_ptr<MetaProperty> p) {
-  for (const auto& q : own_props_)
-    if (q->name() == p->name())
-      detail::throw_error("class '" + name_ + "' declares property '" + p->name() + "' twice");
+  if (own_names_.contains(p->name()))
+    detail::throw_error("class '" + name_ + "' declares property '" + p->name() + "' twice");
   if (base_ != nullptr && base_->find_property(p->name()) != nullptr)
     detail::throw_error("class '" + name_ + "' redeclares inherited property '" + p->name() + "'");
   p->owner_ = this;
+  if (own_props_.size() == own_props_.capacity())  // nothing below may fail once the name is in the set
+    own_props_.reserve(std::max<std::size_t>(8, 2 * own_props_.size()));
+  own_names_.insert(p->name());
   own_props_.push_back(std::move(p));
   return *own_props_.back();
 }
@@ -235,6 +241,12 @@ ClassBuilder::ClassBuilder(std::string name, const MetaInstance& base)
   if (base.builtin_->construct_ == nullptr && !base.is_a(SimStateInstance::static_meta()))
     detail::throw_error("run-time class '" + meta_->name() +
                         "' needs a base derived from SimStateInstance, not '" + base.name() + "'");
+  // Each class keeps its ancestors and the properties of all of them: a chain of classes costs the square
+  // of its length, so a program (or a file) cannot make one without end.
+  if (meta_->depth_ > MetaInstance::max_depth)
+    detail::throw_error("run-time class '" + meta_->name() + "' would derive from more than " +
+                        std::to_string(MetaInstance::max_depth) + " classes (its base '" + base.name() +
+                        "' is " + std::to_string(base.depth_) + " deep)");
 }
 
 namespace {

@@ -4,7 +4,10 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <span>
 #include <string>
+#include <unordered_set>
+#include <vector>
 
 #include "vsd/core/bytes.hpp"
 #include "vsd/core/detail/huge_pages.hpp"
@@ -42,41 +45,9 @@ struct RefAccess {
     l.target = &t;
   }
 
-  // True when @p t holds @p h through a chain of composite references (so h -> t would close a cycle).
-  static bool composite_ancestor(const SimStateInstance& t, const SimStateInstance& h) {
-    // Fast path, no allocation: in a tree every instance has at most one composite holder, so the walk
-    // is a chain up to a root. The general walk below takes over at the first instance held twice.
-    // (Bounded, so that even a broken invariant could never make it loop.)
-    const SimStateInstance* x = &h;
-    for (int steps = 0; steps < 256; ++steps) {
-      if (x == &t) return true;
-      const SimStateInstance* up = nullptr;
-      bool branches = false;
-      for (const RefLink* l = x->composite_head_; l != nullptr; l = l->next) {
-        if (l->holder == nullptr) continue;
-        if (up != nullptr && up != l->holder) {
-          branches = true;
-          break;
-        }
-        up = l->holder;
-      }
-      if (branches) break;
-      if (up == nullptr) return false;
-      x = up;
-    }
-    std::vector<const SimStateInstance*> todo{&h}, seen;
-    while (!todo.empty()) {
-      const SimStateInstance* x = todo.back();
-      todo.pop_back();
-      if (x == &t) return true;
-      if (std::find(seen.begin(), seen.end(), x) != seen.end()) continue;
-      seen.push_back(x);
-      for (const RefLink* l = x->composite_head_; l != nullptr; l = l->next)
-        if (l->holder != nullptr) todo.push_back(l->holder);
-    }
-    return false;
-  }
-
+  // True when @p t holds @p h through a chain of composite references, or is @p h (so that a composite
+  // reference h -> t would close a cycle). See CycleSearch below.
+  static bool composite_ancestor(const SimStateInstance& t, const SimStateInstance& h);
   static void check(const RefLink& l, SimStateInstance& t) {
     // A free reference may still point at a dying instance (old values being recorded, a listener's
     // copy): the SimState drops such links before it frees the instance. A property may not.
@@ -133,6 +104,155 @@ struct RefAccess {
 
   static std::vector<RefLink*>& links(RefListBase& r) noexcept { return r.links_; }
 };
+
+// ---- the composite cycle check ---------------------------------------------------------------------------
+//
+// Is there a path of composite references from t down to h? Both ends are searched at once, one reference
+// per side and round: upwards from h through the holders of each instance, downwards from t through what
+// each instance holds. Either search running out without meeting its goal proves there is no path, so a
+// check costs about twice the smaller of the two searches:
+//  - O(1) for the usual edits: a new leaf or a fresh subtree attached at any depth (nothing below t), a
+//    deep tree attached under a new root (nothing above h);
+//  - at most O(depth of h) for moving a subtree within a tree (the upward search is a chain);
+//  - building any forest reference by reference, in any order, O(n log n) in all: each reference joins
+//    two trees, and the check costs at most the size of the smaller one.
+// Instances held by several holders (a DAG) are visited once per search.
+
+namespace {
+
+bool holds_anything(const SimStateInstance& x) noexcept {
+  for (const MetaProperty* p : x.meta().reference_properties()) {
+    if (!p->type().is_composite()) continue;
+    const void* at = p->address(x);
+    if (p->type().is_ref_list() ? !static_cast<const RefListBase*>(at)->empty()
+                                : static_cast<const RefBase*>(at)->get() != nullptr)
+      return true;
+  }
+  return false;
+}
+
+bool has_holder(const RefLink* head) noexcept {
+  for (const RefLink* l = head; l != nullptr; l = l->next)
+    if (l->holder != nullptr) return true;
+  return false;
+}
+
+enum class Step : std::uint8_t { more, found, exhausted };
+
+// One side of the search: visits instances from a start, one reference per step.
+class Side {
+ public:
+  explicit Side(const SimStateInstance& start) : at_(&start) { seen_.insert(&start); }
+
+ protected:
+  // Records @p x as reached; true when it is new (to be expanded later).
+  bool reach(const SimStateInstance* x) {
+    if (!seen_.insert(x).second) return false;
+    todo_.push_back(x);
+    return true;
+  }
+  // The next instance to expand, or nullptr when there is none.
+  const SimStateInstance* next() {
+    if (todo_.empty()) return nullptr;
+    const SimStateInstance* x = todo_.back();
+    todo_.pop_back();
+    return x;
+  }
+
+  const SimStateInstance* at_;  // the instance being expanded, or nullptr when done
+  std::vector<const SimStateInstance*> todo_;
+  std::unordered_set<const SimStateInstance*> seen_;
+};
+
+// Upwards: the composite holders of each instance (property links only; free references hold nothing).
+class Up : public Side {
+ public:
+  explicit Up(const SimStateInstance& start, const RefLink* head) : Side(start), link_(head) {}
+
+  Step step(const SimStateInstance& goal, const RefLink* (*head_of)(const SimStateInstance&)) {
+    while (link_ == nullptr) {
+      at_ = next();
+      if (at_ == nullptr) return Step::exhausted;
+      link_ = head_of(*at_);
+    }
+    const RefLink* l = link_;
+    link_ = l->next;
+    if (l->holder == nullptr) return Step::more;
+    if (l->holder == &goal) return Step::found;
+    reach(l->holder);
+    return Step::more;
+  }
+
+ private:
+  const RefLink* link_;
+};
+
+// Downwards: the targets of each instance's composite reference properties, element by element.
+class Down : public Side {
+ public:
+  explicit Down(const SimStateInstance& start) : Side(start) { open(); }
+
+  Step step(const SimStateInstance& goal) {
+    while (true) {
+      if (at_ == nullptr) return Step::exhausted;
+      if (prop_ == props_.size()) {
+        at_ = next();
+        open();
+        continue;
+      }
+      const MetaProperty& p = *props_[prop_];
+      if (!p.type().is_composite()) {
+        ++prop_;
+        continue;
+      }
+      const void* address = p.address(*at_);
+      const SimStateInstance* target = nullptr;
+      if (p.type().is_ref_list()) {
+        const auto& list = *static_cast<const RefListBase*>(address);
+        if (element_ == list.size()) {
+          ++prop_;
+          element_ = 0;
+          continue;
+        }
+        target = list.at(element_++);
+      } else {
+        target = static_cast<const RefBase*>(address)->get();
+        ++prop_;
+        if (target == nullptr) continue;
+      }
+      if (target == &goal) return Step::found;
+      reach(target);
+      return Step::more;
+    }
+  }
+
+ private:
+  void open() {
+    props_ = at_ != nullptr ? at_->meta().reference_properties() : std::span<const MetaProperty* const>{};
+    prop_ = 0;
+    element_ = 0;
+  }
+  std::span<const MetaProperty* const> props_;
+  std::size_t prop_ = 0;
+  std::size_t element_ = 0;
+};
+
+}  // namespace
+
+bool RefAccess::composite_ancestor(const SimStateInstance& t, const SimStateInstance& h) {
+  if (&t == &h) return true;
+  // No allocation for the common cases: nothing below t, or nothing above h.
+  if (!holds_anything(t) || !has_holder(h.composite_head_)) return false;
+  auto head_of = [](const SimStateInstance& x) -> const RefLink* { return x.composite_head_; };
+  Up up(h, h.composite_head_);
+  Down down(t);
+  while (true) {
+    const Step u = up.step(t, head_of);
+    if (u != Step::more) return u == Step::found;
+    const Step d = down.step(h);
+    if (d != Step::more) return d == Step::found;
+  }
+}
 
 // ---- LinkBlock: a header, then the links -----------------------------------------------------------------
 

@@ -1,6 +1,7 @@
 #include "vsd/core/registry.hpp"
 
 #include <algorithm>
+#include <unordered_set>
 
 #include "vsd/core/database.hpp"
 #include "vsd/core/environment.hpp"
@@ -76,6 +77,13 @@ void Registry::add(const MetaInstance& cls) {
 }
 
 namespace {
+// Room for one more element, growing geometrically (reserve(size() + 1) reallocates every time: defining
+// n classes or types one by one cost n^2 moves).
+template <class V>
+void room_for_one(V& v) {
+  if (v.size() == v.capacity()) v.reserve(std::max<std::size_t>(16, 2 * v.size()));
+}
+
 // The part of a full class name after the last "::" (the whole name when it has none).
 std::string_view short_name(std::string_view full) {
   const std::size_t sep = full.rfind("::");
@@ -202,6 +210,15 @@ const MetaType& Registry::get_type(std::string_view name) {
   constexpr std::string_view vector_prefix = "vector<";
   if (name.size() > vector_prefix.size() + 1 && name.substr(0, vector_prefix.size()) == vector_prefix &&
       name.back() == '>') {
+    // Each level below is a call: a name nested deeper than any type may be is refused before.
+    std::size_t levels = 0;
+    for (std::string_view rest = name; levels <= MetaType::max_depth && rest.starts_with(vector_prefix);
+         rest.remove_prefix(vector_prefix.size()))
+      ++levels;
+    if (levels > MetaType::max_depth)
+      detail::throw_error("unknown type '" + std::string(name.substr(0, 60)) +
+                          "...': vectors nest deeper than " + std::to_string(MetaType::max_depth) +
+                          " levels");
     const MetaType* element = nullptr;
     try {
       element = &get_type(name.substr(vector_prefix.size(), name.size() - vector_prefix.size() - 1));
@@ -272,8 +289,9 @@ const MetaInstance& Registry::define(std::unique_ptr<MetaInstance> cls) {
     detail::throw_error("run-time class '" + cls->name() + "' derives from run-time class '" + base->name() +
                         "' of another registry; define both in the same registry");
   for (const MetaProperty* p : cls->own_properties()) check_type_locked(p->type());
-  runtime_classes_.reserve(runtime_classes_.size() + 1);  // nothing below may fail half way
+  room_for_one(runtime_classes_);  // nothing below may fail half way
   short_names_.reserve(short_names_.size() + 1);
+  owned_classes_.insert(cls.get());
   cls->link_to_base();
   const MetaInstance& ref = *cls;
   classes_.emplace(ref.name(), &ref);
@@ -283,10 +301,7 @@ const MetaInstance& Registry::define(std::unique_ptr<MetaInstance> cls) {
   return ref;
 }
 
-bool Registry::owns_locked(const MetaInstance& cls) const noexcept {
-  return std::any_of(runtime_classes_.begin(), runtime_classes_.end(),
-                     [&](auto& p) { return p.get() == &cls; });
-}
+bool Registry::owns_locked(const MetaInstance& cls) const noexcept { return owned_classes_.contains(&cls); }
 
 void Registry::undefine(const MetaInstance& cls) {
   std::unique_lock lock(mutex_);
@@ -313,6 +328,7 @@ void Registry::undefine(const MetaInstance& cls) {
   std::erase_if(runtime_types_, [&](const auto& t) { return t->target() == &cls; });
   classes_.erase(cls.name());
   unindex_locked(cls);
+  owned_classes_.erase(&cls);
   runtime_classes_.erase(it);  // ~MetaInstance unlinks it from its base
 }
 
@@ -394,7 +410,7 @@ const MetaType& Registry::define(std::unique_ptr<MetaType> type) {
     detail::throw_error("type name '" + type->name() + "' is already registered for another type");
   if (type->element() != nullptr) check_type_locked(*type->element());
   for (const auto& f : type->fields()) check_type_locked(*f.type);
-  runtime_types_.reserve(runtime_types_.size() + 1);  // nothing below may fail half way
+  room_for_one(runtime_types_);  // nothing below may fail half way
   const MetaType& ref = *type;
   add_type_locked(ref);  // with the types of its fields or elements, so that files find them by name
   runtime_types_.push_back(std::move(type));
@@ -419,7 +435,7 @@ const MetaType& Registry::vector_type(const MetaType& element) {
   auto t = detail::make_runtime_vector(element);
   std::unique_lock lock(mutex_);
   if (auto it = types_.find(name); it != types_.end()) return *it->second;  // made meanwhile
-  runtime_types_.reserve(runtime_types_.size() + 1);
+  room_for_one(runtime_types_);
   const MetaType& ref = *t;
   types_.emplace(name, &ref);
   runtime_types_.push_back(std::move(t));
@@ -453,6 +469,94 @@ void Registry::undefine(const MetaType& type) {
   std::erase_if(runtime_types_, [&](const auto& p) {
     return std::find(vectors.begin(), vectors.end(), p.get()) != vectors.end();
   });
+}
+
+void Registry::undefine_all(std::span<const MetaInstance* const> classes,
+                            std::span<const MetaType* const> types) {
+  std::unique_lock lock(mutex_);
+  // The candidates: the given run-time classes and types of this registry, with the reference types of
+  // those classes and the vectors of those types (made on demand, they go with what they are made of).
+  std::unordered_set<const MetaInstance*> cls;
+  for (const MetaInstance* c : classes)
+    if (c != nullptr && owns_locked(*c)) cls.insert(c);
+  std::unordered_set<const MetaType*> typ;
+  for (const MetaType* t : types)
+    if (t != nullptr && !t->is_reference()) typ.insert(t);
+  auto innermost = [](const MetaType* t) {
+    while (t->kind() == TypeKind::Vector && t->cpp_tag() == nullptr && t->element() != nullptr)
+      t = t->element();
+    return t;
+  };
+  std::unordered_set<const MetaType*> owned_types;
+  for (const auto& t : runtime_types_) owned_types.insert(t.get());
+  std::erase_if(typ, [&](const MetaType* t) { return !owned_types.contains(t); });
+  for (const auto& t : runtime_types_) {
+    if (t->is_reference() ? cls.contains(t->target())
+                          : t.get() != innermost(t.get()) && typ.contains(innermost(t.get())))
+      typ.insert(t.get());
+  }
+  // What is kept, and what a kept one uses (a worklist: each candidate is kept at most once).
+  std::unordered_set<const void*> kept;
+  std::vector<const void*> todo;
+  auto keep = [&](const void* x) {
+    if ((cls.contains(static_cast<const MetaInstance*>(x)) ||
+         typ.contains(static_cast<const MetaType*>(x))) &&
+        kept.insert(x).second)
+      todo.push_back(x);
+  };
+  // A value type's parts (and a reference type's target) that are candidates.
+  auto keep_parts = [&](const MetaType& t) {
+    if (t.is_reference()) {
+      keep(&t);
+      keep(t.target());
+      return;
+    }
+    keep(&t);
+    if (t.element() != nullptr) keep(t.element());
+    for (const auto& f : t.fields()) keep(f.type);
+  };
+  for (const MetaInstance* c : cls) {
+    if (c->live_instances() != 0) keep(c);
+    for (const MetaInstance* d : c->derived())
+      if (!cls.contains(d)) keep(c);
+  }
+  for (const auto& [name, c] : classes_)
+    if (!cls.contains(c))
+      for (const MetaProperty* p : c->own_properties()) keep_parts(p->type());
+  for (const auto& [name, t] : types_)
+    if (!typ.contains(t) && !t->is_reference()) keep_parts(*t);
+  while (!todo.empty()) {
+    const void* x = todo.back();
+    todo.pop_back();
+    if (const auto* c = static_cast<const MetaInstance*>(x); cls.contains(c)) {
+      keep(c->base());
+      for (const MetaProperty* p : c->own_properties()) keep_parts(p->type());
+    } else {
+      const auto* t = static_cast<const MetaType*>(x);
+      if (t->is_reference()) keep(t->target());
+      if (t->element() != nullptr) keep(t->element());
+      for (const auto& f : t->fields()) keep(f.type);
+    }
+  }
+  // Remove the rest: classes before the types their properties use, each list in one pass in the reverse
+  // order of definition (subclasses before their bases).
+  auto gone = [&](const void* x) { return !kept.contains(x); };
+  for (auto it = runtime_classes_.rbegin(); it != runtime_classes_.rend(); ++it) {
+    const MetaInstance* c = it->get();
+    if (!cls.contains(c) || !gone(c)) continue;
+    classes_.erase(c->name());
+    unindex_locked(*c);
+    owned_classes_.erase(c);
+    it->reset();  // ~MetaInstance unlinks it from its base
+  }
+  std::erase(runtime_classes_, nullptr);
+  for (auto it = runtime_types_.rbegin(); it != runtime_types_.rend(); ++it) {
+    const MetaType* t = it->get();
+    if (!typ.contains(t) || !gone(t)) continue;
+    types_.erase(t->name());
+    it->reset();
+  }
+  std::erase(runtime_types_, nullptr);
 }
 
 }  // namespace vsd

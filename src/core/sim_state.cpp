@@ -212,7 +212,32 @@ std::vector<SimStateInstance*> SimState::instances() const {
 
 void SimState::released(SimStateInstance& inst) {
   // While a bundle is applied, deletions come from the bundle itself; the Database is never released.
-  if (applying_ == 0 && !inst.is_being_deleted() && &inst != root_) destroy(inst);
+  if (applying_ != 0 || inst.is_being_deleted() || &inst == root_) return;
+  // Deleting releases what the instance held, which may delete more: a cascade as deep as the tree. The
+  // outermost release runs it as a loop (depth first, each instance's released targets in the order they
+  // were released), so a chain of a million levels takes no million stack frames.
+  if (cascade_ != nullptr) {
+    cascade_->push_back(&inst);
+    return;
+  }
+  if (dispatching_ == 0 && stands_alone(inst)) {  // a leaf nobody watches: nothing can follow
+    destroy(inst);
+    return;
+  }
+  Dispatch d(*this);  // what a listener deletes meanwhile stays allocated: the pending list may name it
+  std::vector<SimStateInstance*> pending{&inst};
+  cascade_ = &pending;
+  struct Done {
+    SimState& s;
+    ~Done() { s.cascade_ = nullptr; }
+  } done{*this};
+  while (!pending.empty()) {
+    SimStateInstance& x = *pending.back();
+    pending.pop_back();
+    const std::size_t before = pending.size();
+    if (!x.is_being_deleted() && x.refs_ == 0 && !x.is_floating()) destroy(x);
+    std::reverse(pending.begin() + static_cast<std::ptrdiff_t>(before), pending.end());
+  }
 }
 
 void SimState::destroy(SimStateInstance& x) {

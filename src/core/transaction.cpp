@@ -291,6 +291,7 @@ class Applier {
       TxParser parser(t_);
       for (std::size_t i = 0; parser.next(op); ++i) check(op, i);
     }
+    check_one_parent();
     reserve();
     ++s_.applying_;
     struct Done {
@@ -364,6 +365,14 @@ class Applier {
     const SimStateInstance* x = s_.find(id);
     return x != nullptr ? &x->meta() : nullptr;
   }
+  // Counts the places @p id has in the lists of the model.
+  void listed(Id id, int change) {
+    if (std::uint32_t* times = listed_.get(id)) {
+      *times = static_cast<std::uint32_t>(static_cast<int>(*times) + change);
+    } else if (change > 0) {
+      listed_.insert(id, 1);
+    }
+  }
   std::vector<Id>& list_model(Id holder, const MetaProperty& p) {
     auto key = std::make_pair(holder, &p);
     // A bundle fills one list after the other: remember the last one (map nodes never move).
@@ -381,6 +390,7 @@ class Applier {
           if (!deleted_.contains(list.at(i)->id())) ids.push_back(list.at(i)->id());
       }
     }
+    for (Id id : ids) listed(id, +1);
     last_list_key_ = key;
     return *(last_list_ = &lists_.emplace(key, std::move(ids)).first->second);
   }
@@ -456,7 +466,17 @@ class Applier {
         if (class_of(op.id) == nullptr) fail(op, n, "no instance #" + std::to_string(op.id));
         created_.erase(op.id);
         deleted_.insert(op.id, true);
-        for (auto& [key, ids] : lists_) std::erase(ids, op.id);
+        // A deleted instance holds no list, and is in none. (Its lists are found by their key; the
+        // lists holding it are looked for only when it is in one: a recorded deletion erases it first.)
+        for (auto it = lists_.lower_bound({op.id, nullptr}); it != lists_.end() && it->first.first == op.id;
+             ++it) {
+          for (Id id : it->second) listed(id, -1);
+          it->second.clear();
+        }
+        if (const std::uint32_t* times = listed_.get(op.id); times != nullptr && *times != 0) {
+          for (auto& [key, ids] : lists_) std::erase(ids, op.id);
+          listed_.erase(op.id);
+        }
         forget_edges(op.id);
         break;
       }
@@ -473,6 +493,10 @@ class Applier {
             for (Id old : list) remove_edge(op.id, old);
             for (Id now : ids) add_edge(op, n, op.id, now);
           }
+          if (is_single_parent(p))
+            for (Id now : ids) placed_.assign(now, Placement{op.op, op.offset, n, op.id, &p});
+          for (Id old : list) listed(old, -1);
+          for (Id now : ids) listed(now, +1);
           list = std::move(ids);
         } else if (p.type().is_composite()) {
           Id& held = single_model(op.id, p);
@@ -497,16 +521,96 @@ class Applier {
                  "index " + std::to_string(op.index) + " is past the end (size " +
                      std::to_string(ids.size()) + ")");
           if (p.type().is_composite()) add_edge(op, n, op.id, op.target);
+          if (is_single_parent(p)) placed_.assign(op.target, Placement{op.op, op.offset, n, op.id, &p});
           ids.insert(ids.begin() + static_cast<std::ptrdiff_t>(op.index), op.target);
+          listed(op.target, +1);
         } else {
           if (op.index >= ids.size() || ids[op.index] != op.target)
             fail(op, n, "#" + std::to_string(op.target) + " is not at index " + std::to_string(op.index));
           ids.erase(ids.begin() + static_cast<std::ptrdiff_t>(op.index));
+          listed(op.target, -1);
           if (p.type().is_composite()) remove_edge(op.id, op.target);
         }
         break;
       }
     }
+  }
+
+  // ---- one parent: a bundle may not leave a node in two children lists (or twice in one) ----------------
+  //
+  // A node has one parent and an extension one owner. A move inserts before it erases, so this is checked
+  // once the whole bundle has been seen, for the instances the bundle placed; the operation named is the
+  // last that placed the instance.
+
+  struct Placement {
+    Transaction::Op op;
+    std::size_t offset, n;
+    Id holder;
+    const MetaProperty* prop;
+  };
+  static bool is_single_parent(const MetaProperty& p) noexcept {
+    return &p == &Node::vsd_prop_children() || &p == &NamedModelInstance::vsd_prop_extensions();
+  }
+  // The holders of @p child through children/extensions as the bundle leaves it.
+  std::vector<Id> single_parents(Id child) const {
+    std::vector<Id> of;
+    for (const auto& [key, ids] : lists_)
+      if (is_single_parent(*key.second) && !deleted_.contains(key.first))
+        for (Id id : ids)
+          if (id == child) of.push_back(key.first);
+    if (!created_.contains(child))
+      if (const SimStateInstance* x = s_.find(child))  // holders whose lists the bundle left alone
+        for (const RefLink* l = x->composite_head_; l != nullptr; l = l->next)
+          if (l->holder != nullptr && is_single_parent(*l->prop) && !deleted_.contains(l->holder->id()) &&
+              !lists_.contains({l->holder->id(), l->prop}))
+            of.push_back(l->holder->id());
+    return of;
+  }
+  void check_one_parent() const {
+    if (placed_.size() == 0) return;
+    FlatIdMap<std::uint32_t> count;  // placed instance -> times listed in the lists the bundle touched
+    for (const auto& [key, ids] : lists_) {
+      if (!is_single_parent(*key.second) || deleted_.contains(key.first)) continue;
+      for (Id id : ids)
+        if (std::uint32_t* c = count.get(id)) {
+          ++*c;
+        } else if (placed_.contains(id)) {
+          count.insert(id, 1);
+        }
+    }
+    const Placement* worst = nullptr;  // the earliest placement that leaves two parents: reported
+    Id child = null_id;
+    placed_.for_each([&](Id id, const Placement& where) {
+      if (deleted_.contains(id) || (worst != nullptr && where.n >= worst->n)) return;
+      std::size_t n = count.find(id);
+      if (n < 2 && !created_.contains(id))
+        if (const SimStateInstance* x = s_.find(id))
+          for (const RefLink* l = x->composite_head_; l != nullptr && n < 2; l = l->next)
+            if (l->holder != nullptr && is_single_parent(*l->prop) && !deleted_.contains(l->holder->id()) &&
+                !lists_.contains({l->holder->id(), l->prop}))
+              ++n;
+      if (n < 2) return;
+      worst = &where;
+      child = id;
+    });
+    if (worst == nullptr) return;
+    const std::vector<Id> of = single_parents(child);
+    const bool node = worst->prop == &Node::vsd_prop_children();
+    std::string what = (node ? "node #" : "extension #") + std::to_string(child);
+    if (of.size() == 2 && of[0] == of[1]) {
+      what += " would be listed twice by #" + std::to_string(of[0]);
+    } else {
+      what += node ? " would be a child of " : " would be attached to ";
+      for (std::size_t i = 0; i < of.size(); ++i)
+        what += (i == 0 ? "#" : i + 1 == of.size() ? " and #" : ", #") + std::to_string(of[i]);
+    }
+    what += node ? ": a node has one parent" : ": an extension has one owner";
+    TxOp op;
+    op.op = worst->op;
+    op.offset = worst->offset;
+    op.id = worst->holder;
+    op.name = worst->prop->name();
+    fail(op, worst->n, what + " (a move erases it from the old one)");
   }
 
   // ---- composite edges: the dry run rejects a bundle that would make an instance its own ancestor ----
@@ -582,7 +686,7 @@ class Applier {
     added_first_.erase(gone);
     added_more_.erase(gone);
     removed_up_.erase(gone);
-    std::erase_if(singles_, [&](const auto& e) { return e.first.first == gone; });
+    singles_.erase(singles_.lower_bound({gone, nullptr}), singles_.lower_bound({gone + 1, nullptr}));
     // Edges where `gone` is the holder are skipped by holders_of() while it stays deleted; should its
     // id come back (an undo), such a stale edge can only make the check stricter.
   }
@@ -652,6 +756,7 @@ class Applier {
   FlatIdMap<const MetaInstance*> created_;
   FlatIdMap<bool> deleted_;
   std::map<std::pair<Id, const MetaProperty*>, std::vector<Id>> lists_;
+  FlatIdMap<std::uint32_t> listed_;  // id -> how many times the lists of lists_ hold it
   std::pair<Id, const MetaProperty*> last_list_key_{null_id, nullptr};
   std::vector<Id>* last_list_ = nullptr;  // lists_[last_list_key_]
   std::map<std::pair<Id, const MetaProperty*>, Id> singles_;
@@ -659,6 +764,7 @@ class Applier {
   std::unordered_map<Id, std::vector<Id>> added_more_;  // child -> further composite holders gained
   std::unordered_map<Id, std::vector<Id>> removed_up_;  // child -> real composite holders lost
   FlatIdMap<bool> holders_;                             // instances that gained composite references
+  FlatIdMap<Placement> placed_;                         // instances put into a children/extensions list
 };
 
 }  // namespace detail

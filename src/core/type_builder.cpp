@@ -252,6 +252,9 @@ bool is_identifier(std::string_view s) {
 
 std::unique_ptr<MetaType> make_runtime_vector(const MetaType& element) {
   if (element.is_reference()) throw_error("vector<" + element.name() + ">: a vector cannot hold references");
+  if (element.depth() >= MetaType::max_depth)
+    throw_error("vector<" + element.name() + ">: values would nest deeper than " +
+                std::to_string(MetaType::max_depth) + " levels");
   auto t = std::make_unique<MetaType>("vector<" + element.name() + ">", TypeKind::Vector, sizeof(RtVector),
                                       alignof(RtVector), vector_ops);
   t->set_element(&element);
@@ -367,6 +370,9 @@ const MetaType& StructBuilder::define(Registry& registry) {
   size = (size + align - 1) / align * align;
   auto t = std::make_unique<MetaType>(name_, TypeKind::Struct, size, align, detail::struct_ops);
   for (auto& f : fields) t->add_field(std::move(f));
+  if (t->depth() > MetaType::max_depth)
+    detail::throw_error("struct '" + name_ + "': values would nest deeper than " +
+                        std::to_string(MetaType::max_depth) + " levels");
   return registry.define(std::move(t));
 }
 

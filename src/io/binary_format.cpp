@@ -77,7 +77,7 @@ class BinaryReader final : public LoadModel {
  public:
   BinaryReader(Registry& registry, std::span<const std::uint8_t> bytes, std::string_view origin,
                const LoadOptions& options)
-      : LoadModel(registry, origin, options), in_(bytes.data(), bytes.size()) {}
+      : LoadModel(registry, origin, options), bytes_(bytes), in_(bytes.data(), bytes.size()) {}
 
   void read() {
     try {
@@ -92,6 +92,13 @@ class BinaryReader final : public LoadModel {
  private:
   [[nodiscard]] std::string where(std::size_t at) const override {
     return std::string(origin_) + ": byte " + std::to_string(at);
+  }
+  [[nodiscard]] std::size_t list_element_at(std::size_t value_at, std::size_t k) const override {
+    ByteReader r(bytes_.data() + value_at, bytes_.size() - value_at);  // read before: well formed
+    (void)r.fixed<std::uint32_t>();                                    // the frame's length
+    (void)r.varint();                                                  // the count
+    for (std::size_t i = 0; i < k; ++i) (void)r.varint();
+    return value_at + r.position();
   }
 
   void read_all() {
@@ -112,13 +119,18 @@ class BinaryReader final : public LoadModel {
     }
     const std::size_t nclasses = in_.size_prefix(2);
     for (std::size_t i = 0; i < nclasses; ++i) read_class();
-    const std::size_t ninstances = in_.size_prefix(2);
+    // An instance takes at least its id, its class index and a 4-byte frame per saved property of the
+    // narrowest class: a count the rest of the file cannot hold is refused before anything is reserved.
+    std::size_t widest = 0, narrowest = classes_.empty() ? 0 : SIZE_MAX;
+    for (const ClassEntry& c : classes_) {
+      widest = std::max(widest, c.slots.size());
+      narrowest = std::min(narrowest, c.slots.size());
+    }
+    const std::size_t ninstances = in_.size_prefix(2 + 4 * std::min<std::size_t>(narrowest, 1 << 20));
     instances_.reserve(ninstances);
     // Values: the widest class's count per instance, bounded by what the bytes left can hold (a frame
     // takes at least 4): growing a vector of millions by doubling costs more than the read itself.
-    std::size_t widest = 0;
-    for (const ClassEntry& c : classes_) widest = std::max(widest, c.slots.size());
-    values_.reserve(std::min(ninstances * widest, in_.remaining() / 4));
+    if (widest != 0) values_.reserve(std::min(ninstances, in_.remaining() / 4 / widest) * widest);
     for (std::size_t i = 0; i < ninstances; ++i) read_instance();
     has_top_ = true;
     top_at_ = in_.position();
@@ -300,6 +312,7 @@ class BinaryReader final : public LoadModel {
     instances_.push_back(x);
   }
 
+  std::span<const std::uint8_t> bytes_;
   ByteReader in_;
 };
 

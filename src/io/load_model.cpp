@@ -14,18 +14,10 @@ namespace vsd::io::detail {
 
 LoadModel::~LoadModel() {
   if (committed_) return;
-  for (auto it = defined_.rbegin(); it != defined_.rend(); ++it) {
-    try {
-      registry_.undefine(**it);
-    } catch (const Error&) {  // still in use elsewhere: keep it
-    }
-  }
-  for (auto it = defined_types_.rbegin(); it != defined_types_.rend();
-       ++it) {  // after the classes using them
-    try {
-      registry_.undefine(**it);
-    } catch (const Error&) {
-    }
+  // What is still in use elsewhere stays; the rest goes, in one pass however many the file defined.
+  try {
+    registry_.undefine_all(defined_, defined_types_);
+  } catch (...) {  // out of memory: the definitions stay, as if still in use
   }
 }
 
@@ -301,8 +293,37 @@ void LoadModel::finish() {
                                        std::to_string(id) + ", a '" + found.name() + "', which is not a '" +
                                        target.name() + "'");
       }
+  check_one_parent();
   check_composite_cycles();
   check_top();
+}
+
+// A node has one parent and an extension one owner: each is listed once in all the children lists (all
+// the extensions lists) of the file together. The second listing is the error.
+void LoadModel::check_one_parent() const {
+  const MetaProperty& children = Node::vsd_prop_children();
+  const MetaProperty& extensions = NamedModelInstance::vsd_prop_extensions();
+  vsd::detail::FlatIdMap<std::size_t> first;  // listed id -> index of its first holder in instances_ + 1
+  for (std::size_t i = 0; i < instances_.size(); ++i) {
+    const SavedInstance& x = instances_[i];
+    for (const SavedValue& v : values_of(x)) {
+      if (v.slot->prop != &children && v.slot->prop != &extensions) continue;
+      const auto ids = ids_of(v);
+      for (std::size_t k = 0; k < ids.size(); ++k) {
+        if (first.insert(ids[k], i + 1)) continue;
+        const bool node = v.slot->prop == &children;
+        const SavedInstance& other = instances_[first.find(ids[k]) - 1];
+        fail_at(
+            list_element_at(offset_of(x, v), k),
+            std::string(node ? "node #" : "extension #") + std::to_string(ids[k]) +
+                (&other == &x ? " is listed twice in #" + std::to_string(x.id) + "." + v.slot->prop->name()
+                              : std::string(node ? " is already a child of #" : " is already attached to #") +
+                                    std::to_string(other.id) + ": #" + std::to_string(x.id) + "." +
+                                    v.slot->prop->name() + " lists it too") +
+                (node ? " (a node has one parent)" : " (an extension has one owner)"));
+      }
+    }
+  }
 }
 
 namespace {

@@ -111,6 +111,8 @@ class LoadModel {
  protected:
   /// The origin and the position @p at in the format's terms ("file: byte 12", "file:3:14").
   [[nodiscard]] virtual std::string where(std::size_t at) const = 0;
+  /// Where element @p k of the reference list whose value starts at @p value_at was written.
+  [[nodiscard]] virtual std::size_t list_element_at(std::size_t value_at, std::size_t k) const = 0;
   /// Throws vsd::Error naming where(at) and @p what.
   [[noreturn]] void fail_at(std::size_t at, const std::string& what) const {
     throw Error(where(at) + ": " + what);
@@ -194,6 +196,7 @@ class LoadModel {
 
  private:
   void check_composite_cycles() const;
+  void check_one_parent() const;
   const MetaInstance& make_placeholder(std::size_t at, const std::string& name,
                                        std::span<const SavedProperty> saved);
 

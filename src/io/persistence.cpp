@@ -1,6 +1,7 @@
 // The public persistence API (vsd/io/snapshot.hpp): what a save writes, and the choice of format.
 #include <algorithm>
 #include <cctype>
+#include <new>
 
 #include "formats.hpp"
 #include "vsd/io/file.hpp"
@@ -93,11 +94,24 @@ std::unique_ptr<detail::LoadModel> read(Registry& registry, std::span<const std:
                                                   : detail::read_binary(registry, bytes, origin, options);
 }
 
+// Runs @p f, turning running out of memory (a file whose model does not fit) into a vsd::Error that
+// names the file, like every other reason a load fails.
+template <class F>
+auto out_of_memory_is_an_error(std::string_view origin, std::string_view doing, F&& f) {
+  try {
+    return f();
+  } catch (const std::bad_alloc&) {
+    throw Error(std::string(origin) + ": out of memory " + std::string(doing));
+  }
+}
+
 LoadReport load_into(SimState& state, Node* parent, std::span<const std::uint8_t> bytes,
                      std::string_view origin, const LoadOptions& options = {}) {
-  LoadReport report = read(state.environment().registry(), bytes, origin, options)->apply(state, parent);
-  report.format = format_of(bytes, origin);
-  return report;
+  return out_of_memory_is_an_error(origin, "while loading", [&] {
+    LoadReport report = read(state.environment().registry(), bytes, origin, options)->apply(state, parent);
+    report.format = format_of(bytes, origin);
+    return report;
+  });
 }
 
 }  // namespace
@@ -140,9 +154,11 @@ std::vector<std::uint8_t> save_bytes(const Node& root, Format format, SaveReport
 
 LoadReport check_bytes(std::span<const std::uint8_t> bytes, std::string_view origin, Registry& registry,
                        const LoadOptions& options) {
-  LoadReport report = read(registry, bytes, origin, options)->summary();
-  report.format = format_of(bytes, origin);
-  return report;
+  return out_of_memory_is_an_error(origin, "while reading", [&] {
+    LoadReport report = read(registry, bytes, origin, options)->summary();
+    report.format = format_of(bytes, origin);
+    return report;
+  });
 }
 
 LoadReport load_bytes(SimState& state, std::span<const std::uint8_t> bytes, std::string_view origin) {
@@ -165,13 +181,15 @@ LoadReport load_bytes(Node& parent, std::span<const std::uint8_t> bytes, std::st
 
 SaveReport save(const SimState& state, const std::filesystem::path& path, Format format) {
   SaveReport report;
-  write_file_atomically(path, save_bytes(state, format, &report));
+  write_file_atomically(path, out_of_memory_is_an_error(path.string(), "while saving",
+                                                        [&] { return save_bytes(state, format, &report); }));
   return report;
 }
 
 SaveReport save(const Node& root, const std::filesystem::path& path, Format format) {
   SaveReport report;
-  write_file_atomically(path, save_bytes(root, format, &report));
+  write_file_atomically(path, out_of_memory_is_an_error(path.string(), "while saving",
+                                                        [&] { return save_bytes(root, format, &report); }));
   return report;
 }
 

@@ -328,12 +328,37 @@ class TextSnapshotReader final : public LoadModel {
     std::vector<const MetaProperty*> props;
     std::vector<std::string> names;
     std::vector<Value> scratch;
+    // A wide class finds a key's slot by hash, not by a search through all of them (a narrow one searches:
+    // that is quicker for a handful), and marks the slots an instance gave with the instance's number.
+    std::unordered_map<const MetaProperty*, std::size_t> slot_of_prop;
+    std::unordered_map<std::string, std::size_t> slot_of_name;  // slots of properties the class lacks
+    std::vector<std::size_t> given_by;                          // per slot: the last instance + 1
   };
+  static constexpr std::size_t wide_class = 16;
 
   [[nodiscard]] std::string where(std::size_t at) const override {
-    TextReader r = in_;
-    r.seek(at);
-    return std::string(origin_) + ":" + std::to_string(r.line()) + ":" + std::to_string(r.column());
+    // Counted on from the last position asked for: warnings come in file order, and a file with many of
+    // them must not be scanned from its start for each.
+    const std::string_view text = in_.text();
+    at = std::min(at, text.size());
+    if (at < where_.pos) where_ = {};
+    for (; where_.pos < at; ++where_.pos)
+      if (text[where_.pos] == '\n') {
+        ++where_.line;
+        where_.line_start = where_.pos + 1;
+      }
+    return std::string(origin_) + ":" + std::to_string(where_.line) + ":" +
+           std::to_string(at - where_.line_start + 1);
+  }
+  [[nodiscard]] std::size_t list_element_at(std::size_t value_at, std::size_t k) const override {
+    TextReader r = in_;  // the list was read before: it is well formed
+    r.seek(value_at);
+    r.expect('[');
+    for (std::size_t i = 0; i < k; ++i) {
+      r.skip_value();
+      r.expect(',');
+    }
+    return r.token_start();
   }
 
   template <class F>
@@ -596,7 +621,8 @@ class TextSnapshotReader final : public LoadModel {
     if (auto it = by_name_.find(name); it != by_name_.end()) return it->second;
     ClassEntry& entry = classes_.emplace_back();
     entry.cls = &resolve_class(at, name, def, saved);
-    return by_name_.emplace(name, TextClass{&entry, {}, {}, {}, {}, {}, {}, {}, {}}).first->second;
+    return by_name_.emplace(name, TextClass{&entry, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}})
+        .first->second;
   }
 
   // One slot per saved property of today's class (with the file's type where it names one), then one for
@@ -630,6 +656,14 @@ class TextSnapshotReader final : public LoadModel {
     }
     for (const Slot& s : e.slots)
       tc.scratch.emplace_back(s.prop == nullptr ? Value() : Value(s.convert ? *s.file_type : s.prop->type()));
+    tc.given_by.assign(e.slots.size(), 0);
+    if (e.slots.size() > wide_class)
+      for (std::size_t i = 0; i < e.slots.size(); ++i) {
+        if (tc.props[i] != nullptr)
+          tc.slot_of_prop.emplace(tc.props[i], i);
+        else
+          tc.slot_of_name.emplace(tc.names[i], i);
+      }
   }
 
   TextClass& class_named(std::size_t at, const std::string& name) {
@@ -651,7 +685,6 @@ class TextSnapshotReader final : public LoadModel {
     TextClass* tc = nullptr;
     std::vector<std::pair<std::string, std::size_t>> early;  // properties seen before "@class"
     bool has_id = false;
-    seen_.clear();
     read_object([&](const std::string& key, std::size_t key_at) {
       if (key == "@id") {
         if (has_id) fail_at(key_at, "\"@id\" is given twice");
@@ -687,8 +720,14 @@ class TextSnapshotReader final : public LoadModel {
     const ClassEntry& e = *tc.entry;
     const MetaProperty* prop = e.cls->find_property(key);  // through aliases too
     std::size_t index = e.slots.size();
-    for (std::size_t i = 0; i < e.slots.size() && index == e.slots.size(); ++i)
-      if (prop != nullptr ? tc.props[i] == prop : tc.names[i] == key) index = i;
+    if (e.slots.size() <= wide_class) {
+      for (std::size_t i = 0; i < e.slots.size() && index == e.slots.size(); ++i)
+        if (prop != nullptr ? tc.props[i] == prop : tc.names[i] == key) index = i;
+    } else if (prop != nullptr) {
+      if (auto it = tc.slot_of_prop.find(prop); it != tc.slot_of_prop.end()) index = it->second;
+    } else if (auto it = tc.slot_of_name.find(key); it != tc.slot_of_name.end()) {
+      index = it->second;
+    }
     if (index == e.slots.size()) {  // neither a saved property of the class nor one the file declared
       if (std::find(tc.reported.begin(), tc.reported.end(), key) == tc.reported.end()) {
         tc.reported.push_back(key);
@@ -698,9 +737,9 @@ class TextSnapshotReader final : public LoadModel {
       in_.skip_value();
       return;
     }
-    if (std::find(seen_.begin(), seen_.end(), index) != seen_.end())
-      fail_at(key_at, "property '" + key + "' is given twice");
-    seen_.push_back(index);
+    const std::size_t instance = instances_.size() + 1;  // the number of the instance being read
+    if (tc.given_by[index] == instance) fail_at(key_at, "property '" + key + "' is given twice");
+    tc.given_by[index] = instance;
     const Slot& s = e.slots[index];
     if (s.prop == nullptr) {  // reported once per class, when the slots were made
       in_.skip_value();
@@ -742,8 +781,10 @@ class TextSnapshotReader final : public LoadModel {
   }
 
   TextReader in_;
+  mutable struct {
+    std::size_t pos = 0, line = 1, line_start = 0;
+  } where_;  // where() counted lines up to pos
   std::unordered_map<std::string, TextClass> by_name_;
-  std::vector<std::size_t> seen_;
   std::vector<std::uint8_t> bytes_;
 };
 

@@ -14,6 +14,8 @@
 #include <vector>
 #include <vsd/vsd.hpp>
 
+#include "memory_cap.hpp"
+
 namespace mt {
 
 enum class MtColor { Red, Green = 5, Blue = -3 };
@@ -1366,6 +1368,18 @@ TEST(MetaTypeBytesErrors, AbsurdSizesThrowWithoutAllocating) {
   vsd::ByteWriter mw(m);
   mw.varint(std::numeric_limits<std::uint64_t>::max());
   EXPECT_THAT(bytes_error<std::vector<std::int32_t>>(m), StartsWith("byte 0: "));
+}
+
+// A count that the bytes could hold at one byte per element, of elements that take far more memory (a
+// frame: 128 bytes): memory grows with what is really read, not with what the count announces.
+TEST(MetaTypeBytesErrors, CountsOfBigElementsDoNotReserveAhead) {
+  VSD_TEST_RUN_CAPPED();
+  std::vector<std::uint8_t> b;
+  vsd::ByteWriter w(b);
+  w.varint(4'000'000);             // 512 MB of frames announced ...
+  b.resize(b.size() + 4'000'000);  // ... in 4 MB: one frame takes 96 bytes, so they run short
+  vsd_test::cap_memory(std::size_t{64} << 20);
+  EXPECT_THAT(bytes_error<std::vector<Eigen::Isometry3d>>(b), HasSubstr("truncated data"));
 }
 
 TEST(MetaTypeBytesErrors, OverlongVarint) {

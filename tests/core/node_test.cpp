@@ -104,6 +104,17 @@ TEST_F(NodeTest, VisitGoesDepthFirstParentsFirst) {
   EXPECT_THAT(seen, ElementsAre("", "a", "b", "c"));
 }
 
+TEST_F(NodeTest, VisitAndPathReachAnyDepth) {
+  vsd::Node* at = &root;
+  for (int i = 0; i < 100'000; ++i) at = &at->add_child(node(i % 2 == 0 ? "x" : "y"));
+  std::size_t count = 0;
+  root.visit([&](vsd::Node&) { ++count; });  // a recursion per level overflowed the stack here
+  EXPECT_EQ(count, 100'001u);
+  EXPECT_EQ(at->path().size(), 200'000u);
+  EXPECT_TRUE(root.contains(*at));
+  EXPECT_EQ(root.size(), 100'001u);
+}
+
 TEST_F(NodeTest, ExtensionsAttachToNodesAndToExtensions) {
   auto& n = node("n");
   auto& sensor = state.create<vsd_test::TSensor>();

@@ -271,6 +271,48 @@ TEST(Registry, APrivateRegistryTearsDownRunTimeClassHierarchies) {
   EXPECT_EQ(vsd::Registry::global().find_class("RgPrivBase"), nullptr);
 }
 
+// undefine_all removes what nothing else uses and keeps the rest with what it uses, in one pass.
+TEST(Registry, UndefineAllKeepsWhatIsUsedAndRemovesTheRest) {
+  vsd::Registry r;
+  const vsd::MetaType& color = vsd::EnumBuilder("RgColor").value("Red", 0).define(r);
+  const vsd::MetaType& tag = vsd::StructBuilder("RgTag").field("color", color).define(r);
+  const vsd::MetaType& spare = vsd::EnumBuilder("RgSpare").value("A", 0).define(r);
+  const vsd::MetaType& spares = r.get_type("vector<vector<RgSpare>>");
+  const vsd::MetaInstance& base = vsd::ClassBuilder("RgAllBase", vsd::Node::static_meta()).define(r);
+  const vsd::MetaInstance& sub = vsd::ClassBuilder("RgAllSub", base).property("tag", tag).define(r);
+  const vsd::MetaInstance& lone = vsd::ClassBuilder("RgAllLone", vsd::Node::static_meta())
+                                      .property("spare", spares)
+                                      .property("other", r.reference_type(vsd::TypeKind::SharedRef, base))
+                                      .define(r);
+  const vsd::MetaInstance& user = vsd::ClassBuilder("RgAllUser", vsd::Node::static_meta())
+                                      .property("watched", r.reference_type(vsd::TypeKind::SharedRef, lone))
+                                      .define(r);
+  {
+    vsd::Environment env(0, r);
+    env.main_state().create(sub);  // a live instance keeps RgAllSub, its base and the types it uses
+    const std::vector<const vsd::MetaInstance*> classes{&base, &sub, &lone};
+    const std::vector<const vsd::MetaType*> types{&color, &tag, &spare};
+    r.undefine_all(classes, types);
+    EXPECT_NE(r.find_class("RgAllSub"), nullptr);
+    EXPECT_NE(r.find_class("RgAllBase"), nullptr);
+    EXPECT_NE(r.find_type("RgTag"), nullptr);
+    EXPECT_NE(r.find_type("RgColor"), nullptr);
+    EXPECT_NE(r.find_class("RgAllLone"), nullptr) << "RgAllUser, not in the lists, refers to it";
+    EXPECT_NE(r.find_type("RgSpare"), nullptr) << "RgAllLone, kept, uses it";
+  }
+  r.undefine(user);
+  const std::vector<const vsd::MetaInstance*> classes{&lone, &sub, &base};
+  const std::vector<const vsd::MetaType*> types{&tag, &spare, &color};
+  r.undefine_all(classes, types);  // the instance is gone: everything goes
+  for (const char* name : {"RgAllBase", "RgAllSub", "RgAllLone"})
+    EXPECT_EQ(r.find_class(name), nullptr) << name;
+  for (const char* name : {"RgColor", "RgTag", "RgSpare", "vector<RgSpare>", "vector<vector<RgSpare>>",
+                           "shared<RgAllBase>", "shared<RgAllLone>"})
+    EXPECT_EQ(r.find_type(name), nullptr) << name;
+  const auto derived = vsd::Node::static_meta().derived();
+  EXPECT_EQ(std::count(derived.begin(), derived.end(), &base), 0) << "unlinked from its base";
+}
+
 TEST(Registry, ARunTimeBaseMustLiveInTheSameRegistry) {
   vsd::Registry one;
   vsd::Registry two;

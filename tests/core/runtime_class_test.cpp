@@ -517,6 +517,25 @@ TEST(RuntimeClass, BaseMustBeASimStateInstance) {
   EXPECT_EQ(vsd::Registry::global().find_class("RcBadBase_Env"), nullptr);
 }
 
+// Each class keeps all its ancestors and their properties: a chain of classes costs the square of its length
+// in memory. A chain a file or a script could make without end (100,000 classes: tens of GB) stops at
+// MetaInstance::max_depth.
+TEST(RuntimeClass, ClassChainsAreBounded) {
+  vsd::Registry registry;
+  const vsd::MetaInstance* base = &vsd::Node::static_meta();
+  while (base->depth() < vsd::MetaInstance::max_depth)
+    base = &vsd::ClassBuilder("Deep" + std::to_string(base->depth()), *base)
+                .property<int>("p" + std::to_string(base->depth()), 1)
+                .define(registry);
+  EXPECT_EQ(base->properties().size(), vsd::Node::static_meta().properties().size() +
+                                           vsd::MetaInstance::max_depth - vsd::Node::static_meta().depth());
+  const std::string e = error_of([&] { vsd::ClassBuilder("TooDeep", *base); });
+  EXPECT_EQ(e, "run-time class 'TooDeep' would derive from more than 256 classes (its base '" + base->name() +
+                   "' is 256 deep)");
+  vsd::Environment env(0, registry);
+  EXPECT_EQ(env.main_state().create(*base).get<int>("p200"), 1);
+}
+
 // ---- the element index and signals ------------------------------------------------------------------------
 
 TEST(RuntimeClass, ElementIndexFindsInstances) {

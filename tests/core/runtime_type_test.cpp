@@ -237,4 +237,34 @@ TEST(RuntimeTypes, BuildersCheckWhatTheyAreGiven) {
   EXPECT_EQ(r.find_type("S"), nullptr);
 }
 
+// Values of run-time types are copied, compared, read and written by recursion over their parts: how deep
+// a type may nest is bounded (MetaType::max_depth), so that a file or a script defining a struct of a
+// struct of ... (or naming vector<vector<...>>) a hundred thousand levels deep gets an error, not a crash.
+TEST(RuntimeTypes, NestingIsBounded) {
+  vsd::Registry r;
+  const vsd::MetaType* t = &vsd::meta_type<double>();
+  EXPECT_EQ(t->depth(), 1u);
+  for (std::size_t depth = 2; depth <= vsd::MetaType::max_depth; ++depth) {
+    t = depth % 2 == 0 ? &vsd::StructBuilder("S" + std::to_string(depth)).field("inner", *t).define(r)
+                       : &r.vector_type(*t);
+    ASSERT_EQ(t->depth(), depth);
+  }
+  EXPECT_THAT([&] { vsd::StructBuilder("Deeper").field("inner", *t).define(r); },
+              ThrowsMessage<vsd::Error>("struct 'Deeper': values would nest deeper than 64 levels"));
+  EXPECT_THAT([&] { (void)r.vector_type(*t); },
+              ThrowsMessage<vsd::Error>(HasSubstr(">: values would nest deeper than 64 levels")));
+  EXPECT_EQ(r.find_type("Deeper"), nullptr);
+  // A value of the deepest type goes through text and bytes.
+  vsd::Value v(*t);
+  EXPECT_EQ(vsd::Value::from_text(*t, v.type()->to_text(v.data())), v);
+  // Names: each "vector<" is a level; a name deeper than any type may be is refused before it is parsed.
+  std::string name = "S64";
+  for (int i = 0; i < 100'000; ++i) name = "vector<" + name + ">";
+  EXPECT_THAT([&] { (void)r.get_type(name); },
+              ThrowsMessage<vsd::Error>(HasSubstr("vectors nest deeper than 64 levels")));
+  EXPECT_THAT([&] { (void)r.get_type("vector<S64>"); },
+              ThrowsMessage<vsd::Error>(HasSubstr("values would nest deeper than 64 levels")));
+  EXPECT_EQ(r.get_type("vector<S62>").depth(), 63u);
+}
+
 }  // namespace

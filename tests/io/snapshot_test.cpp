@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <string_view>
 
+#include "../core/memory_cap.hpp"
 #include "../core/random_model.hpp"
 #include "io_model.hpp"
+#include "vsd/core/bytes.hpp"
 #include "vsd/io/file.hpp"
 
 using testing::HasSubstr;
@@ -42,6 +45,30 @@ TEST_P(Snapshot, WholeStateRoundTripKeepsIdsAndEverything) {
   EXPECT_TRUE(report.warnings.empty());
   EXPECT_EQ(vsd_test::check_reference_counts(copy), "");
   EXPECT_EQ(vsd::io::save_bytes(copy, format()), bytes) << "saving what was loaded gives the same bytes";
+}
+
+// A chain of 100,000 nodes saves, loads (whole, and under the bottom of another deep chain) and goes in
+// about linear time: a load used to check every link against all the levels above it.
+TEST_P(Snapshot, DeepChainsLoadAndGo) {
+  constexpr std::size_t deep = 100'000;
+  vsd::Environment env;
+  vsd::Node* at = &env.main_state().database();
+  for (std::size_t i = 0; i < deep; ++i) at = &at->add_child(env.main_state().create<vsd::Node>());
+  const auto bytes = vsd::io::save_bytes(env.main_state(), format());
+  auto& copy = env.create_state("copy");
+  vsd::io::load_bytes(copy, bytes);
+  EXPECT_EQ(copy.size(), deep + 1);
+  const vsd::Node* bottom = copy.find(at->id())->as<vsd::Node>();
+  ASSERT_NE(bottom, nullptr);
+  std::size_t depth = 0;
+  for (const vsd::Node* n = bottom; n != &copy.database(); n = n->parent()) ++depth;
+  EXPECT_EQ(depth, deep);
+  const auto report = vsd::io::load_bytes(*at, bytes);  // under the bottom of the original chain
+  ASSERT_EQ(report.roots.size(), 1u);
+  EXPECT_EQ(env.main_state().size(), 2 * deep + 1);
+  copy.destroy(*copy.database().children()[0]);
+  EXPECT_EQ(copy.size(), 1u);
+  env.remove_state(copy);
 }
 
 // A load keeps no value for a reference without targets (an empty list, a null reference): the property
@@ -320,6 +347,53 @@ TEST(SnapshotFiles, SaveAndLoadThroughFiles) {
   std::filesystem::remove(path);
   EXPECT_THAT([&] { vsd::io::load(copy, path); },
               testing::ThrowsMessage<vsd::Error>(HasSubstr("cannot open")));
+  // A directory is said to be one (it was "a file of 9223372036854775807 bytes").
+  const auto dir = std::filesystem::temp_directory_path();
+  EXPECT_THAT([&] { vsd::io::load(copy, dir); },
+              testing::ThrowsMessage<vsd::Error>(HasSubstr(dir.string() + ": is a directory, not a file")));
+}
+
+// A file whose model does not fit the memory left is a vsd::Error naming the file, like any bad file:
+// std::bad_alloc never leaves a load or a check.
+TEST_P(Snapshot, RunningOutOfMemoryIsAnError) {
+  VSD_TEST_RUN_CAPPED();
+  // 300,000 nodes, written directly (a state built first would leave its freed memory to the load).
+  constexpr vsd::Id count = 300'000;
+  std::vector<std::uint8_t> bytes;
+  if (format() == vsd::io::Format::Binary) {
+    vsd::ByteWriter w(bytes);
+    for (const char c : std::string_view("VSDS\x01\x00", 6)) w.u8(static_cast<std::uint8_t>(c));
+    w.varint(1);  // one class: Node, C++, no saved property
+    w.string("Node");
+    w.u8(0);
+    w.varint(0);
+    w.varint(count);
+    for (vsd::Id id = 2; id < count + 2; ++id) {
+      w.varint(id);
+      w.varint(0);
+    }
+    w.varint(0);  // no top-level node
+  } else {
+    std::string text = "{\"format\": \"vsd-text\", \"version\": 1, \"instances\": [";
+    for (vsd::Id id = 2; id < count + 2; ++id)
+      text +=
+          (id == 2 ? "" : ",\n") + std::string("{\"@id\": ") + std::to_string(id) + ", \"@class\": \"Node\"}";
+    text += "]}\n";
+    bytes.assign(text.begin(), text.end());
+  }
+  vsd_test::cap_memory(std::size_t{16} << 20);
+  for (const bool load : {false, true}) {
+    vsd::Environment env;
+    EXPECT_THAT(
+        [&] {
+          if (load)
+            vsd::io::load_bytes(env.main_state(), bytes, "big.vsd");
+          else
+            (void)vsd::io::check_bytes(bytes, "big.vsd");
+        },
+        testing::ThrowsMessage<vsd::Error>(testing::StartsWith("big.vsd: out of memory while")))
+        << (load ? "load" : "check");
+  }
 }
 
 }  // namespace

@@ -68,6 +68,20 @@ TEST(TextFormat, GoldenFileIsStable) {
 
 // A file written by hand: members in another order, "@class" after properties, no class table, the
 // older value forms (bare enum names, unquoted struct keys, @ids), properties left out, a byte order mark.
+// A saved text file is a text file: it ends with a newline (and one without reads as well).
+TEST(TextFormat, SavedTextEndsWithANewline) {
+  vsd::Environment env;
+  build_golden_model(env.main_state());
+  std::string text = text_of(vsd::io::save_bytes(env.main_state(), Format::Text));
+  ASSERT_FALSE(text.empty());
+  EXPECT_EQ(text.back(), '\n');
+  EXPECT_NE(text[text.size() - 2], '\n') << "one newline";
+  text.pop_back();
+  vsd::Environment other;
+  vsd::io::load_bytes(other.main_state(), bytes_of(text));
+  EXPECT_EQ(diff_of(env.main_state(), other.main_state()), "");
+}
+
 TEST(TextFormat, HandWrittenFilesLoad) {
   vsd::Environment env;
   const auto report = vsd::io::load(env.main_state(), golden_path("handwritten.json"));
@@ -282,6 +296,87 @@ TEST_F(BadText, DeepNestingIsAnErrorNotACrash) {
   for (int i = 0; i < 100000; ++i) objects += "{\"a\":";
   EXPECT_THAT(load_error("{\"format\": \"vsd-text\", \"version\": 1, \"extra\": " + objects + "}"),
               HasSubstr("nested deeper"));
+}
+
+// Definitions a file may chain without end: a struct of a struct of ..., a class derived from a class
+// derived from ... . Both stop at a fixed depth with an error where the definition is, and leave nothing.
+TEST_F(BadText, EndlessChainsOfDefinitionsAreRefused) {
+  std::string types = "{\"format\": \"vsd-text\", \"version\": 2, \"types\": [\n";
+  for (int i = 0; i < 100; ++i)
+    types += std::string(i == 0 ? "" : ",\n") + "{\"type\": \"IoChain" + std::to_string(i) +
+             "\", \"kind\": \"struct\", \"fields\": [[\"x\", \"" +
+             (i == 0 ? std::string("double") : "IoChain" + std::to_string(i - 1)) + "\"]]}";
+  types += "]}";
+  EXPECT_EQ(
+      load_error(types),
+      "model.json:65:1: cannot define type 'IoChain63': struct 'IoChain63': values would nest deeper than "
+      "64 levels");
+  EXPECT_EQ(vsd::Registry::global().find_type("IoChain0"), nullptr) << "nothing is left behind";
+
+  std::string classes = "{\"format\": \"vsd-text\", \"version\": 1, \"classes\": [\n";
+  for (int i = 0; i < 100'000; ++i)
+    classes += std::string(i == 0 ? "" : ",\n") + "{\"class\": \"IoDeep" + std::to_string(i) +
+               "\", \"base\": \"" + (i == 0 ? std::string("Node") : "IoDeep" + std::to_string(i - 1)) +
+               "\", \"properties\": []}";
+  classes += "]}";
+  EXPECT_THAT(load_error(classes), HasSubstr("model.json:255:1: cannot define class 'IoDeep253': run-time "
+                                             "class 'IoDeep253' would derive from more than 256 classes"));
+  EXPECT_EQ(vsd::Registry::global().find_class("IoDeep0"), nullptr);
+}
+
+// A class of many properties and instances that give them all: each value finds its property at once (a
+// search through all of them for each value, and for "given twice", was quadratic in the class's width).
+TEST_F(BadText, WideClassesLoadInLinearTime) {
+  constexpr int width = 20'000;
+  std::string file =
+      "{\"format\": \"vsd-text\", \"version\": 1, \"classes\": [{\"class\": \"IoWide\", "
+      "\"base\": \"Node\", \"properties\": [";
+  for (int i = 0; i < width; ++i)
+    file +=
+        std::string(i == 0 ? "" : ",\n") + "{\"name\": \"p" + std::to_string(i) + "\", \"type\": \"int32\"}";
+  file += "]}],\n\"instances\": [";
+  for (int k = 0; k < 3; ++k) {
+    file +=
+        std::string(k == 0 ? "" : ",\n") + "{\"@id\": " + std::to_string(k + 2) + ", \"@class\": \"IoWide\"";
+    for (int i = width; i-- > 0;) file += ", \"p" + std::to_string(i) + "\": " + std::to_string(i + k);
+    file += "}";
+  }
+  file += "]}";
+  vsd::Environment env;
+  vsd::io::load_bytes(env.main_state(), bytes_of(file), "wide.json");
+  EXPECT_EQ(env.main_state().find(4)->get<std::int32_t>("p19999"), 20'001);
+}
+
+// Many definitions: defining them, and removing them again when the load fails or was only a check, each
+// cost what one does.
+TEST_F(BadText, ManyDefinitionsComeAndGoInLinearTime) {
+  constexpr int count = 10'000;
+  std::string file = "{\"format\": \"vsd-text\", \"version\": 2, \"types\": [\n";
+  for (int i = 0; i < count; ++i)
+    file += std::string(i == 0 ? "" : ",\n") + "{\"type\": \"IoMany" + std::to_string(i) +
+            "\", \"kind\": \"enum\", \"values\": [[\"A\", 0]]}";
+  file += "],\n\"classes\": [\n";
+  for (int i = 0; i < count; ++i)
+    file += std::string(i == 0 ? "" : ",\n") + "{\"class\": \"IoManyC" + std::to_string(i) +
+            "\", \"base\": \"Node\", \"properties\": [{\"name\": \"e\", \"type\": \"IoMany" +
+            std::to_string(i) + "\"}]}";
+  file += "]}";
+  const auto report = vsd::io::check_bytes(bytes_of(file), "many.json");
+  EXPECT_EQ(report.defined_types.size(), static_cast<std::size_t>(count));
+  EXPECT_EQ(report.defined_classes.size(), static_cast<std::size_t>(count));
+  EXPECT_EQ(vsd::Registry::global().find_type("IoMany0"), nullptr) << "a check leaves nothing behind";
+  EXPECT_EQ(vsd::Registry::global().find_class("IoManyC0"), nullptr);
+}
+
+// Many warnings cost what one does: their positions are counted on through the file, not from its start.
+TEST_F(BadText, ManyWarningsAreCheap) {
+  std::string file = "{\"format\": \"vsd-text\", \"version\": 1";
+  for (int i = 0; i < 100'000; ++i) file += ",\n\"unknown" + std::to_string(i) + "\": [1, 2, 3]";
+  file += "}";
+  std::vector<std::string> warnings;
+  EXPECT_EQ(load_error(file, &warnings), "<loaded>");
+  ASSERT_EQ(warnings.size(), 100'000u);
+  EXPECT_EQ(warnings.back(), "model.json:100001:1: unknown member 'unknown99999' is ignored");
 }
 
 TEST_F(BadText, UnknownMembersAndPropertiesAreReported) {

@@ -55,6 +55,51 @@ TEST(TopLevel, RootsAreTheDatabasesChildrenInBothFormats) {
   }
 }
 
+// A node has one parent and an extension one owner: a file that lists one twice is refused where the
+// second listing is. The core lets a program make such a state (SimStateInstance::list_insert), so both
+// formats can carry it.
+TEST(TopLevel, ANodeHasOneParentInEveryFile) {
+  vsd::Environment env;
+  const std::string twice = head +
+                            "{\"@id\": 2, \"@class\": \"Node\", \"children\": [\"@4\"]},\n"
+                            "{\"@id\": 3, \"@class\": \"Node\", \"children\": [\"@5\", \"@4\"]},\n"
+                            "{\"@id\": 4, \"@class\": \"Node\"}, {\"@id\": 5, \"@class\": \"Node\"}],\n"
+                            "\"top\": [\"@2\", \"@3\"]}";
+  EXPECT_EQ(
+      load_error(env.main_state(), bytes_of(twice), "two.json"),
+      "two.json:4:49: node #4 is already a child of #2: #3.children lists it too (a node has one parent)");
+  const std::string same = head +
+                           "{\"@id\": 2, \"@class\": \"Node\", \"children\": [\"@4\", \"@4\"]},\n"
+                           "{\"@id\": 4, \"@class\": \"Node\"}], \"top\": [\"@2\"]}";
+  EXPECT_EQ(load_error(env.main_state(), bytes_of(same), "same.json"),
+            "same.json:3:49: node #4 is listed twice in #2.children (a node has one parent)");
+  const std::string owners = head +
+                             "{\"@id\": 2, \"@class\": \"Node\", \"extensions\": [\"@4\"]},\n"
+                             "{\"@id\": 3, \"@class\": \"Node\", \"extensions\": [\"@4\"]},\n"
+                             "{\"@id\": 4, \"@class\": \"Extension\"}], \"top\": [\"@2\", \"@3\"]}";
+  EXPECT_THAT(
+      load_error(env.main_state(), bytes_of(owners), "owners.json"),
+      HasSubstr("owners.json:4:45: extension #4 is already attached to #2: #3.extensions lists it too"));
+
+  // Written by a program, in both formats.
+  vsd::SimState& s = env.main_state();
+  auto& a = s.create<vsd::Node>();
+  auto& b = s.create<vsd::Node>();
+  auto& c = s.create<vsd::Node>();
+  s.database().add_child(a);
+  s.database().add_child(b);
+  a.add_child(c);
+  b.list_insert(vsd::Node::vsd_prop_children(), 0, c);
+  for (const Format f : {Format::Binary, Format::Text}) {
+    auto& copy = env.create_state(f == Format::Text ? "text" : "binary");
+    const std::string e = load_error(copy, vsd::io::save_bytes(s, f), "file");
+    EXPECT_THAT(
+        e, HasSubstr("node #" + std::to_string(c.id()) + " is already a child of #" + std::to_string(a.id()) +
+                     ": #" + std::to_string(b.id()) + ".children lists it too"));
+    EXPECT_THAT(e, testing::StartsWith(f == Format::Text ? "file:" : "file: byte "));
+  }
+}
+
 TEST(TopLevel, TextTopMustAgreeWithTheDatabase) {
   // #3 is a node of the file but not a child of the Database: "top" that names it is an error where it says
   // so.

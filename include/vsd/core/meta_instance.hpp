@@ -18,6 +18,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_set>
 #include <vector>
 
 #include "vsd/core/meta_method.hpp"
@@ -108,6 +109,8 @@ class MetaInstance {
   [[nodiscard]] const MetaInstance* base() const noexcept { return base_; }
   /// @brief Distance from Instance in the hierarchy (Instance is 0).
   [[nodiscard]] std::size_t depth() const noexcept { return depth_; }
+  /// @brief The deepest a run-time class may be (ClassBuilder refuses deeper ones).
+  static constexpr std::size_t max_depth = 256;
   /// @brief Dense number unique among all MetaInstances of the program (element index slots).
   [[nodiscard]] std::size_t index() const noexcept { return index_; }
   [[nodiscard]] bool is_runtime() const noexcept { return runtime_; }
@@ -196,6 +199,7 @@ class MetaInstance {
   bool runtime_ = false;
   bool abstract_ = false;
   std::vector<std::unique_ptr<MetaProperty>> own_props_;
+  std::unordered_set<std::string_view> own_names_;  // of own_props_: a property given twice is found at once
   std::vector<std::unique_ptr<MetaMethod>> own_methods_;
   std::vector<const MetaProperty*> props_;
   std::vector<const MetaProperty*> ref_props_;

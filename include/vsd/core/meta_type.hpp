@@ -143,6 +143,11 @@ class MetaType {
   [[nodiscard]] const std::vector<Field>& fields() const noexcept { return fields_; }
   /// @brief Element type of a Vector type.
   [[nodiscard]] const MetaType* element() const noexcept { return element_; }
+  /// @brief How deeply a value nests: 1 for a value without parts, one more than its deepest field for a
+  /// struct, one more than its element for a vector. Run-time types are limited to max_depth, so that
+  /// the recursive operations on values (copy, compare, read, write) stay shallow whatever a file defines.
+  [[nodiscard]] std::size_t depth() const noexcept { return depth_; }
+  static constexpr std::size_t max_depth = 64;
   /// @brief Class a reference type points to.
   [[nodiscard]] const MetaInstance* target() const {
     return target_ != nullptr ? target_ : (target_fn_ != nullptr ? &target_fn_() : nullptr);
@@ -198,6 +203,7 @@ class MetaType {
     return *this;
   }
   MetaType& add_field(Field f) {
+    deepen(*f.type);
     fields_.push_back(std::move(f));
     return *this;
   }
@@ -211,6 +217,7 @@ class MetaType {
   }
   MetaType& set_element(const MetaType* e) noexcept {
     element_ = e;
+    if (e != nullptr) deepen(*e);
     return *this;
   }
   MetaType& set_target(const MetaInstance* t) noexcept {
@@ -224,12 +231,17 @@ class MetaType {
   }
 
  private:
+  void deepen(const MetaType& part) noexcept {
+    if (part.depth_ >= depth_ && part.depth_ < 0xFFFF) depth_ = static_cast<std::uint16_t>(part.depth_ + 1);
+  }
+
   std::string name_;
   const TypeOps* ops_;
   std::size_t size_;
   std::size_t align_;
   TypeKind kind_;
   bool unsigned_ = false;
+  std::uint16_t depth_ = 1;  // (in the padding after kind_ and unsigned_)
   const void* tag_ = nullptr;
   std::vector<EnumValue> enum_values_;
   std::vector<Field> fields_;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <string_view>
+#include <vector>
 
 #include "vsd/core/named_model_instance.hpp"
 
@@ -31,11 +32,17 @@ class Node : public NamedModelInstance {
   [[nodiscard]] Node* find_child(std::string_view name) const noexcept;
   /// @brief Names from the root down, joined by '/': "/robot/arm".
   [[nodiscard]] std::string path() const;
-  /// @brief Calls @p fn for this node and every descendant, depth first, parents before children.
+  /// @brief Calls @p fn for this node and every descendant, depth first, parents before children. A loop,
+  /// not a recursion: a tree of any depth fits the stack.
   template <class F>
   void visit(F&& fn) {
-    fn(*this);
-    for (Node* c : children_) c->visit(fn);
+    std::vector<Node*> todo{this};
+    while (!todo.empty()) {
+      Node* n = todo.back();
+      todo.pop_back();
+      fn(*n);
+      for (std::size_t i = n->children_.size(); i-- > 0;) todo.push_back(n->children_[i]);
+    }
   }
 };
 

@@ -20,9 +20,11 @@
 #include <memory>
 #include <mutex>
 #include <shared_mutex>
+#include <span>
 #include <string>
 #include <string_view>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "vsd/core/meta_instance.hpp"
@@ -108,6 +110,14 @@ class Registry {
   /// @brief True when @p type is a run-time value type this Registry owns (not a reference type).
   [[nodiscard]] bool owns(const MetaType& type) const;
 
+  /// @brief Undefines as many of @p classes and @p types (run-time ones of this registry) as nothing else
+  /// uses, and keeps the rest: a class with live instances, a subclass or a referring property outside
+  /// the lists, a type used outside them, and what those kept ones use. The reference types of removed
+  /// classes and the vectors of removed types go with them. One pass over the registry, however many are
+  /// removed: what a load that fails (or only checks) defined goes in time linear in the registry's size,
+  /// where one undefine() per class and type was quadratic.
+  void undefine_all(std::span<const MetaInstance* const> classes, std::span<const MetaType* const> types);
+
  private:
   void add_locked(const MetaInstance& cls);
   void index_locked(const MetaInstance& cls);
@@ -127,6 +137,7 @@ class Registry {
   // run-time class's properties (and their default values) use these types until the class is gone.
   std::vector<std::unique_ptr<MetaType>> runtime_types_;
   std::vector<std::unique_ptr<MetaInstance>> runtime_classes_;
+  std::unordered_set<const MetaInstance*> owned_classes_;  // those of runtime_classes_
 };
 
 }  // namespace vsd

@@ -252,6 +252,7 @@ class SimState : public Instance {
   std::vector<std::unique_ptr<TypeSignal>> type_exact_, type_tree_;
   std::vector<std::uint8_t> class_watch_;  // per class index: 0 not known yet, 1 unwatched, 2 watched
   std::vector<SimStateInstance*> graveyard_;  // deleted during a dispatch, freed when it ends
+  std::vector<SimStateInstance*>* cascade_ = nullptr;  // released instances still to delete (released())
   int dispatching_ = 0;
   int derive_depth_ = -1;  // dispatch depth of derived changes (see Deriving), -1 when none
   std::size_t type_signals_ = 0;

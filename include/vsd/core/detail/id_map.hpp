@@ -47,6 +47,7 @@ class FlatIdMap {
       if (e.id == null_id) {
         e = Entry{id, value};
         ++size_;
+        note_reach(id, i);
         return true;
       }
       if (e.id == id) return false;
@@ -62,6 +63,7 @@ class FlatIdMap {
       if (e.id == null_id) {
         e = Entry{id, V{}};
         ++size_;
+        if (VSD_UNLIKELY(note_reach(id, i))) return get(id);  // the table was rebuilt
         return &e.value;
       }
       if (e.id == id) return nullptr;
@@ -88,11 +90,13 @@ class FlatIdMap {
     std::size_t i = slot(id);
     while (table_[i].id != null_id && table_[i].id != id) i = (i + 1) & mask_;
     if (table_[i].id == null_id) return;
-    // Backward-shift deletion: pull later entries of the probe run into the hole.
-    for (std::size_t j = (i + 1) & mask_; table_[j].id != null_id; j = (j + 1) & mask_) {
-      const std::size_t home = slot(table_[j].id);
-      const bool movable = i <= j ? (home <= i || home > j) : (home <= i && home > j);
-      if (movable) {
+    // Backward-shift deletion: pull later entries of the probe run into the hole. An entry can fill it
+    // when it sits at least as far from its home slot as from the hole; none sits farther than reach_,
+    // so the scan ends reach_ slots past the hole. (Dense ids fill one long run, each entry at home: a
+    // scan to the end of the run made erasing them in order quadratic.)
+    for (std::size_t j = (i + 1) & mask_; table_[j].id != null_id && ((j - i) & mask_) <= reach_;
+         j = (j + 1) & mask_) {
+      if (((j - slot(table_[j].id)) & mask_) >= ((j - i) & mask_)) {
         table_[i] = table_[j];
         i = j;
       }
@@ -105,6 +109,8 @@ class FlatIdMap {
     table_.clear();
     mask_ = 0;
     size_ = 0;
+    reach_ = 0;
+    mixed_ = false;
   }
 
   /// Calls @p fn(id, value) for every entry, in no particular order.
@@ -131,16 +137,35 @@ class FlatIdMap {
     // Ids of one site are dense and handed out in order: their low bits are already a perfect hash,
     // and neighbouring ids land in neighbouring slots (instances made together are looked up
     // together). Only the site (top 16 bits) is mixed in, so that sites do not pile onto one run.
+    // But ids only grow: once the live ones span more than the table, new ids land on the run of old
+    // ones still there (a long-lived tree of 65,536 and a churn of others: every insert walked the run).
+    // A probe that long switches the table to a mixing hash (note_reach), for good.
     const std::uint64_t site = id >> 48;
+    if (VSD_UNLIKELY(mixed_)) return static_cast<std::size_t>((id * 0x9E3779B97F4A7C15ULL) >> shift_);
     return static_cast<std::size_t>(id ^ (site * 0x9E3779B97F4A7C15ULL)) & mask_;
   }
+  // Keeps reach_ at least the distance of every entry from its home slot (a backward shift only brings
+  // entries nearer home, so it stays a bound until the table is rebuilt).
+  // Returns true when it rebuilt the table (entries moved).
+  bool note_reach(Id id, std::size_t at) {
+    const std::size_t d = (at - slot(id)) & mask_;
+    if (d > reach_) reach_ = d;
+    if (VSD_LIKELY(d <= long_probe || mixed_)) return false;
+    mixed_ = true;
+    rehash(table_.size());
+    return true;
+  }
+  static constexpr std::size_t long_probe = 64;
   void grow() { rehash(table_.empty() ? 16 : table_.size() * 2); }
   void rehash(std::size_t capacity) {
     std::vector<Entry, HugeAllocator<Entry>> old;
     old.swap(table_);
     table_.assign(capacity, Entry{});
     mask_ = table_.size() - 1;
+    shift_ = 64;
+    for (std::size_t n = table_.size(); n > 1; n /= 2) --shift_;
     size_ = 0;
+    reach_ = 0;
     for (const Entry& e : old)
       if (e.id != null_id) insert(e.id, e.value);
   }
@@ -149,6 +174,9 @@ class FlatIdMap {
   std::vector<Entry, HugeAllocator<Entry>> table_;
   std::size_t mask_ = 0;
   std::size_t size_ = 0;
+  std::size_t reach_ = 0;  // no entry sits farther than this from its home slot
+  unsigned shift_ = 64;    // 64 - log2(table size): the mixing hash takes the top bits of a product
+  bool mixed_ = false;     // slots by a mixing hash (see slot())
 };
 
 /// Instances of a SimState by id.

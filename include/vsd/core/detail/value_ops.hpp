@@ -3,6 +3,7 @@
  */
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -169,7 +170,9 @@ void bytes_in(const MetaType& t, T& v, ByteReader& in, const RefResolver* refs) 
     } else {
       const std::size_t n = vector_read_bytes_size(in, 1);
       T result;
-      result.reserve(n);
+      // The count is checked against one byte per element, but an element may take far more memory than
+      // that (a frame: 128 bytes): past a megabyte, memory grows with what is really read.
+      result.reserve(std::min(n, (std::size_t{1} << 20) / sizeof(E) + 1));
       for (std::size_t i = 0; i < n; ++i) {
         E e = DefaultValue<E>::make();
         bytes_in<E>(et, e, in, refs);
