@@ -343,6 +343,10 @@ SomlNetImport read_soml_net(std::string_view text, std::string_view source) {
   return net_from_soml(*checked);
 }
 
+SomlNetImport read_soml_net(std::istream& in, std::string_view source) {
+  return read_soml_net(detail::read_text(in, source), source);
+}
+
 SomlNetImport read_soml_net_file(const std::filesystem::path& path) {
   return read_soml_net(detail::read_text_file(path), path.string());
 }
