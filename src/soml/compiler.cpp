@@ -209,7 +209,13 @@ class Compiler {
       if (it == P.prop_slot_.end()) not_supported(P, loc, "this property");
       return it->second;
     }
-    return meta_slot(b.property);
+    const int slot = meta_slot(b.property);
+    // What the VM cannot move between a property and a register is refused here, at load, never at run
+    // time (every kind is handled today; a new one must be added to meta_slot and the VM first).
+    const PropSlot& ps = P.props_[static_cast<std::size_t>(slot)];
+    if (ps.kind == PK::Other && ps.prop->type().kind() != TypeKind::Float)
+      not_supported(P, loc, "property '" + ps.prop->name() + "' of type " + ps.prop->type().name());
+    return slot;
   }
   int meta_slot(const MetaProperty* mp) {
     auto it = P.meta_prop_slot_.find(mp);
@@ -246,11 +252,16 @@ class Compiler {
       case TypeKind::SharedRefList:
         s.kind = PK::List;
         break;
+      // Structs (Vector3d, Quaterniond, Isometry3d, VSD_STRUCTs) and vectors of structs or enums of a
+      // built-in class are Values in X registers, as those of script classes are (prop_kind).
+      case TypeKind::Struct:
+        s.kind = PK::Value;
+        break;
       case TypeKind::Vector:
-        s.kind = vector_elem_kind(t) != RK::None ? PK::Vector : PK::Other;
+        s.kind = vector_elem_kind(t) != RK::None ? PK::Vector : PK::Value;
         break;
       default:
-        s.kind = PK::Other;
+        s.kind = PK::Other;  // float: through the MetaType's width (the VM's default cases)
     }
     P.props_.push_back(s);
     const int i = static_cast<int>(P.props_.size() - 1);
