@@ -115,6 +115,7 @@ class Compiler {
     F.code.push_back(Ins{op, 0, static_cast<std::uint16_t>(a), static_cast<std::uint16_t>(b),
                          static_cast<std::uint16_t>(c)});
     F.lines.push_back(line_);
+    F.positions.push_back(Function::Pos{pos_.line, pos_.column});
     return F.code.size() - 1;
   }
   // A vector instruction whose x says the element kind (1: strings).
@@ -158,7 +159,24 @@ class Compiler {
     if (top_ > max_) max_ = top_;
     return r;
   }
-  void at(SourceLoc loc) { line_ = loc.line; }
+  void at(SourceLoc loc) {
+    line_ = loc.line;
+    pos_ = loc;
+  }
+  // The position of an expression or statement while it is compiled: what its own instructions, emitted
+  // before and after those of its operands, carry for run-time errors. (line_ keeps the debugger's
+  // stepping as it was: the last line set.)
+  class Here {
+   public:
+    Here(Compiler& c, SourceLoc loc) : c_(c), saved_(c.pos_) { c.at(loc); }
+    ~Here() { c_.pos_ = saved_; }
+    Here(const Here&) = delete;
+    Here& operator=(const Here&) = delete;
+
+   private:
+    Compiler& c_;
+    SourceLoc saved_;
+  };
 
   int konst(std::int64_t v) {
     if (P.consts_.size() >= 65535) not_supported(P, SourceLoc{}, "more than 65535 constants in one script");
@@ -356,7 +374,7 @@ class Compiler {
   }
 
   int expr(const Expr& e) {
-    at(e.loc);
+    const Here at_node(*this, e.loc);
     switch (e.kind) {
       case ExprKind::Int: {
         const int r = temp();
@@ -882,6 +900,7 @@ class Compiler {
 
   // Computes a (non-logical) binary expression into register dst.
   void binary_into(const BinaryExpr& e, int dst) {
+    const Here at_node(*this, e.loc);
     const int save = top_;
     if (immediate(e, dst)) {
       top_ = save;
@@ -1339,7 +1358,7 @@ class Compiler {
   void stmt(const Stmt& s) {
     const int save = top_;
     const std::size_t open = open_.size();
-    at(s.loc);
+    const Here at_node(*this, s.loc);
     switch (s.kind) {
       case StmtKind::Block:
         block(s.as<BlockStmt>());
@@ -1554,6 +1573,7 @@ class Compiler {
   int top_;
   int max_;
   std::uint32_t line_ = 0;
+  SourceLoc pos_{0, 0, 0};
 };
 
 }  // namespace

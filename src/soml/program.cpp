@@ -2,6 +2,7 @@
 // classes and enums, the linkage table, compilation, and the instances of the script object, its objects
 // and their nets.
 #include <algorithm>
+#include <limits>
 #include <cctype>
 #include <mutex>
 
@@ -610,7 +611,12 @@ void ProgramImpl::define(std::string name, std::string text) {
             if (ti.in.back().object && !ti.in.back().inhibitor)
               ti.mark_in = static_cast<int>(ti.in.size() - 1);
           }
-          for (const ArrowDecl* a : t.outputs) ti.out.push_back(arrow_info(*a, a->to_decl));
+          for (const ArrowDecl* a : t.outputs) {
+            ti.out.push_back(arrow_info(*a, a->to_decl));
+            if (!ti.out.back().object &&
+                __builtin_add_overflow(ti.out_weight, ti.out.back().weight, &ti.out_weight))
+              ti.out_weight = std::numeric_limits<std::int64_t>::max();
+          }
           ti.guarded = ti.action >= 0 || ti.invoke != nullptr;
           for (const ArrowInfo& a : ti.out) ti.guarded = ti.guarded || a.cond >= 0;
           ci.net->transitions.push_back(std::move(ti));

@@ -218,9 +218,9 @@ double local(int i) { vector<Vector3d> v = points; v[i].x = 1; return v[i].x; }
   p.root().set("points", vsd::Value(std::vector<V3>{V3(1, 2, 3)}));
   EXPECT_DOUBLE_EQ(p.root().call("at", {vsd::Value(std::int64_t{0})}).as<double>(), 2.0);
   EXPECT_THAT(soml_test::error_of([&] { p.root().call("at", {vsd::Value(std::int64_t{1})}); }),
-              HasSubstr("index 1 out of range (size 1)\n  at at (test.soml:2)"));
+              HasSubstr("index 1 out of range (size 1)\n  at at (test.soml:2:33)"));
   EXPECT_THAT(soml_test::error_of([&] { p.root().call("local", {vsd::Value(std::int64_t{-1})}); }),
-              HasSubstr("index -1 out of range (size 1)\n  at local (test.soml:3)"));
+              HasSubstr("index -1 out of range (size 1)\n  at local (test.soml:3:53)"));
 }
 
 // docs/soml.md promises the properties of built-in classes and struct values: a struct property of a C++
