@@ -38,9 +38,115 @@ void walk(const Decl& d, F&& fn) {
 
 }  // namespace
 
+ProgramImpl::ProgramImpl(SimState& state, RunOptions options)
+    : registry_(state.environment().registry()), state_(state), opt_(options) {}
+
 ProgramImpl::~ProgramImpl() {
   listener_.disconnect();
   deleted_listener_.disconnect();
+  release_uses(true);
+}
+
+namespace {
+// How many live programs use each run-time class and enum (ProgramImpl::used_classes_): the last one to
+// go undefines them. Keyed by address; an entry lives only while its count is positive, that is while some
+// program holds the class.
+std::mutex users_mutex;
+std::unordered_map<const void*, int>& users() {
+  static std::unordered_map<const void*, int> all;
+  return all;
+}
+int users_of(const void* p) {
+  std::lock_guard lock(users_mutex);
+  auto it = users().find(p);
+  return it == users().end() ? 0 : it->second;
+}
+}  // namespace
+
+void ProgramImpl::release_uses(bool undefine) noexcept {
+  if (!counted_) return;
+  counted_ = false;
+  std::vector<const MetaInstance*> classes;
+  std::vector<const MetaType*> enums;
+  {
+    std::lock_guard lock(users_mutex);
+    auto last = [](const void* p) {
+      auto it = users().find(p);
+      if (it == users().end() || --it->second > 0) return false;
+      users().erase(it);
+      return true;
+    };
+    for (const MetaInstance* m : used_classes_)
+      if (last(m)) classes.push_back(m);
+    for (const MetaType* t : used_enums_)
+      if (last(t)) enums.push_back(t);
+  }
+  used_classes_.clear();
+  used_enums_.clear();
+  if (!undefine) return;
+  Registry& reg = registry_;
+  // Subclasses first. One with instances left (a state that outlives its program) or one still named by
+  // another class's property stays; a later load replaces it once nothing uses it.
+  std::stable_sort(classes.begin(), classes.end(),
+                   [](const MetaInstance* a, const MetaInstance* b) { return a->depth() > b->depth(); });
+  for (const MetaInstance* m : classes) try {
+      reg.undefine(*m);
+    } catch (const Error&) {  // NOLINT(bugprone-empty-catch): it stays (see above)
+    }
+  for (auto it = enums.rbegin(); it != enums.rend(); ++it) try {
+      reg.undefine(**it);
+    } catch (const Error&) {  // NOLINT(bugprone-empty-catch)
+    }
+}
+
+// SOML++ classes and enums that no live program uses and no instance holds are garbage — left by a
+// program that went while its state lived on, whose instances are gone now — and go before a load, so
+// that a script loads again under its names (docs/soml.md 8.1). Repeated while it makes progress: a class
+// goes after its subclasses and after the classes whose properties name it.
+void ProgramImpl::sweep_leftovers() {
+  Registry& reg = registry_;
+  auto garbage_class = [&](const MetaInstance* m) {
+    return m->is_runtime() && m->name().starts_with("soml::") && m->live_instances() == 0 && users_of(m) == 0;
+  };
+  for (bool progress = true; progress;) {
+    progress = false;
+    std::vector<const MetaInstance*> classes;
+    for (const MetaInstance* m : reg.classes())
+      if (garbage_class(m)) classes.push_back(m);
+    std::stable_sort(classes.begin(), classes.end(),
+                     [](const MetaInstance* a, const MetaInstance* b) { return a->depth() > b->depth(); });
+    for (const MetaInstance* m : classes) try {
+        reg.undefine(*m);
+        progress = true;
+      } catch (const Error&) {  // NOLINT(bugprone-empty-catch): a subclass or a property still names it
+      }
+  }
+  for (const MetaType* t : reg.types())
+    if (t->kind() == TypeKind::Enum && t->name().starts_with("soml::") && reg.owns(*t) && users_of(t) == 0) try {
+        reg.undefine(*t);
+      } catch (const Error&) {  // NOLINT(bugprone-empty-catch): a class still uses it
+      }
+}
+
+const MetaInstance& ProgramImpl::class_for(ClassBuilder& b, const std::string& name, const MetaInstance& base,
+                                           const ScopeDecl& decl) {
+  const MetaInstance* m = nullptr;
+  if (!attaching_ && registry_.find_class_exact(name) == nullptr) {
+    adopted_props_.clear();
+    adopted_methods_.clear();
+    m = &define_class(b);
+  } else {
+    m = &adopt_class(b, name, base, decl);  // shared when it is the same (defined when there is none)
+  }
+  used_classes_.push_back(m);
+  return *m;
+}
+
+const MetaType& ProgramImpl::enum_for(EnumBuilder& b, const std::string& name, const EnumDecl& decl) {
+  const MetaType* t = !attaching_ && registry_.find_type(name) == nullptr ? &define_enum(b)
+                                                                          : &adopt_enum(b, name, decl);
+  used_enums_.push_back(t);
+  return *t;
 }
 
 // The MetaType that stores a value of static type t (references to script classes are stored as
@@ -158,6 +264,8 @@ void ProgramImpl::undefine_own() noexcept {
     }
   defined_classes_.clear();
   defined_enums_.clear();
+  used_classes_.clear();
+  used_enums_.clear();
   scope_meta_.clear();
   by_meta_.clear();
   enums_.clear();
@@ -165,6 +273,7 @@ void ProgramImpl::undefine_own() noexcept {
 
 void ProgramImpl::define(std::string name, std::string text) {
   Registry& reg = state_.environment().registry();
+  sweep_leftovers();
   checked_ = check_source(name, std::move(text), reg);
   if (!checked_->ok()) throw Error(checked_->diagnostics.format());
   {
@@ -207,12 +316,13 @@ void ProgramImpl::define(std::string name, std::string text) {
         if (!same) not_supported(*this, e.loc, "changing the values of enum '" + e.name + "' at run time");
         enums_[&e] = old_type;
         reused_enums_.push_back(old_type);
+        used_enums_.push_back(old_type);
         return;
       }
     EnumBuilder b("soml::" + qualified(e));
     b.underlying(meta_type<std::int64_t>());
     for (std::size_t i = 0; i < e.values.size(); ++i) b.value(e.values[i], static_cast<std::int64_t>(i));
-    enums_[&e] = attaching_ ? &adopt_enum(b, "soml::" + qualified(e), e) : &define_enum(b);
+    enums_[&e] = &enum_for(b, "soml::" + qualified(e), e);
   });
 
   // 3. Class-like declarations, bases first.
@@ -248,7 +358,7 @@ void ProgramImpl::define(std::string name, std::string text) {
         const MetaType* t = storage_type(*this, reg, pd.type);
         if (t == nullptr) not_supported(*this, pd.loc, "a property of type '" + pd.type.name() + "'");
         b.property(pd.name, *t);
-        if (attaching_) adopted_props_.emplace_back(pd.name, t);
+        adopted_props_.emplace_back(pd.name, t);  // (what class_for compares with a class of that name)
       } else if (m->kind == DeclKind::Function && !m->as<FunctionDecl>().is_constructor) {
         const auto& fd = m->as<FunctionDecl>();
         std::vector<const MetaType*> args;
@@ -261,7 +371,7 @@ void ProgramImpl::define(std::string name, std::string text) {
             fd.result_type.kind == K::Void ? nullptr : storage_type(*this, reg, fd.result_type);
         const int fi = function_index_.at(&fd);
         std::weak_ptr<ProgramImpl> weak = weak_self_;
-        if (attaching_) adopted_methods_.push_back(AdoptedMethod{fd.name, args, result});
+        adopted_methods_.push_back(AdoptedMethod{fd.name, args, result});
         b.method(fd.name, std::move(args), result,
                  [weak, fi, fname = functions_[static_cast<std::size_t>(fi)]->name](
                      SimStateInstance& self, std::span<const Value> a) {
@@ -289,7 +399,7 @@ void ProgramImpl::define(std::string name, std::string text) {
       }
       ClassBuilder pb(cname + "::" + m->name, sb);
       add_members(pb, s);
-      scope_meta_[m.get()] = attaching_ ? &adopt_class(pb, cname + "::" + m->name, sb, s) : &define_class(pb);
+      scope_meta_[m.get()] = &class_for(pb, cname + "::" + m->name, sb, s);
     }
   };
   for (const ClassDecl* c : class_order_) {
@@ -313,9 +423,9 @@ void ProgramImpl::define(std::string name, std::string text) {
       const MetaType* t = storage_type(*this, reg, c->result_type);
       if (t == nullptr) not_supported(*this, c->loc, "a net result of type '" + c->result_type.name() + "'");
       b.property("result", *t);
-      if (attaching_) adopted_props_.emplace_back("result", t);
+      adopted_props_.emplace_back("result", t);
     }
-    ci->meta = attaching_ ? &adopt_class(b, cname, *base, *c) : &define_class(b);
+    ci->meta = &class_for(b, cname, *base, *c);
     scope_meta_[c] = ci->meta;
     by_meta_[ci->meta] = ci.get();
     member_classes(*c, cname);
@@ -333,7 +443,7 @@ void ProgramImpl::define(std::string name, std::string text) {
       const MetaInstance& sb = Transition::static_meta();
       ClassBuilder b(cname, sb);
       add_members(b, n);
-      scope_meta_[&n] = attaching_ ? &adopt_class(b, cname, sb, n) : &define_class(b);
+      scope_meta_[&n] = &class_for(b, cname, sb, n);
     }
     member_classes(n, cname);
   });
@@ -905,10 +1015,18 @@ std::vector<std::pair<const SimState*, std::weak_ptr<ProgramImpl>>>& programs_by
 }  // namespace
 
 void ProgramImpl::register_program() {
-  std::lock_guard lock(programs_mutex);
-  auto& all = programs_by_state();
-  std::erase_if(all, [](const auto& e) { return e.second.expired(); });
-  all.emplace_back(&state_, weak_self_);
+  {
+    std::lock_guard lock(programs_mutex);
+    auto& all = programs_by_state();
+    std::erase_if(all, [](const auto& e) { return e.second.expired(); });
+    all.emplace_back(&state_, weak_self_);
+  }
+  if (!counted_) {  // from now on a user of its classes (release_uses)
+    std::lock_guard lock(users_mutex);
+    for (const MetaInstance* m : used_classes_) ++users()[m];
+    for (const MetaType* t : used_enums_) ++users()[t];
+    counted_ = true;
+  }
 }
 
 Value ProgramImpl::dispatch(const std::weak_ptr<ProgramImpl>& weak, int fi, const std::string& fname,

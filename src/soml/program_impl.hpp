@@ -303,7 +303,7 @@ inline std::size_t pc_index(const Frame& f) noexcept {
 
 class ProgramImpl {
  public:
-  ProgramImpl(SimState& state, RunOptions options) : state_(state), opt_(options) {}
+  ProgramImpl(SimState& state, RunOptions options);
   ~ProgramImpl();
 
   void load(std::string name, std::string text);
@@ -325,6 +325,28 @@ class ProgramImpl {
   void undefine_own() noexcept;
   const MetaInstance& define_class(ClassBuilder& b);
   const MetaType& define_enum(EnumBuilder& b);
+  // The run-time class (enum) of a declaration when loading: defined, or, when the Registry has one of
+  // that name — the same script loaded in another Environment on the same Registry, or a class whose
+  // instances outlive their program — shared if it has the same definition; another definition is an
+  // error naming what differs.
+  const MetaInstance& class_for(ClassBuilder& b, const std::string& name, const MetaInstance& base,
+                                const ScopeDecl& decl);
+  const MetaType& enum_for(EnumBuilder& b, const std::string& name, const EnumDecl& decl);
+  // Every run-time class and enum this program uses (defined or shared), in definition order. A program
+  // counts as a user of them once it is registered (register_program); when the last user goes, they go
+  // too (Registry::undefine; a class whose instances outlive its programs stays until a load replaces
+  // it). docs/soml.md 8.1.
+  std::vector<const MetaInstance*> used_classes_;
+  std::vector<const MetaType*> used_enums_;
+  bool counted_ = false;  // register_program counted this program's uses
+  // The state's Registry, kept apart: a program may outlive its state (an Environment destroys its states
+  // before its modules, which own the programs), never the Registry.
+  Registry& registry_;
+  // Stops using them: each whose last user this was is undefined when @p undefine (a reload undefines the
+  // running version's classes itself).
+  void release_uses(bool undefine) noexcept;
+  // Before a definition: undefines the SOML++ classes and enums no program uses and no instance holds.
+  void sweep_leftovers();
   // Program::load and Program::attach: define and populate, all or nothing (a refused load leaves the
   // Registry and the SimState as they were).
   void load_or_undo(std::string name, std::string text);

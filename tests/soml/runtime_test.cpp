@@ -178,7 +178,7 @@ int copies(int n) { vector<string> keep; string big = "x"; for (int i = 0; i < 1
   const std::string e = error_of([&] { p.step(1); });
   EXPECT_THAT(e, HasSubstr("SOML++ run-time error: memory budget exhausted (4194304 bytes of strings, vectors, "
                            "values, stored changes and instances in one call; "));
-  EXPECT_THAT(e, HasSubstr("\n  at spawn (action) (alloc.soml:6:"));
+  EXPECT_THAT(e, HasSubstr("\n  at spawn (action) (alloc.soml:6:60)"));
   EXPECT_EQ(env.main_state().size(), nodes) << "the failed firing's instances are gone";
   EXPECT_EQ(p.place("go")->tokens(), 1) << "and its token is back";
   EXPECT_EQ(p.root().get<std::int64_t>("made"), 0);
@@ -404,6 +404,90 @@ object o : C;
 #include <fstream>
 
 namespace {
+
+constexpr const char* kJobs = R"(enum Mode { Idle, Busy }
+class Job : Node {
+  Mode mode = Mode::Idle;
+  int done = 0;
+  void work() { done += 1; }
+  start cell.queue;
+}
+object cell {
+  place<Job> queue;
+  transition go { do { mark.work(); } }
+  arrow queue -> go;
+}
+object first : Job {}
+int made() { shared<Job> j = new Job(); return j.done; }
+)";
+
+// A script's run-time classes stayed in the Registry after its Environment was gone, so the same script
+// could not be loaded again ("class name 'soml::Job' is already registered"), as when a simulation is
+// restarted in one process. They go with the last program that uses them.
+TEST(ProgramLifetime, TheSameScriptLoadsAgainAfterItsEnvironmentIsGone) {
+  vsd::Registry reg;  // shared by the Environments, as the global Registry is
+  for (int round = 0; round < 3; ++round) {
+    SCOPED_TRACE(round);
+    vsd::Environment env(0, reg);
+    Program& p = env.use<vsd::soml::Module>().load(env.main_state(), "jobs.soml", kJobs);
+    EXPECT_EQ(p.run_until_quiet(100), 1u);
+    ASSERT_NE(reg.find_class_exact("soml::Job"), nullptr);
+    EXPECT_EQ(p.script_class("Job"), reg.find_class_exact("soml::Job"));
+  }
+  EXPECT_EQ(reg.find_class_exact("soml::Job"), nullptr) << "gone with the last Environment that used it";
+  EXPECT_EQ(reg.find_class_exact("soml::cell"), nullptr);
+  EXPECT_EQ(reg.find_class_exact("soml::jobs"), nullptr) << "the script object's class too";
+  EXPECT_EQ(reg.find_type("soml::Mode"), nullptr);
+}
+
+TEST(ProgramLifetime, EnvironmentsOnOneRegistryShareTheClassesOfTheSameScript) {
+  vsd::Registry reg;
+  auto a = std::make_unique<vsd::Environment>(0, reg);
+  auto b = std::make_unique<vsd::Environment>(0, reg);
+  Program& pa = a->use<vsd::soml::Module>().load(a->main_state(), "jobs.soml", kJobs);
+  Program& pb = b->use<vsd::soml::Module>().load(b->main_state(), "jobs.soml", kJobs);
+  EXPECT_EQ(pa.script_class("Job"), pb.script_class("Job")) << "one class, used by both";
+  EXPECT_EQ(pa.run_until_quiet(100), 1u);
+  EXPECT_EQ(pb.run_until_quiet(100), 1u);
+  // The first goes; the class stays for the second, whose methods and `new` go on working.
+  a.reset();
+  ASSERT_NE(reg.find_class_exact("soml::Job"), nullptr);
+  vsd::Node* job = pb.object("first");
+  ASSERT_NE(job, nullptr);
+  job->call("work", {});
+  EXPECT_EQ(job->get<std::int64_t>("done"), 2);
+  EXPECT_EQ(pb.root().call("made", {}).as<std::int64_t>(), 0);
+  b.reset();
+  EXPECT_EQ(reg.find_class_exact("soml::Job"), nullptr);
+  EXPECT_EQ(reg.find_type("soml::Mode"), nullptr);
+
+  // Another script with the same class names while the first runs: refused, naming the difference, and
+  // the running one is untouched.
+  std::string changed = kJobs;
+  changed.replace(changed.find("int done = 0;"), 13, "int done = 0; double speed = 1.0;");
+  {
+    vsd::Environment c(0, reg), d(0, reg);
+    Program& pc = c.use<vsd::soml::Module>().load(c.main_state(), "jobs.soml", kJobs);
+    EXPECT_THAT(error_of([&] { d.use<vsd::soml::Module>().load(d.main_state(), "jobs.soml", changed); }),
+                HasSubstr("jobs.soml:2:7: class 'soml::Job' is registered already, in use with another "
+                          "definition: the registered one has no property 'speed'"));
+    EXPECT_EQ(pc.run_until_quiet(100), 1u);
+  }
+  EXPECT_EQ(reg.find_class_exact("soml::Job"), nullptr);
+
+  // A Program its caller holds and drops while its state lives: the classes stay while their instances
+  // do; once those are gone too, the next load replaces them (with another definition here).
+  {
+    vsd::Environment e(0, reg);
+    { auto held = Program::load(e.main_state(), "jobs.soml", kJobs); }
+    EXPECT_NE(reg.find_class_exact("soml::Job"), nullptr) << "its instances are still in the state";
+  }
+  vsd::Environment f(0, reg);
+  Program& pf = f.use<vsd::soml::Module>().load(f.main_state(), "jobs.soml", changed);
+  ASSERT_NE(pf.script_class("Job"), nullptr);
+  EXPECT_NE(pf.script_class("Job")->find_property("speed"), nullptr);
+}
+
 
 // Every golden script that checks clean either loads and runs (a bounded number of firings) or is
 // refused with the position of what the runtime cannot run yet; never a crash.
