@@ -333,13 +333,15 @@ void ProgramImpl::define(std::string name, std::string text) {
       all.push_back(&d.as<ClassDecl>());
   });
   std::unordered_map<const ClassDecl*, bool> placed;
-  std::function<void(const ClassDecl*)> order = [&](const ClassDecl* c) {
-    if (placed[c]) return;
-    placed[c] = true;
-    if (c->base.decl != nullptr) order(c->base.decl);
-    class_order_.push_back(c);
-  };
-  for (const ClassDecl* c : all) order(c);
+  std::vector<const ClassDecl*> chain;  // a class and its bases not placed yet (no recursion: chains of
+  for (const ClassDecl* c : all) {      // any length)
+    for (const ClassDecl* d = c; d != nullptr && !placed[d]; d = d->base.decl) {
+      placed[d] = true;
+      chain.push_back(d);
+    }
+    class_order_.insert(class_order_.end(), chain.rbegin(), chain.rend());
+    chain.clear();
+  }
 
   // Function shells first: the MetaMethods' invokers and the compiler refer to them by index.
   walk(root, [&](const Decl& d) {
@@ -541,10 +543,22 @@ void ProgramImpl::define(std::string name, std::string text) {
           if (m->kind == DeclKind::Transition && m->as<TransitionDecl>().substituted != nullptr)
             expand_places(net, exps, m->as<TransitionDecl>(), map, depth + 1);
       };
+  // Each class's net holds its bases' places and transitions too: a long chain of classes with nets
+  // would hold the square of its length. Refused past this many copied (the input bounds nothing else).
+  constexpr std::size_t kMaxInherited = 4'000'000;
+  std::size_t inherited = 0;
+  auto inherit = [&](const ClassDecl& c, std::size_t n) {
+    inherited += n;
+    if (inherited > kMaxInherited)
+      not_supported(*this, c.loc,
+                    "nets this large through inheritance (the classes would hold more than " +
+                        std::to_string(kMaxInherited) + " places and transitions of their bases)");
+  };
   for (const ClassDecl* c : class_order_) {
     ClassInfo& ci = *class_info_.at(c);
     auto net = std::make_unique<NetClass>();
     if (ci.base != nullptr && ci.base->net) {
+      inherit(*c, ci.base->net->places.size());
       net->places = ci.base->net->places;
       net->place_holder = ci.base->net->place_holder;
       net->transitions = ci.base->net->transitions;
@@ -564,10 +578,15 @@ void ProgramImpl::define(std::string name, std::string text) {
       ci.start_place = top.count(c->start->place_decl) != 0 ? top.at(c->start->place_decl) : -1;
     if (!net->places.empty()) ci.net = std::move(net);
   }
+  // A place's index in a class's net, by a table made once per net (a search per arrow was quadratic in
+  // a net of many places: a PNML net of 100,000 places took seconds to load).
+  std::unordered_map<const NetClass*, std::unordered_map<const Decl*, int>> place_indices;
   auto place_index = [&](const NetClass& n, const Decl* d) {
-    for (std::size_t i = 0; i < n.places.size(); ++i)
-      if (n.places[i] == d) return static_cast<int>(i);
-    return -1;
+    auto [it, fresh] = place_indices.try_emplace(&n);
+    if (fresh)
+      for (std::size_t i = 0; i < n.places.size(); ++i) it->second.try_emplace(n.places[i], static_cast<int>(i));
+    const auto at = it->second.find(d);
+    return at == it->second.end() ? -1 : at->second;
   };
   for (const ClassDecl* c : class_order_) {
     ClassInfo& ci = *class_info_.at(c);
@@ -762,6 +781,7 @@ void ProgramImpl::define(std::string name, std::string text) {
   for (const ClassDecl* c : class_order_) {
     ClassInfo& ci = *class_info_.at(c);
     if (ci.base == nullptr || !ci.base->net || !ci.net) continue;
+    inherit(*c, ci.base->net->transitions.size());
     std::vector<TransitionInfo> own = std::move(ci.net->transitions);
     ci.net->transitions = ci.base->net->transitions;
     const int offset = static_cast<int>(ci.net->transitions.size());
