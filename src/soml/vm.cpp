@@ -36,7 +36,6 @@ static void to_registers(const MetaType& t, const void* addr, Val& v, std::strin
 
 namespace {
 
-
 void store_integer(const MetaProperty& p, SimStateInstance& o, std::int64_t v) {
   alignas(8) unsigned char buf[8] = {};
   const std::size_t n = p.type().size();
@@ -696,6 +695,16 @@ Val ProgramImpl::exec(std::size_t entry) {
     R = regs_.data() + fr->base;  \
     S = sregs_.data() + fr->base; \
   } while (0)
+// R[a] = x op y of ints, checked: one overflow flag test (a jump never taken), the error out of line.
+#define VSD_CHECKED(builtin, x, y, op)     \
+  do {                                     \
+    std::int64_t v_;                       \
+    if (builtin(x, y, &v_)) [[unlikely]] { \
+      VSD_SAVE();                          \
+      int_overflow(x, op, y);              \
+    }                                      \
+    R[in.a].i = v_;                        \
+  } while (0)
 
   auto obj = [&](std::uint64_t id) -> SimStateInstance& {
     SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
@@ -743,34 +752,15 @@ Val ProgramImpl::exec(std::size_t entry) {
         string_room(S[in.a], S[in.b].size());
         S[in.a] = S[in.b];
         break;
-      // Checked: one overflow flag test each (a jump never taken), the error out of line.
-      case OP_ADDI: {
-        std::int64_t v;
-        if (__builtin_add_overflow(R[in.b].i, R[in.c].i, &v)) [[unlikely]] {
-          VSD_SAVE();
-          int_overflow(R[in.b].i, "+", R[in.c].i);
-        }
-        R[in.a].i = v;
+      case OP_ADDI:
+        VSD_CHECKED(__builtin_add_overflow, R[in.b].i, R[in.c].i, "+");
         break;
-      }
-      case OP_SUBI: {
-        std::int64_t v;
-        if (__builtin_sub_overflow(R[in.b].i, R[in.c].i, &v)) [[unlikely]] {
-          VSD_SAVE();
-          int_overflow(R[in.b].i, "-", R[in.c].i);
-        }
-        R[in.a].i = v;
+      case OP_SUBI:
+        VSD_CHECKED(__builtin_sub_overflow, R[in.b].i, R[in.c].i, "-");
         break;
-      }
-      case OP_MULI: {
-        std::int64_t v;
-        if (__builtin_mul_overflow(R[in.b].i, R[in.c].i, &v)) [[unlikely]] {
-          VSD_SAVE();
-          int_overflow(R[in.b].i, "*", R[in.c].i);
-        }
-        R[in.a].i = v;
+      case OP_MULI:
+        VSD_CHECKED(__builtin_mul_overflow, R[in.b].i, R[in.c].i, "*");
         break;
-      }
       case OP_DIVI:
       case OP_MODI: {
         const std::int64_t x = R[in.b].i, y = R[in.c].i;
@@ -801,24 +791,12 @@ Val ProgramImpl::exec(std::size_t entry) {
       case OP_DIVD:
         R[in.a].d = R[in.b].d / R[in.c].d;
         break;
-      case OP_ADDIK: {  // also ++, --, `i += 1` of a local and the counters of loops
-        std::int64_t v;
-        if (__builtin_add_overflow(R[in.b].i, std::int64_t{static_cast<std::int16_t>(in.c)}, &v)) [[unlikely]] {
-          VSD_SAVE();
-          int_overflow(R[in.b].i, "+", static_cast<std::int16_t>(in.c));
-        }
-        R[in.a].i = v;
+      case OP_ADDIK:  // also ++, --, `i += 1` of a local and the counters of loops
+        VSD_CHECKED(__builtin_add_overflow, R[in.b].i, std::int64_t{static_cast<std::int16_t>(in.c)}, "+");
         break;
-      }
-      case OP_MULIK: {
-        std::int64_t v;
-        if (__builtin_mul_overflow(R[in.b].i, std::int64_t{static_cast<std::int16_t>(in.c)}, &v)) [[unlikely]] {
-          VSD_SAVE();
-          int_overflow(R[in.b].i, "*", static_cast<std::int16_t>(in.c));
-        }
-        R[in.a].i = v;
+      case OP_MULIK:
+        VSD_CHECKED(__builtin_mul_overflow, R[in.b].i, std::int64_t{static_cast<std::int16_t>(in.c)}, "*");
         break;
-      }
       case OP_DIVIK:
         R[in.a].i = R[in.b].i / static_cast<std::int16_t>(in.c);
         break;
@@ -1487,6 +1465,7 @@ Val ProgramImpl::exec(std::size_t entry) {
 #undef VSD_SAVE
 #undef VSD_TARGET
 #undef VSD_REFRESH
+#undef VSD_CHECKED
 }
 
 }  // namespace vsd::soml
