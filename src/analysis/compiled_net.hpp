@@ -2,6 +2,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -23,13 +24,17 @@ struct Compiled {
   std::vector<std::uint32_t> in_begin, inh_begin, delta_begin, aff_begin;  // size transitions + 1
   std::vector<PW> in, inh;
   std::vector<PD> delta;
-  std::vector<std::uint32_t> aff;  // transitions to test again after firing t
+  std::vector<std::uint32_t> aff;  // transitions to test again after firing t (unless aff_all)
+  // aff would have passed the cap given to the constructor (it grows with the square of the transitions
+  // that share a place): it is empty, and every transition is tested again after a firing.
+  bool aff_all = false;
   std::vector<std::uint8_t> inhibitor_place;
   bool conserving = true;  // no transition adds tokens in total: every marking has <= initial tokens
   std::uint64_t initial_sum = 0;
   std::uint32_t initial_max = 0;
 
-  explicit Compiled(const PtNet& net) {
+  /// @param max_aff_entries the most entries aff may hold (see aff_all).
+  explicit Compiled(const PtNet& net, std::size_t max_aff_entries = SIZE_MAX) {
     places = static_cast<std::uint32_t>(net.place_count());
     transitions = static_cast<std::uint32_t>(net.transition_count());
     inhibitor_place.assign(places, 0);
@@ -72,16 +77,22 @@ struct Compiled {
       for (std::uint32_t p : touched) {
         if (d[p] != 0) {
           delta.push_back({p, d[p]});
-          for (std::uint32_t u : readers[p])
-            if (!mark[u]) {
-              mark[u] = 1;
-              aff.push_back(u);
-            }
+          if (!aff_all)
+            for (std::uint32_t u : readers[p])
+              if (!mark[u]) {
+                mark[u] = 1;
+                aff.push_back(u);
+              }
         }
         d[p] = 0;
       }
       for (std::size_t i = aff_start; i < aff.size(); ++i) mark[aff[i]] = 0;
       std::sort(aff.begin() + static_cast<std::ptrdiff_t>(aff_start), aff.end());
+      if (aff.size() > max_aff_entries) {  // no more: the begins stay, aff_all says not to use them
+        aff_all = true;
+        aff.clear();
+        aff.shrink_to_fit();
+      }
     }
     in_begin.push_back(static_cast<std::uint32_t>(in.size()));
     inh_begin.push_back(static_cast<std::uint32_t>(inh.size()));
@@ -91,6 +102,14 @@ struct Compiled {
       initial_sum += p.initial;
       initial_max = std::max(initial_max, p.initial);
     }
+  }
+
+  /// Bytes held (what the explorer counts against its memory limit).
+  std::size_t bytes() const {
+    return (in_begin.capacity() + inh_begin.capacity() + delta_begin.capacity() + aff_begin.capacity() +
+            aff.capacity()) * sizeof(std::uint32_t) +
+           (in.capacity() + inh.capacity()) * sizeof(PW) + delta.capacity() * sizeof(PD) +
+           inhibitor_place.capacity();
   }
 
   bool enabled(std::uint32_t t, const std::uint32_t* m) const {

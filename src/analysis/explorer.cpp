@@ -125,25 +125,32 @@ struct PackedNet {
     auto word_of = [&](std::uint32_t p) { return p >> L.shift; };
     auto off_of = [&](std::uint32_t p) { return (p & per_word_mask) * L.bits; };
     never.assign(c.transitions, 0);
+    // Per word of a marking: the index of its WordOp (WordTest) for the transition at hand, so that a
+    // transition over n words costs O(n), not a search per place.
+    std::vector<std::uint32_t> op_of(L.words, kNone), test_of(L.words, kNone);
     for (std::uint32_t t = 0; t < c.transitions; ++t) {
       op_begin.push_back(static_cast<std::uint32_t>(ops.size()));
       for (std::uint32_t i = c.delta_begin[t]; i < c.delta_begin[t + 1]; ++i) {
         const auto& d = c.delta[i];
         const std::uint32_t w = word_of(d.place);
-        auto it =
-            std::find_if(ops.begin() + op_begin[t], ops.end(), [&](const WordOp& o) { return o.word == w; });
-        if (it == ops.end()) it = ops.insert(ops.end(), WordOp{w, 0, 0});
+        if (op_of[w] == kNone) {
+          op_of[w] = static_cast<std::uint32_t>(ops.size());
+          ops.push_back(WordOp{w, 0, 0});
+        }
+        WordOp& o = ops[op_of[w]];
         const auto magnitude = static_cast<std::uint64_t>(d.delta < 0 ? -d.delta : d.delta);
-        (d.delta < 0 ? it->sub : it->add) += magnitude << off_of(d.place);
+        (d.delta < 0 ? o.sub : o.add) += magnitude << off_of(d.place);
       }
+      for (std::size_t i = op_begin[t]; i < ops.size(); ++i) op_of[ops[i].word] = kNone;
       test_begin.push_back(static_cast<std::uint32_t>(tests.size()));
       if (L.bits != 1) continue;
       auto test_for = [&](std::uint32_t p) -> WordTest& {
         const std::uint32_t w = word_of(p);
-        auto it = std::find_if(tests.begin() + test_begin[t], tests.end(),
-                               [&](const WordTest& x) { return x.word == w; });
-        if (it == tests.end()) it = tests.insert(tests.end(), WordTest{w, 0, 0});
-        return *it;
+        if (test_of[w] == kNone) {
+          test_of[w] = static_cast<std::uint32_t>(tests.size());
+          tests.push_back(WordTest{w, 0, 0});
+        }
+        return tests[test_of[w]];
       };
       const Transition& tr = net.transitions()[t];
       for (const auto& a : tr.inputs) {
@@ -153,6 +160,7 @@ struct PackedNet {
       for (const auto& a : tr.inhibitors)
         if (a.weight == 1) test_for(a.place).forbid |= std::uint64_t{1} << off_of(a.place);
       // (an inhibitor of weight 2 or more is always satisfied by a one-bit place)
+      for (std::size_t i = test_begin[t]; i < tests.size(); ++i) test_of[tests[i].word] = kNone;
     }
     op_begin.push_back(static_cast<std::uint32_t>(ops.size()));
     test_begin.push_back(static_cast<std::uint32_t>(tests.size()));
@@ -170,6 +178,12 @@ struct PackedNet {
       }
       if (never[t]) need[t * W] = forbid[t * W] = ~std::uint64_t{0};
     }
+  }
+
+  std::size_t bytes() const {
+    return (op_begin.capacity() + test_begin.capacity()) * 4 + ops.capacity() * sizeof(WordOp) +
+           tests.capacity() * sizeof(WordTest) + never.capacity() +
+           (diff.capacity() + need.capacity() + forbid.capacity()) * 8;
   }
 
   bool enabled(std::uint32_t t, const std::uint64_t* m) const {
@@ -390,9 +404,14 @@ struct alignas(64) Shard {
 
 class Explorer {
  public:
-  Explorer(const PtNet& net, const ExploreOptions& opt) : net_(net), c_(net), opt_(opt) {
+  // The list of transitions to test again after a firing (Compiled::aff) may take an eighth of the limit;
+  // past that every transition is tested (it grows with the square of the transitions sharing a place).
+  Explorer(const PtNet& net, const ExploreOptions& opt)
+      : net_(net),
+        limit_(opt.memory_limit == 0 ? default_memory_limit() : opt.memory_limit),
+        c_(net, limit_ / 8 / sizeof(std::uint32_t)),
+        opt_(opt) {
     threads_ = opt.threads == 0 ? std::max(1u, std::thread::hardware_concurrency()) : opt.threads;
-    limit_ = opt.memory_limit == 0 ? default_memory_limit() : opt.memory_limit;
     show_progress_ = opt.progress == ExploreOptions::Progress::always ||
                      (opt.progress == ExploreOptions::Progress::automatic && isatty(STDERR_FILENO) == 1);
     tw_ = std::max<std::uint32_t>(1, (c_.transitions + 63) / 64);
@@ -426,41 +445,50 @@ class Explorer {
         }
       }
     }
+    fixed_ = c_.bytes() + (up_.capacity() + down_.capacity()) * 8;
   }
 
   ExploreResult run() {
     const auto start = Clock::now();
     start_ = start;
-    if (c_.places > 0) bounds_ = detail::place_bounds(net_);  // timed: part of the analysis
-    // Conserving nets never hold more than the initial token count in a place: size fields for that.
-    // A net with structural bounds gets fields that hold them, and needs no unboundedness check. Other
-    // nets start as narrow as the initial marking allows and double the fields when a place outgrows them.
-    unsigned bits = bits_for(std::max<std::uint32_t>(c_.initial_max, 1));
-    if (bounds_)
-      bits = bits_for(std::max<std::uint64_t>(*std::max_element(bounds_->begin(), bounds_->end()), 1));
     ExploreResult r;
-    while (true) {
-      r = ExploreResult{};
-      if (attempt(bits, r)) break;
-      if (bits == 32)
-        vsd::detail::throw_error("explore: a place of net '" + net_.id() +
-                                 "' would hold more than 2^32-1 tokens");
-      bits *= 2;  // a place outgrew the fields: start again with wider ones
+    if (fixed_ > limit_) {  // the compiled net alone
+      over_limit(r, "while compiling the net", fixed_);
+    } else {
+      // Timed: part of the analysis. It may use what the compiled net leaves of the limit, and gives up
+      // (no bounds) rather than pass it.
+      if (c_.places > 0) bounds_ = detail::place_bounds(net_, limit_ - fixed_);
+      if (bounds_) fixed_ += bounds_->capacity() * 8;
+      // Conserving nets never hold more than the initial token count in a place: size fields for that.
+      // A net with structural bounds gets fields that hold them, and needs no unboundedness check. Other
+      // nets start as narrow as the initial marking allows and double the fields when a place outgrows
+      // them.
+      unsigned bits = bits_for(std::max<std::uint32_t>(c_.initial_max, 1));
+      if (bounds_)
+        bits = bits_for(std::max<std::uint64_t>(*std::max_element(bounds_->begin(), bounds_->end()), 1));
+      while (true) {
+        r = ExploreResult{};
+        if (attempt(bits, r)) break;
+        if (bits == 32)
+          vsd::detail::throw_error("explore: a place of net '" + net_.id() +
+                                   "' would hold more than 2^32-1 tokens");
+        bits *= 2;  // a place outgrew the fields: start again with wider ones
+      }
     }
     r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
     r.threads = threads_;
     r.memory_limit = limit_;
-    r.peak_memory = peak_;
+    r.peak_memory = std::max(peak_, fixed_);
     if (progress_shown_) std::fputs("\n", stderr);
     return r;
   }
 
  private:
   const std::uint64_t* record(std::uint32_t id) const {
-    return blocks_[id >> kBlockBits].get() + std::size_t(id & ((1u << kBlockBits) - 1)) * layout_.record;
+    return blocks_[id >> block_bits_].get() + std::size_t(id & ((1u << block_bits_) - 1)) * layout_.record;
   }
   std::uint64_t* record(std::uint32_t id) {
-    return blocks_[id >> kBlockBits].get() + std::size_t(id & ((1u << kBlockBits) - 1)) * layout_.record;
+    return blocks_[id >> block_bits_].get() + std::size_t(id & ((1u << block_bits_) - 1)) * layout_.record;
   }
   std::uint32_t parent(std::uint32_t id) const {
     return static_cast<std::uint32_t>(record(id)[layout_.words] >> 32);
@@ -468,34 +496,96 @@ class Explorer {
   std::uint32_t firing(std::uint32_t id) const {
     return static_cast<std::uint32_t>(record(id)[layout_.words] & 0xFFFFFFFFu);
   }
+  std::size_t block_bytes() const { return (std::size_t{1} << block_bits_) * layout_.record * 8; }
 
+  // Everything the exploration holds, read between phases (not while workers run: they change it).
   std::size_t memory() const {
-    std::size_t m = blocks_.size() * (std::size_t{1} << kBlockBits) * layout_.record * 8;
+    std::size_t m = fixed_ + attempt_fixed_ + blocks_.size() * block_bytes() + blocks_.capacity() * 8;
     for (const auto& s : shards_) m += s.slots.capacity() * 8 + s.pending.capacity() * 8;
     for (const auto& ch : chunks_) m += ch.bytes();
+    m += chunks_.capacity() * sizeof(Chunk);
     m += (prev_enabled_.capacity() + cur_enabled_.capacity()) * 8;
     return m;
+  }
+
+  // The limit holds before anything is allocated. Between phases memory() says what is held; within a
+  // phase, whatever grows (an arena block, a hash shard, a successor buffer; on any thread) first takes
+  // room for its new size here, and gives back the old size once that is freed. Without room the phase
+  // stops (full_) and the exploration ends with Status::memory_limit.
+  void begin_phase() {
+    phase_base_ = memory();
+    growth_.store(0, std::memory_order_relaxed);
+    peak_ = std::max(peak_, phase_base_);
+  }
+  void end_phase() { peak_ = std::max(peak_, phase_base_ + peak_growth_.exchange(0)); }
+  bool room(std::size_t bytes) {
+    const std::size_t now = growth_.fetch_add(bytes, std::memory_order_relaxed) + bytes;
+    if (phase_base_ + now > limit_) {
+      growth_.fetch_sub(bytes, std::memory_order_relaxed);
+      full_.store(true, std::memory_order_relaxed);
+      return false;
+    }
+    std::size_t seen = peak_growth_.load(std::memory_order_relaxed);
+    while (now > seen && !peak_growth_.compare_exchange_weak(seen, now, std::memory_order_relaxed)) {
+    }
+    return true;
+  }
+  void release(std::size_t bytes) { growth_.fetch_sub(bytes, std::memory_order_relaxed); }
+  // Capacity for n elements in b (doubling), within the limit.
+  template <class T>
+  bool fit(PodBuffer<T>& b, std::size_t n) {
+    if (n <= b.capacity()) return true;
+    const std::size_t cap = std::max(n, b.capacity() * 2);
+    if (!room(cap * sizeof(T))) return false;
+    const std::size_t old = b.capacity() * sizeof(T);
+    b.reserve(cap);
+    release(old);
+    return true;
+  }
+  template <class T>
+  bool fit(std::vector<T>& v, std::size_t n) {
+    if (n <= v.capacity()) return true;
+    if (!room(n * sizeof(T))) return false;
+    const std::size_t old = v.capacity() * sizeof(T);
+    v.reserve(n);
+    release(old);
+    return true;
+  }
+
+  void over_limit(ExploreResult& r, const std::string& phase, std::size_t needed) {
+    r.status = ExploreResult::Status::memory_limit;
+    r.message = "memory limit of " + format_bytes(limit_) + " reached " + phase + " (it needs at least " +
+                format_bytes(needed) + "). Raise it with --limit-mem.";
   }
   bool check_memory(ExploreResult& r) {
     const std::size_t m = memory();
     peak_ = std::max(peak_, m);
-    if (m <= limit_) return true;
+    if (m <= limit_ && !full_.load()) return true;
     r.status = ExploreResult::Status::memory_limit;
-    r.message = "memory limit of " + format_bytes(limit_) + " reached after " + std::to_string(states_) +
-                " states (" + format_bytes(m) +
-                " in use); the figures count the states visited so far. Raise it with --limit-mem.";
+    r.message = "memory limit of " + format_bytes(limit_) + " reached in the exploration after " +
+                std::to_string(states_) + " states (" + format_bytes(std::max(m, phase_base_ + growth_.load())) +
+                " in use or asked for); the figures count the states visited so far. Raise it with --limit-mem.";
     return false;
   }
 
-  std::uint32_t add_state(const std::uint64_t* marking, std::uint32_t par, std::uint32_t t) {
-    const auto id = static_cast<std::uint32_t>(states_);
-    if ((id >> kBlockBits) >= blocks_.size())
-      blocks_.emplace_back(new std::uint64_t[(std::size_t{1} << kBlockBits) * layout_.record]);
+  // Stores a new state; false (nothing stored) when its arena block does not fit the limit.
+  bool add_state(const std::uint64_t* marking, std::uint32_t par, std::uint32_t t, std::uint32_t& id) {
+    id = static_cast<std::uint32_t>(states_);
+    if ((id >> block_bits_) >= blocks_.size()) {
+      const std::size_t list = blocks_.size() == blocks_.capacity() ? std::max<std::size_t>(8, blocks_.size() * 2) : 0;
+      if (!room(block_bytes() + list * 8)) return false;
+      if (list != 0) {
+        const std::size_t old = blocks_.capacity() * 8;
+        blocks_.reserve(list);
+        release(old);
+      }
+      blocks_.emplace_back(new std::uint64_t[(std::size_t{1} << block_bits_) * layout_.record]);
+    }
     std::uint64_t* rec = record(id);
     std::memcpy(rec, marking, layout_.words * 8);
     rec[layout_.words] = (std::uint64_t{par} << 32) | t;
     ++states_;
-    return id;
+    return true;
   }
 
   std::vector<std::uint32_t> path_to(std::uint32_t id) const {
@@ -513,10 +603,14 @@ class Explorer {
     return m;
   }
 
-  // Inserts a marking known to be new (the initial one) directly.
-  void insert_committed(std::uint64_t h, std::uint32_t id) {
-    Shard& s = shards_[h >> (64 - kShardBits)];
-    insert_slot(s, h, (h & 0x7FFFFFFFull) << 32 | id);
+  // Room in shard s for one more entry: grown (doubled) when half full; false when that does not fit.
+  bool ensure_slot(Shard& s) {
+    if ((s.used + 1) * 2 <= s.slots.size()) return true;
+    const std::size_t old = s.slots.size() * 8;
+    if (!room(2 * old)) return false;
+    grow(s);
+    release(old);
+    return true;
   }
   static void grow(Shard& s) {
     std::vector<std::uint64_t> old = std::move(s.slots);
@@ -529,8 +623,8 @@ class Explorer {
       s.slots[i] = v;
     }
   }
-  static void insert_slot(Shard& s, std::uint64_t h, std::uint64_t value) {
-    if ((s.used + 1) * 2 > s.slots.size()) grow(s);
+  // After ensure_slot.
+  static void put_slot(Shard& s, std::uint64_t h, std::uint64_t value) {
     const std::size_t mask = s.slots.size() - 1;
     std::size_t i = (h & 0x7FFFFFFFull) & mask;
     while (s.slots[i] != kEmpty) i = (i + 1) & mask;
@@ -554,7 +648,8 @@ class Explorer {
 
   // One exploration with `bits` per place; false when a place outgrew them.
   bool attempt(unsigned bits, ExploreResult& r);
-  void phases_b_to_d(std::size_t nchunks, const Layout& L);
+  // False when a hash shard or an arena block found no room (the level is then incomplete).
+  bool phases_b_to_d(std::size_t nchunks, const Layout& L);
 
   // Whether the hash set holds marking mk (fragment frag of its hash), committed or pending. W: the
   // marking's words if the loop over them is unrolled, else 0.
@@ -578,12 +673,19 @@ class Explorer {
   }
 
   const PtNet& net_;
+  std::size_t limit_ = 0;  // before c_, whose constructor uses it
   Compiled c_;
   std::optional<std::vector<std::uint64_t>> bounds_;  // structural place bounds, when the net proves them
   ExploreOptions opt_;
   unsigned threads_ = 1;
-  std::size_t limit_ = 0;
   std::size_t peak_ = 0;
+  std::size_t fixed_ = 0;          // the compiled net (and bounds) for the whole run
+  std::size_t attempt_fixed_ = 0;  // the net compiled for the layout, workers' scratch, the result's markings
+  std::size_t phase_base_ = 0;     // memory() when the phase under way began
+  std::atomic<std::size_t> growth_{0};       // room taken since
+  std::atomic<std::size_t> peak_growth_{0};  // the most of it at once
+  std::atomic<bool> full_{false};            // some growth found no room: the run stops
+  unsigned block_bits_ = kBlockBits;         // states per arena block = 2^block_bits_
   bool show_progress_ = false;
   bool progress_shown_ = false;
   Clock::time_point start_, last_progress_;
@@ -607,10 +709,19 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
   shards_.assign(kShards, Shard{});
   for (auto& s : shards_) s.slots.assign(16, kEmpty);
   chunks_.clear();
+  prev_enabled_.clear();
+  cur_enabled_.clear();
+  attempt_fixed_ = 0;
+  full_.store(false);
   states_ = 0;
   edges_ = 0;
   const std::uint32_t P = c_.places;
   const Layout L = layout_;
+  // Arena blocks of 2^12 states, fewer for large markings: a block stays near 1 MiB (at least one
+  // record), so that the first state does not take gigabytes at once (a record of 200,000 places of 32 bits
+  // is 800 KB).
+  block_bits_ = kBlockBits;
+  while (block_bits_ > 0 && block_bytes() > (std::size_t{1} << 20)) --block_bits_;
   const bool check_cover = !bounds_.has_value();
   // Fast paths on the packed words: enabling by masks with one bit per place; firing by word arithmetic
   // when the structural bounds fit the fields (no field can overflow into its neighbour). Where both
@@ -619,7 +730,22 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
   const bool use_masks = L.bits == 1;
   const bool use_ops = !check_cover;
   const bool unpack_states = !(use_masks && use_ops);
+  // For the whole attempt: the net compiled for the layout, each worker's two unpacked markings, and the
+  // result's markings (a dead one, an unbounded pair).
+  attempt_fixed_ = pk.bytes() + std::size_t{threads_} * P * 8 + std::size_t{3} * P * 4;
+  if (fixed_ + attempt_fixed_ > limit_) {
+    over_limit(r, "while preparing the exploration (the net compiled for " + std::to_string(bits) +
+                      " bit(s) per place, " + std::to_string(threads_) + " worker(s))",
+               fixed_ + attempt_fixed_);
+    return true;
+  }
+  std::vector<WorkerStats> ws(threads_);
+  for (auto& w : ws) {
+    w.unpacked.assign(P, 0);
+    w.unpacked2.assign(P, 0);
+  }
 
+  begin_phase();
   {  // the initial marking
     std::vector<std::uint64_t> m0(L.words, 0);
     for (std::uint32_t p = 0; p < P; ++p) {
@@ -627,17 +753,20 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
       if (v > L.mask) return false;
       L.set(m0.data(), p, v);
     }
-    insert_committed(hash_words(m0.data(), L.words), add_state(m0.data(), kNone, kNone));
+    const std::uint64_t h = hash_words(m0.data(), L.words);
+    Shard& s = shards_[h >> (64 - kShardBits)];
+    std::uint32_t id = 0;
+    if (!ensure_slot(s) || !add_state(m0.data(), kNone, kNone, id)) {
+      end_phase();
+      over_limit(r, "storing the initial marking", phase_base_ + block_bytes());
+      return true;
+    }
+    put_slot(s, h, (h & 0x7FFFFFFFull) << 32 | id);
   }
+  end_phase();
 
-  std::vector<WorkerStats> ws(threads_);
-  for (auto& w : ws) {
-    w.unpacked.assign(P, 0);
-    w.unpacked2.assign(P, 0);
-  }
   std::uint32_t first_dead = kNone;
   std::uint64_t lo = 0, hi = 1, prev_lo = 0;
-  prev_enabled_.clear();
   std::uint32_t level = 0;
   for (; lo < hi; ++level) {
     const std::uint64_t n = hi - lo;
@@ -658,13 +787,20 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
                                  : static_cast<unsigned>(std::min<std::size_t>(threads_, nchunks));
     const bool fused = workers == 1 && small_table;
     const std::uint64_t new_lo = states_;
-    if (chunks_.size() < (fused ? 1 : nchunks)) chunks_.resize(fused ? 1 : nchunks);
-    cur_enabled_.assign(n * tw_, 0);
+    begin_phase();
+    {  // the chunks and the level's enabled sets, within the limit
+      const std::size_t want = fused ? 1 : nchunks;
+      const bool chunks_fit = chunks_.size() >= want || fit(chunks_, want);
+      if (!chunks_fit || !fit(cur_enabled_, n * tw_)) {
+        end_phase();
+        check_memory(r);
+        break;
+      }
+      if (chunks_.size() < want) chunks_.resize(want);
+      cur_enabled_.assign(n * tw_, 0);
+    }
     std::atomic<std::size_t> next_chunk{0};
     std::atomic<bool> stop{false};
-    std::size_t base_memory = memory();
-    for (std::size_t ci = 0; ci < chunks_.size(); ++ci) base_memory -= chunks_[ci].bytes();
-    std::atomic<std::size_t> successor_bytes{0};
     const double successors_per_state = lo == 0 ? 1.0 : static_cast<double>(edges_) / static_cast<double>(lo);
 
     // ---- phase A: expand the frontier -------------------------------------------------------------
@@ -683,13 +819,17 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
           const std::uint64_t first = lo + ci * kChunkStates;
           const std::uint64_t last = std::min(hi, first + kChunkStates);
           // Size the buffers from the successors per state so far: few reallocations while filling them.
-          const auto expect =
-              static_cast<std::size_t>(static_cast<double>(last - first) * successors_per_state * 1.25) + 16;
-          ch.markings.reserve(expect * words);
-          ch.hashes.reserve(expect);
-          ch.parents.reserve(expect);
-          ch.firings.reserve(expect);
-          for (std::uint64_t s64 = first; s64 < last; ++s64) {
+          if (!fused) {
+            const auto expect =
+                static_cast<std::size_t>(static_cast<double>(last - first) * successors_per_state * 1.25) + 16;
+            if (!fit(ch.markings, expect * words) || !fit(ch.hashes, expect) || !fit(ch.parents, expect) ||
+                !fit(ch.firings, expect)) {
+              stop.store(true, std::memory_order_relaxed);
+              break;
+            }
+          }
+          bool no_room = false;  // an arena block or a hash shard found no room (fused)
+          for (std::uint64_t s64 = first; s64 < last && !no_room; ++s64) {
             const auto s = static_cast<std::uint32_t>(s64);
             const std::uint64_t* rec = record(s);
             if (unpack_states) {
@@ -743,6 +883,11 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
                     en[wd] = (en[wd] & ~(std::uint64_t{1} << b)) | (e << b);
                   }
                 }
+              } else if (c_.aff_all) {  // no list of them (it would not fit the limit): all
+                for (std::uint32_t u = 0; u < c_.transitions; ++u) {
+                  const std::uint64_t e = enabled(u) ? 1 : 0;
+                  en[u >> 6] = (en[u >> 6] & ~(std::uint64_t{1} << (u & 63))) | (e << (u & 63));
+                }
               } else {
                 for (std::uint32_t i = c_.aff_begin[ft]; i < c_.aff_begin[ft + 1]; ++i) {
                   const std::uint32_t u = c_.aff[i];
@@ -751,18 +896,26 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
                 }
               }
             }
-            // Room for every transition's successor: no per-successor growth checks in the loop below.
+            // Room for the successor of every enabled transition (fused: one at a time), within the limit: no
+            // per-successor growth checks in the loop below. (Room for every transition was 5 GB for one
+            // state of a net of 200,000 places and transitions.)
             const std::size_t k0 = ch.hashes.size();
-            ch.markings.ensure((k0 + c_.transitions) * words);
-            ch.hashes.ensure(k0 + c_.transitions);
-            ch.parents.ensure(k0 + c_.transitions);
-            ch.firings.ensure(k0 + c_.transitions);
+            std::size_t need = 1;
+            if (!fused) {
+              need = k0;
+              for (std::uint32_t wd = 0; wd < tw_; ++wd) need += static_cast<std::size_t>(std::popcount(en[wd]));
+            }
+            if (!fit(ch.markings, need * words) || !fit(ch.hashes, need) || !fit(ch.parents, need) ||
+                !fit(ch.firings, need)) {
+              stop.store(true, std::memory_order_relaxed);
+              break;
+            }
             std::uint64_t* const out_markings = ch.markings.data();
             std::uint64_t* const out_hashes = ch.hashes.data();
             std::uint32_t* const out_parents = ch.parents.data();
             std::uint32_t* const out_firings = ch.firings.data();
             std::size_t k = k0;
-            for (std::uint32_t wd = 0; wd < tw_; ++wd) {
+            for (std::uint32_t wd = 0; wd < tw_ && !no_room; ++wd) {
               std::uint64_t bitsw = en[wd];
               while (bitsw != 0) {
                 const std::uint32_t t = wd * 64 + static_cast<std::uint32_t>(std::countr_zero(bitsw));
@@ -797,7 +950,13 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
                   if (!contains<W>(sh, frag, out, words)) {
                     if (states_ >= kMaxStates)
                       vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
-                    insert_slot(sh, h, frag << 32 | add_state(out, s, t));
+                    std::uint32_t id = 0;
+                    if (!ensure_slot(sh) || !add_state(out, s, t, id)) {
+                      no_room = true;
+                      stop.store(true, std::memory_order_relaxed);
+                      break;
+                    }
+                    put_slot(sh, h, frag << 32 | id);
                   }
                 } else {
                   out_hashes[k] = h;
@@ -815,16 +974,15 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
             }
             const std::uint64_t count = k - k0;
             st.edges += count;
-            if (count == 0 && s < st.first_dead) st.first_dead = s;
+            if (count == 0 && !no_room && s < st.first_dead) st.first_dead = s;
           }
-          if (fused) {  // the new states go straight into the arena and the hash set
-            if (memory() > limit_) stop.store(true);
-            continue;
+          if (fused) continue;  // the new states went straight into the arena and the hash set
+          if (!fit(ch.fresh, ch.hashes.size()) || !fit(ch.ids, ch.hashes.size())) {
+            stop.store(true, std::memory_order_relaxed);
+            break;
           }
           ch.fresh.assign(ch.hashes.size(), 0);
           ch.ids.resize(ch.hashes.size());
-          // A level whose successors alone would pass the limit stops here, before it exhausts the machine.
-          if (base_memory + (successor_bytes += ch.bytes()) > limit_) stop.store(true);
         }
       });
     });
@@ -839,17 +997,11 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     std::swap(prev_enabled_, cur_enabled_);
     prev_lo = lo;
     r.levels = level + 1;
-    if (stop.load() || !check_memory(r)) {
-      if (r.status == ExploreResult::Status::complete) {
-        r.status = ExploreResult::Status::memory_limit;
-        r.message = "memory limit of " + format_bytes(limit_) + ": the successors of level " +
-                    std::to_string(level) + " do not fit; stopped after " + std::to_string(states_) +
-                    " states. Raise it with --limit-mem.";
-      }
+    if (stop.load() || (!fused && !phases_b_to_d(nchunks, L))) {  // no room (the only other stop, an
+      end_phase();                                                // overflow, returned above)
+      check_memory(r);
       break;
     }
-
-    if (!fused) phases_b_to_d(nchunks, L);
 
     // ---- unboundedness: does a new marking strictly cover an ancestor? -------------------------------
     if (check_cover && states_ > new_lo) {
@@ -908,6 +1060,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     }
     lo = hi;
     hi = states_;
+    end_phase();
     if (!check_memory(r)) break;
     progress(level, false);
   }
@@ -923,7 +1076,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
 }
 
 // Phases B to D of a level expanded by several workers (see the file comment).
-void Explorer::phases_b_to_d(std::size_t nchunks, const Layout& L) {
+bool Explorer::phases_b_to_d(std::size_t nchunks, const Layout& L) {
   // ---- phase B: look up / insert into the shards ----------------------------------------------------
   std::size_t candidates = 0;
   for (std::size_t ci = 0; ci < nchunks; ++ci) candidates += chunks_[ci].hashes.size();
@@ -960,10 +1113,16 @@ void Explorer::phases_b_to_d(std::size_t nchunks, const Layout& L) {
           const std::uint64_t* mk = markings + i * words;
           const bool found = contains<W>(sh, frag, mk, words);
           if (found) continue;
+          // Room for its pending entry and its slot first: a pending entry without a slot would never
+          // be found by phase D.
+          if (sh.pending.size() == sh.pending.capacity() &&
+              !fit(sh.pending, std::max<std::size_t>(16, sh.pending.capacity() * 2)))
+            continue;
+          if (!ensure_slot(sh)) continue;
           ch.fresh[i] = 1;
           const std::uint64_t pidx = sh.pending.size();
           sh.pending.push_back((std::uint64_t{ci} << 32) | i);
-          insert_slot(sh, h, kPendingBit | frag << 32 | pidx);
+          put_slot(sh, h, kPendingBit | frag << 32 | pidx);
         }
       }
     });
@@ -979,7 +1138,8 @@ void Explorer::phases_b_to_d(std::size_t nchunks, const Layout& L) {
         too_many = true;
         break;
       }
-      ch.ids[i] = add_state(ch.markings.data() + i * L.words, ch.parents[i], ch.firings[i]);
+      if (!add_state(ch.markings.data() + i * L.words, ch.parents[i], ch.firings[i], ch.ids[i]))
+        return false;  // (phase D would give the unnumbered ones made-up indices; the run stops here)
     }
   }
   if (too_many) vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
@@ -1004,6 +1164,7 @@ void Explorer::phases_b_to_d(std::size_t nchunks, const Layout& L) {
       sh.pending.clear();
     }
   });
+  return !full_.load();
 }
 
 }  // namespace

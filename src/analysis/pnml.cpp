@@ -160,20 +160,29 @@ class Reader {
     out_.net.set_id(required_id(net));
     out_.net.set_name(name_of(net));
     std::vector<pugi::xml_node> arcs;
-    collect(net, arcs, true);
+    collect(net, arcs);
     resolve_references();
     for (const auto& a : arcs) read_arc(a);
   }
 
-  // Walks a net or page: nodes now, arcs later (their ends may come after them).
-  void collect(const pugi::xml_node& container, std::vector<pugi::xml_node>& arcs, bool is_net) {
-    for (pugi::xml_node c = container.first_child(); c; c = c.next_sibling()) {
+  // Walks a net and its pages, nested to any depth, in document order: nodes now, arcs later (their
+  // ends may come after them). An explicit stack of the next sibling to visit on each open level, not
+  // recursion: 50,000 nested pages overflowed the call stack.
+  void collect(const pugi::xml_node& net, std::vector<pugi::xml_node>& arcs) {
+    std::vector<pugi::xml_node> open{net.first_child()};
+    while (!open.empty()) {
+      const pugi::xml_node c = open.back();
+      if (!c) {
+        open.pop_back();
+        continue;
+      }
+      open.back() = c.next_sibling();
       if (c.type() != pugi::node_element) continue;
       const std::string_view n = local_name(c);
       if (n == "name") continue;
       if (n == "page") {
         check_unique(c);
-        collect(c, arcs, false);
+        open.push_back(c.first_child());
       } else if (n == "place") {
         read_place(c);
       } else if (n == "transition") {
@@ -183,8 +192,6 @@ class Reader {
         references_.push_back(c);
       } else if (n == "arc") {
         arcs.push_back(c);
-      } else if (n == "graphics" && !is_net) {
-        skipped(c);
       } else {
         skipped(c);
       }
@@ -225,27 +232,70 @@ class Reader {
     out_.net.add_transition(id, name_of(t));
   }
 
-  // A reference node stands for the node named by its `ref` (possibly another reference).
+  // A reference node stands for the node named by its `ref`, possibly another reference. Each chain is
+  // followed once: a reference whose target is known gives it to every reference met on the way there,
+  // so resolving n references costs O(n) however they chain (following each chain to its end was
+  // quadratic: 20,000 chained references took 10 s). A chain that comes back to a reference on it is a
+  // cycle, reported with its ids.
   void resolve_references() {
-    std::unordered_map<std::string, pugi::xml_node> by_id;
-    for (const auto& r : references_) by_id.emplace(r.attribute("id").value(), r);
-    for (const auto& r : references_) {
-      std::string target = r.attribute("ref").value();
-      if (target.empty()) fail(r, "<" + std::string(r.name()) + "> without a ref attribute");
-      for (std::size_t steps = 0; by_id.count(target); ++steps) {
-        if (steps > references_.size()) fail(r, "reference cycle through '" + target + "'");
-        target = by_id.at(target).attribute("ref").value();
+    std::unordered_map<std::string, std::size_t> by_id;  // reference id -> index in references_
+    for (std::size_t i = 0; i < references_.size(); ++i) by_id.emplace(references_[i].attribute("id").value(), i);
+    enum : std::uint8_t { kTodo, kOnPath, kDone };
+    std::vector<std::uint8_t> state(references_.size(), kTodo);
+    std::vector<std::string> target(references_.size());
+    std::vector<std::size_t> path;
+    for (std::size_t start = 0; start < references_.size(); ++start) {
+      if (state[start] == kDone) continue;
+      std::string end;
+      for (std::size_t i = start;;) {
+        const pugi::xml_node& r = references_[i];
+        const std::string ref = r.attribute("ref").value();
+        if (ref.empty()) fail(r, "<" + std::string(r.name()) + "> without a ref attribute");
+        state[i] = kOnPath;
+        path.push_back(i);
+        const auto next = by_id.find(ref);
+        if (next == by_id.end()) {  // a place or transition (or nothing: checked below)
+          end = ref;
+          break;
+        }
+        if (state[next->second] == kDone) {
+          end = target[next->second];
+          break;
+        }
+        if (state[next->second] == kOnPath) fail(references_[next->second], cycle_text(path, next->second));
+        i = next->second;
       }
+      for (const std::size_t i : path) {
+        state[i] = kDone;
+        target[i] = end;
+      }
+      path.clear();
+    }
+    for (std::size_t i = 0; i < references_.size(); ++i) {
+      const pugi::xml_node& r = references_[i];
       const bool want_place = local_name(r) == "referencePlace";
-      if (want_place ? !out_.net.find_place(target) : !out_.net.find_transition(target))
-        fail(r, "reference to unknown " + std::string(want_place ? "place" : "transition") + " '" + target +
+      if (want_place ? !out_.net.find_place(target[i]) : !out_.net.find_transition(target[i]))
+        fail(r, "reference to unknown " + std::string(want_place ? "place" : "transition") + " '" + target[i] +
                     "'");
-      alias_.emplace(r.attribute("id").value(), target);
+      alias_.emplace(r.attribute("id").value(), target[i]);
       check_children(r, {"name"});
     }
   }
 
-  std::string resolve(const std::string& id) const {
+  // "reference cycle: 'a' -> 'b' -> 'a'": the references of @p path from @p from on, and back (at most
+  // 10 of them named).
+  std::string cycle_text(const std::vector<std::size_t>& path, std::size_t from) const {
+    const auto begin = std::find(path.begin(), path.end(), from);
+    const auto length = static_cast<std::size_t>(path.end() - begin);
+    std::string s = "reference cycle of " + std::to_string(length) + " reference(s): ";
+    std::size_t shown = 0;
+    for (auto it = begin; it != path.end() && shown < 10; ++it, ++shown)
+      s += "'" + std::string(references_[*it].attribute("id").value()) + "' -> ";
+    if (length > shown) s += "... -> ";
+    return s + "'" + references_[from].attribute("id").value() + "'";
+  }
+
+  const std::string& resolve(const std::string& id) const {
     const auto it = alias_.find(id);
     return it == alias_.end() ? id : it->second;
   }
@@ -258,10 +308,12 @@ class Reader {
     const std::string source = a.attribute("source").value();
     const std::string target = a.attribute("target").value();
     if (source.empty() || target.empty()) fail(a, "arc '" + id + "' needs source and target attributes");
-    const auto sp = out_.net.find_place(resolve(source));
-    const auto st = out_.net.find_transition(resolve(source));
-    const auto tp = out_.net.find_place(resolve(target));
-    const auto tt = out_.net.find_transition(resolve(target));
+    const std::string& from = resolve(source);
+    const std::string& to = resolve(target);
+    const auto sp = out_.net.find_place(from);
+    const auto st = out_.net.find_transition(from);
+    const auto tp = out_.net.find_place(to);
+    const auto tt = out_.net.find_transition(to);
     if (!sp && !st) fail(a, "arc '" + id + "' has unknown source '" + source + "'");
     if (!tp && !tt) fail(a, "arc '" + id + "' has unknown target '" + target + "'");
     if ((sp && tp) || (st && tt))
@@ -281,27 +333,21 @@ class Reader {
         fail(type, "arc type '" + std::string(v) + "' is not supported (normal and inhibitor are)");
     }
     check_children(a, {"inscription", "type"});
-    const Transition* existing = nullptr;
     if (inhibitor) {
       if (!sp) fail(a, "inhibitor arc '" + id + "' must go from a place to a transition");
       out_.net.add_inhibitor(*tt, *sp, weight, id);
       return;
     }
-    if (sp) {
-      existing = &out_.net.transitions()[*tt];
-      if (std::any_of(existing->inputs.begin(), existing->inputs.end(),
-                      [&](const ArcRef& r) { return r.place == *sp; }))
-        note(a, "arc '" + id + "' is parallel to an earlier arc from '" + source + "' to '" + target +
-                    "'; their weights are added and the net keeps the earlier id");
+    // A parallel arc is merged into the earlier one: the transition's arc count stays the same.
+    const Transition& t = out_.net.transitions()[sp ? *tt : *st];
+    const std::size_t before = sp ? t.inputs.size() : t.outputs.size();
+    if (sp)
       out_.net.add_input(*tt, *sp, weight, id);
-    } else {
-      existing = &out_.net.transitions()[*st];
-      if (std::any_of(existing->outputs.begin(), existing->outputs.end(),
-                      [&](const ArcRef& r) { return r.place == *tp; }))
-        note(a, "arc '" + id + "' is parallel to an earlier arc from '" + source + "' to '" + target +
-                    "'; their weights are added and the net keeps the earlier id");
+    else
       out_.net.add_output(*st, *tp, weight, id);
-    }
+    if ((sp ? t.inputs.size() : t.outputs.size()) == before)
+      note(a, "arc '" + id + "' is parallel to an earlier arc from '" + source + "' to '" + target +
+                  "'; their weights are added and the net keeps the earlier id");
   }
 
   std::string_view text_;
@@ -323,6 +369,10 @@ void add_text(pugi::xml_node parent, const char* label, const std::string& text)
 }  // namespace
 
 PnmlImport read_pnml(std::string_view text, std::string_view source) { return Reader(text, source).run(); }
+
+PnmlImport read_pnml(std::istream& in, std::string_view source) {
+  return read_pnml(detail::read_text(in, source), source);
+}
 
 PnmlImport read_pnml_file(const std::filesystem::path& path) {
   return read_pnml(detail::read_text_file(path), path.string());

@@ -5,6 +5,7 @@
 #include <map>
 #include <set>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 
 #include "text_file.hpp"
@@ -23,10 +24,42 @@ using namespace vsd::soml;
 // ---- does an action change a marking? --------------------------------------------------------------
 
 // Walks statements and expressions looking for `put`/`clear` on a place, and for calls of script
-// functions that (transitively) do. The answer per function is cached; a function on the current call
-// path counts as harmless (recursion adds nothing new).
+// functions that (transitively) do. Which functions do is worked out once for the whole script, over its
+// call graph and without recursion (following each call into its callee recursed once per function of a
+// call chain: a chain of 100,000 functions overflowed the stack); the walks themselves are bounded by the
+// parser's nesting limit.
 class MarkingEffects {
  public:
+  explicit MarkingEffects(const ClassDecl& root) {
+    std::vector<const FunctionDecl*> functions;
+    std::vector<const ScopeDecl*> scopes{&root};
+    while (!scopes.empty()) {
+      const ScopeDecl* sc = scopes.back();
+      scopes.pop_back();
+      for (const DeclPtr& m : sc->members) {
+        if (m->kind == DeclKind::Function) functions.push_back(&m->as<FunctionDecl>());
+        if (m->has_members()) scopes.push_back(&m->as<ScopeDecl>());
+      }
+    }
+    // Each function's own put/clear and the functions it calls; then, from those that change a marking
+    // themselves, their callers, and theirs, ...
+    std::unordered_map<const FunctionDecl*, std::vector<const FunctionDecl*>> callers;
+    std::vector<const FunctionDecl*> work;
+    for (const FunctionDecl* f : functions) {
+      std::vector<const FunctionDecl*> callees;
+      callees_ = &callees;
+      if (in(f->body.get()) != nullptr && changing_.insert(f).second) work.push_back(f);
+      callees_ = nullptr;
+      for (const FunctionDecl* g : callees) callers[g].push_back(f);
+    }
+    while (!work.empty()) {
+      const FunctionDecl* g = work.back();
+      work.pop_back();
+      for (const FunctionDecl* f : callers[g])
+        if (changing_.insert(f).second) work.push_back(f);
+    }
+  }
+
   /// The first place operation reached from @p stmt (its position), or null.
   const Expr* in(const Stmt* stmt) {
     if (stmt == nullptr) return nullptr;
@@ -87,9 +120,13 @@ class MarkingEffects {
         if (c.binding.kind == Binding::Kind::Builtin &&
             (c.binding.builtin == Builtin::PlacePut || c.binding.builtin == Builtin::PlaceClear))
           return at;
-        if (c.binding.kind == Binding::Kind::Function && c.binding.decl != nullptr &&
-            function(c.binding.decl->as<FunctionDecl>()))
-          return at;
+        if (c.binding.kind == Binding::Kind::Function && c.binding.decl != nullptr) {
+          const auto* f = &c.binding.decl->as<FunctionDecl>();
+          if (callees_ != nullptr)
+            callees_->push_back(f);  // (the call graph is being made: only direct effects count)
+          else if (changing_.count(f) != 0)
+            return at;
+        }
         if (const Expr* x = in(c.callee.get())) return x;
         for (const auto& a : c.args)
           if (const Expr* x = in(a.get())) return x;
@@ -116,13 +153,6 @@ class MarkingEffects {
   }
 
  private:
-  bool function(const FunctionDecl& f) {
-    if (auto it = cache_.find(&f); it != cache_.end()) return it->second;
-    cache_[&f] = false;  // on the call path: recursion adds nothing
-    const bool changes = in(f.body.get()) != nullptr;
-    cache_[&f] = changes;
-    return changes;
-  }
   // The first token of a postfix expression: `free` of `free.put`.
   static const Expr* leftmost(const Expr* e) {
     for (;;) {
@@ -142,14 +172,15 @@ class MarkingEffects {
     ((found = found != nullptr ? found : e), ...);
     return found;
   }
-  std::unordered_map<const FunctionDecl*, bool> cache_;
+  std::unordered_set<const FunctionDecl*> changing_;  // the functions that change a marking, transitively
+  std::vector<const FunctionDecl*>* callees_ = nullptr;  // while the call graph is made: the calls met
 };
 
 // ---- SOML++ -> PtNet ---------------------------------------------------------------------------------
 
 class Converter {
  public:
-  explicit Converter(const CheckResult& checked) : checked_(checked) {}
+  explicit Converter(const CheckResult& checked) : checked_(checked), effects_(*checked.script.root) {}
 
   SomlNetImport run() {
     const ClassDecl& root = *checked_.script.root;
@@ -345,6 +376,10 @@ SomlNetImport net_from_soml(const CheckResult& checked) {
 SomlNetImport read_soml_net(std::string_view text, std::string_view source) {
   const auto checked = check_source(std::string(source), std::string(text));
   return net_from_soml(*checked);
+}
+
+SomlNetImport read_soml_net(std::istream& in, std::string_view source) {
+  return read_soml_net(detail::read_text(in, source), source);
 }
 
 SomlNetImport read_soml_net_file(const std::filesystem::path& path) {

@@ -8,6 +8,7 @@
 #include "compiled_net.hpp"
 #include "place_bounds.hpp"
 #include "vsd/core/error.hpp"
+#include "vsd/analysis/explorer.hpp"  // default_memory_limit
 
 namespace vsd::analysis {
 
@@ -70,7 +71,7 @@ struct TokenGame::Net {
   explicit Net(const PtNet& net) : c(net), initial(net.initial_marking()) {
     for (const auto& t : net.transitions()) transition_ids.push_back(t.id);
     std::optional<std::vector<std::uint64_t>> bounds;
-    if (c.places > 0) bounds = detail::place_bounds(net);
+    if (c.places > 0) bounds = detail::place_bounds(net, default_memory_limit() / 4);
     safe = bounds && std::all_of(bounds->begin(), bounds->end(), [](std::uint64_t b) { return b <= 1; });
     if (safe)
       compile_safe(net);

@@ -41,23 +41,27 @@ const MetaInstance& ProgramImpl::adopt_class(ClassBuilder& b, const std::string&
   if (known == nullptr) return define_class(b);  // the state has no instance of it: defined as by a load
   auto disagree = [&](const std::string& what) {
     throw Error(where(*this, decl.loc) + ": class '" + name +
-                "' of the state does not match the script: " + what);
+                (attaching_ ? "' of the state does not match the script: "
+                            : "' is registered already, in use with another definition: ") +
+                what);
   };
-  if (!known->is_runtime()) disagree("the state's is a built-in class");
+  const std::string theirs = attaching_ ? "the state's" : "the registered one";
+  const std::string in_theirs = attaching_ ? " in the state" : " in the registered one";
+  if (!known->is_runtime()) disagree(theirs + " is a built-in class");
   if (known->base() != &base)
     disagree("it derives from '" +
              (known->base() != nullptr ? known->base()->name() : std::string("nothing")) +
              "', the script's from '" + base.name() + "'");
   const auto own = known->own_properties();
   for (std::size_t i = 0; i < props.size() || i < own.size(); ++i) {
-    if (i >= own.size()) disagree("the state's has no property '" + props[i].first + "'");
+    if (i >= own.size()) disagree(theirs + " has no property '" + props[i].first + "'");
     if (i >= props.size())
-      disagree("the state's has a property '" + own[i]->name() + "' the script does not declare");
+      disagree(theirs + " has a property '" + own[i]->name() + "' the script does not declare");
     if (own[i]->name() != props[i].first)
-      disagree("property " + std::to_string(i + 1) + " is '" + own[i]->name() + "' in the state, '" +
+      disagree("property " + std::to_string(i + 1) + " is '" + own[i]->name() + "'" + in_theirs + ", '" +
                props[i].first + "' in the script");
     if (&own[i]->type() != props[i].second)
-      disagree("property '" + props[i].first + "' is " + own[i]->type().name() + " in the state, " +
+      disagree("property '" + props[i].first + "' is " + own[i]->type().name() + in_theirs + ", " +
                type_name(props[i].second) + " in the script");
   }
   // Its methods: none when a file defined it (they are bound once the attach succeeded), the script's
@@ -67,9 +71,9 @@ const MetaInstance& ProgramImpl::adopt_class(ClassBuilder& b, const std::string&
     auto it =
         std::find_if(methods.begin(), methods.end(), [&](const auto& x) { return x.name == m->name(); });
     if (it == methods.end())
-      disagree("the state's has a method '" + m->name() + "' the script does not declare");
+      disagree(theirs + " has a method '" + m->name() + "' the script does not declare");
     if (it->args != m->arguments() || it->result != m->result())
-      disagree("method '" + m->name() + "' is " + m->signature() + " in the state");
+      disagree("method '" + m->name() + "' is " + m->signature() + in_theirs);
   }
   pending_methods_.emplace_back(known, std::move(b));
   return *known;
@@ -92,7 +96,8 @@ const MetaType& ProgramImpl::adopt_enum(EnumBuilder& b, const std::string& name,
   }
   if (!same)
     throw Error(where(*this, e.loc) + ": enum '" + name +
-                "' of the state does not match the script's values");
+                (attaching_ ? "' of the state does not match the script's values"
+                            : "' is registered already, in use with other values"));
   return *known;
 }
 

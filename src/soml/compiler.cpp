@@ -115,6 +115,7 @@ class Compiler {
     F.code.push_back(Ins{op, 0, static_cast<std::uint16_t>(a), static_cast<std::uint16_t>(b),
                          static_cast<std::uint16_t>(c)});
     F.lines.push_back(line_);
+    F.positions.push_back(Function::Pos{pos_.line, pos_.column});
     return F.code.size() - 1;
   }
   // A vector instruction whose x says the element kind (1: strings).
@@ -158,7 +159,24 @@ class Compiler {
     if (top_ > max_) max_ = top_;
     return r;
   }
-  void at(SourceLoc loc) { line_ = loc.line; }
+  void at(SourceLoc loc) {
+    line_ = loc.line;
+    pos_ = loc;
+  }
+  // The position of an expression or statement while it is compiled: what its own instructions, emitted
+  // before and after those of its operands, carry for run-time errors. (line_ keeps the debugger's
+  // stepping as it was: the last line set.)
+  class Here {
+   public:
+    Here(Compiler& c, SourceLoc loc) : c_(c), saved_(c.pos_) { c.at(loc); }
+    ~Here() { c_.pos_ = saved_; }
+    Here(const Here&) = delete;
+    Here& operator=(const Here&) = delete;
+
+   private:
+    Compiler& c_;
+    SourceLoc saved_;
+  };
 
   int konst(std::int64_t v) {
     if (P.consts_.size() >= 65535) not_supported(P, SourceLoc{}, "more than 65535 constants in one script");
@@ -209,7 +227,13 @@ class Compiler {
       if (it == P.prop_slot_.end()) not_supported(P, loc, "this property");
       return it->second;
     }
-    return meta_slot(b.property);
+    const int slot = meta_slot(b.property);
+    // What the VM cannot move between a property and a register is refused here, at load, never at run
+    // time (every kind is handled today; a new one must be added to meta_slot and the VM first).
+    const PropSlot& ps = P.props_[static_cast<std::size_t>(slot)];
+    if (ps.kind == PK::Other && ps.prop->type().kind() != TypeKind::Float)
+      not_supported(P, loc, "property '" + ps.prop->name() + "' of type " + ps.prop->type().name());
+    return slot;
   }
   int meta_slot(const MetaProperty* mp) {
     auto it = P.meta_prop_slot_.find(mp);
@@ -246,11 +270,16 @@ class Compiler {
       case TypeKind::SharedRefList:
         s.kind = PK::List;
         break;
+      // Structs (Vector3d, Quaterniond, Isometry3d, VSD_STRUCTs) and vectors of structs or enums of a
+      // built-in class are Values in X registers, as those of script classes are (prop_kind).
+      case TypeKind::Struct:
+        s.kind = PK::Value;
+        break;
       case TypeKind::Vector:
-        s.kind = vector_elem_kind(t) != RK::None ? PK::Vector : PK::Other;
+        s.kind = vector_elem_kind(t) != RK::None ? PK::Vector : PK::Value;
         break;
       default:
-        s.kind = PK::Other;
+        s.kind = PK::Other;  // float: through the MetaType's width (the VM's default cases)
     }
     P.props_.push_back(s);
     const int i = static_cast<int>(P.props_.size() - 1);
@@ -345,7 +374,7 @@ class Compiler {
   }
 
   int expr(const Expr& e) {
-    at(e.loc);
+    const Here at_node(*this, e.loc);
     switch (e.kind) {
       case ExprKind::Int: {
         const int r = temp();
@@ -871,6 +900,7 @@ class Compiler {
 
   // Computes a (non-logical) binary expression into register dst.
   void binary_into(const BinaryExpr& e, int dst) {
+    const Here at_node(*this, e.loc);
     const int save = top_;
     if (immediate(e, dst)) {
       top_ = save;
@@ -1328,7 +1358,7 @@ class Compiler {
   void stmt(const Stmt& s) {
     const int save = top_;
     const std::size_t open = open_.size();
-    at(s.loc);
+    const Here at_node(*this, s.loc);
     switch (s.kind) {
       case StmtKind::Block:
         block(s.as<BlockStmt>());
@@ -1543,6 +1573,7 @@ class Compiler {
   int top_;
   int max_;
   std::uint32_t line_ = 0;
+  SourceLoc pos_{0, 0, 0};
 };
 
 }  // namespace

@@ -4,10 +4,12 @@
 // signal. Among the enabled transitions one is chosen with a seeded generator, so runs are
 // reproducible. Every firing changes markings through the setters of the place nodes.
 #include <algorithm>
+#include <limits>
 #include <utility>
 
 #include "program_impl.hpp"
 #include "vsd/core/error.hpp"
+#include "vsd/soml/debugger.hpp"  // net_node_label
 
 namespace vsd::soml {
 
@@ -52,12 +54,41 @@ void ProgramImpl::on_deleted(SimStateInstance& inst) {
 
 void ProgramImpl::put_token(Place& p, SimStateInstance* obj, std::int64_t n) {
   if (obj == nullptr) {
-    p.set_tokens(p.tokens() + n);
+    std::int64_t v;
+    if (__builtin_add_overflow(p.tokens(), n, &v)) too_many_tokens(p, n);
+    p.set_tokens(v);
     return;
   }
   Node* node = obj->as<Node>();
   if (node == nullptr) fail("only nodes can be tokens");
   p.edit_objects().push_back(*node);
+}
+
+void ProgramImpl::too_many_tokens(const Place& p, std::int64_t n, const ArrowDecl* arrow) {
+  fail("place '" + net_node_label(&p) + "' would hold more than 9223372036854775807 (2^63-1) tokens: " +
+       std::to_string(p.tokens()) + " + " + std::to_string(n) +
+       (arrow != nullptr ? "\n  at the arrow (" + where(*this, arrow->loc) + ")" : std::string()));
+}
+
+void ProgramImpl::check_token_room(NetInst& net, const TransitionInfo& t) {
+  constexpr std::int64_t kMax = std::numeric_limits<std::int64_t>::max();
+  for (const ArrowInfo& a : t.out) {
+    if (a.object) continue;
+    Place* p = a.remote ? remote_place(a, net) : net.places[static_cast<std::size_t>(a.place)];
+    if (p == nullptr || p->tokens() <= kMax - t.out_weight) continue;
+    // Near the top: the place's count after the firing, exactly (its inputs take first, then every
+    // output arrow to it gives).
+    auto place_of = [&](const ArrowInfo& x) {
+      return x.remote ? remote_place(x, net) : net.places[static_cast<std::size_t>(x.place)];
+    };
+    std::int64_t after = p->tokens();
+    for (const ArrowInfo& i : t.in)
+      if (!i.object && !i.inhibitor && place_of(i) == p) after -= std::min(after, i.weight);
+    bool over = false;
+    for (const ArrowInfo& o : t.out)
+      if (!o.object && place_of(o) == p) over = over || __builtin_add_overflow(after, o.weight, &after);
+    if (over) too_many_tokens(*p, a.weight, a.decl);
+  }
 }
 
 void ProgramImpl::set_enabled(std::uint32_t i, bool on) {
@@ -234,6 +265,7 @@ void ProgramImpl::fire(std::uint32_t i) {
   // undoes every change it made — properties, markings, created and deleted instances — so a firing is
   // all or nothing. One without code cannot fail and runs without the recording that costs.
   if (!t.guarded) {
+    check_token_room(net, t);  // the one way it could fail: before anything changes
     fire_body(i);
   } else {
     const SimState::Savepoint sp = state_.savepoint();
@@ -370,7 +402,9 @@ Place* ProgramImpl::produce(NetInst& net, const TransitionInfo& t, std::uint64_t
     Place& p = *pp;
     if (!a.object) {
       if (a.cond < 0 || run(a.cond, arrow_self(net, a), mark, nullptr, nullptr).i != 0) {
-        p.set_tokens(p.tokens() + a.weight);
+        std::int64_t v;
+        if (__builtin_add_overflow(p.tokens(), a.weight, &v)) too_many_tokens(p, a.weight, a.decl);
+        p.set_tokens(v);
         if (given != nullptr) given->push_back(TokenMove{&p, a.weight});
       }
     } else if (to == nullptr && m != nullptr && m->as<Node>() != nullptr) {

@@ -450,6 +450,8 @@ MigrationReport migrate(ProgramImpl& old, ProgramImpl& nw, std::string name, std
   RetiredNames retired(reg, old_classes);
 
   auto undefine_new = [&] {
+    nw.used_classes_.clear();  // (never counted: it was not registered)
+    nw.used_enums_.clear();
     for (const MetaInstance* m : nw.runtime_classes()) try {
         reg.undefine(*m);
       } catch (const Error&) {  // NOLINT(bugprone-empty-catch): a leftover class is harmless; it is named
@@ -522,7 +524,9 @@ MigrationReport migrate(ProgramImpl& old, ProgramImpl& nw, std::string name, std
     nw.root_->add_child(*nw.exec_);
   }
   nw.sync_state();
-  // The retired classes and enums go (a class something else still uses stays, under its retired name).
+  // The retired classes and enums go (a class something else still uses stays, under its retired name):
+  // the running version stops counting as their user first (ProgramImpl::release_uses).
+  old.release_uses(false);
   for (const MetaInstance* m : old_classes) try {
       reg.undefine(*m);
     } catch (const Error& e) {
@@ -624,6 +628,7 @@ void Program::follow_reload(std::string name, std::string text, const Transactio
   fresh->tests_ = old.tests_;
   fresh->condition_errors_ = old.condition_errors_;
   // The retired classes and enums go, as on the source (one something else still uses stays).
+  old.release_uses(false);
   for (const MetaInstance* m : old_classes) try {
       reg.undefine(*m);
     } catch (const Error&) {  // NOLINT(bugprone-empty-catch): it stays under its retired name

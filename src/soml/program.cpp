@@ -2,6 +2,7 @@
 // classes and enums, the linkage table, compilation, and the instances of the script object, its objects
 // and their nets.
 #include <algorithm>
+#include <limits>
 #include <cctype>
 #include <mutex>
 
@@ -37,9 +38,115 @@ void walk(const Decl& d, F&& fn) {
 
 }  // namespace
 
+ProgramImpl::ProgramImpl(SimState& state, RunOptions options)
+    : registry_(state.environment().registry()), state_(state), opt_(options) {}
+
 ProgramImpl::~ProgramImpl() {
   listener_.disconnect();
   deleted_listener_.disconnect();
+  release_uses(true);
+}
+
+namespace {
+// How many live programs use each run-time class and enum (ProgramImpl::used_classes_): the last one to
+// go undefines them. Keyed by address; an entry lives only while its count is positive, that is while some
+// program holds the class.
+std::mutex users_mutex;
+std::unordered_map<const void*, int>& users() {
+  static std::unordered_map<const void*, int> all;
+  return all;
+}
+int users_of(const void* p) {
+  std::lock_guard lock(users_mutex);
+  auto it = users().find(p);
+  return it == users().end() ? 0 : it->second;
+}
+}  // namespace
+
+void ProgramImpl::release_uses(bool undefine) noexcept {
+  if (!counted_) return;
+  counted_ = false;
+  std::vector<const MetaInstance*> classes;
+  std::vector<const MetaType*> enums;
+  {
+    std::lock_guard lock(users_mutex);
+    auto last = [](const void* p) {
+      auto it = users().find(p);
+      if (it == users().end() || --it->second > 0) return false;
+      users().erase(it);
+      return true;
+    };
+    for (const MetaInstance* m : used_classes_)
+      if (last(m)) classes.push_back(m);
+    for (const MetaType* t : used_enums_)
+      if (last(t)) enums.push_back(t);
+  }
+  used_classes_.clear();
+  used_enums_.clear();
+  if (!undefine) return;
+  Registry& reg = registry_;
+  // Subclasses first. One with instances left (a state that outlives its program) or one still named by
+  // another class's property stays; a later load replaces it once nothing uses it.
+  std::stable_sort(classes.begin(), classes.end(),
+                   [](const MetaInstance* a, const MetaInstance* b) { return a->depth() > b->depth(); });
+  for (const MetaInstance* m : classes) try {
+      reg.undefine(*m);
+    } catch (const Error&) {  // NOLINT(bugprone-empty-catch): it stays (see above)
+    }
+  for (auto it = enums.rbegin(); it != enums.rend(); ++it) try {
+      reg.undefine(**it);
+    } catch (const Error&) {  // NOLINT(bugprone-empty-catch)
+    }
+}
+
+// SOML++ classes and enums that no live program uses and no instance holds are garbage — left by a
+// program that went while its state lived on, whose instances are gone now — and go before a load, so
+// that a script loads again under its names (docs/soml.md 8.1). Repeated while it makes progress: a class
+// goes after its subclasses and after the classes whose properties name it.
+void ProgramImpl::sweep_leftovers() {
+  Registry& reg = registry_;
+  auto garbage_class = [&](const MetaInstance* m) {
+    return m->is_runtime() && m->name().starts_with("soml::") && m->live_instances() == 0 && users_of(m) == 0;
+  };
+  for (bool progress = true; progress;) {
+    progress = false;
+    std::vector<const MetaInstance*> classes;
+    for (const MetaInstance* m : reg.classes())
+      if (garbage_class(m)) classes.push_back(m);
+    std::stable_sort(classes.begin(), classes.end(),
+                     [](const MetaInstance* a, const MetaInstance* b) { return a->depth() > b->depth(); });
+    for (const MetaInstance* m : classes) try {
+        reg.undefine(*m);
+        progress = true;
+      } catch (const Error&) {  // NOLINT(bugprone-empty-catch): a subclass or a property still names it
+      }
+  }
+  for (const MetaType* t : reg.types())
+    if (t->kind() == TypeKind::Enum && t->name().starts_with("soml::") && reg.owns(*t) && users_of(t) == 0) try {
+        reg.undefine(*t);
+      } catch (const Error&) {  // NOLINT(bugprone-empty-catch): a class still uses it
+      }
+}
+
+const MetaInstance& ProgramImpl::class_for(ClassBuilder& b, const std::string& name, const MetaInstance& base,
+                                           const ScopeDecl& decl) {
+  const MetaInstance* m = nullptr;
+  if (!attaching_ && registry_.find_class_exact(name) == nullptr) {
+    adopted_props_.clear();
+    adopted_methods_.clear();
+    m = &define_class(b);
+  } else {
+    m = &adopt_class(b, name, base, decl);  // shared when it is the same (defined when there is none)
+  }
+  used_classes_.push_back(m);
+  return *m;
+}
+
+const MetaType& ProgramImpl::enum_for(EnumBuilder& b, const std::string& name, const EnumDecl& decl) {
+  const MetaType* t = !attaching_ && registry_.find_type(name) == nullptr ? &define_enum(b)
+                                                                          : &adopt_enum(b, name, decl);
+  used_enums_.push_back(t);
+  return *t;
 }
 
 // The MetaType that stores a value of static type t (references to script classes are stored as
@@ -157,6 +264,8 @@ void ProgramImpl::undefine_own() noexcept {
     }
   defined_classes_.clear();
   defined_enums_.clear();
+  used_classes_.clear();
+  used_enums_.clear();
   scope_meta_.clear();
   by_meta_.clear();
   enums_.clear();
@@ -164,6 +273,7 @@ void ProgramImpl::undefine_own() noexcept {
 
 void ProgramImpl::define(std::string name, std::string text) {
   Registry& reg = state_.environment().registry();
+  sweep_leftovers();
   checked_ = check_source(name, std::move(text), reg);
   if (!checked_->ok()) throw Error(checked_->diagnostics.format());
   {
@@ -206,12 +316,13 @@ void ProgramImpl::define(std::string name, std::string text) {
         if (!same) not_supported(*this, e.loc, "changing the values of enum '" + e.name + "' at run time");
         enums_[&e] = old_type;
         reused_enums_.push_back(old_type);
+        used_enums_.push_back(old_type);
         return;
       }
     EnumBuilder b("soml::" + qualified(e));
     b.underlying(meta_type<std::int64_t>());
     for (std::size_t i = 0; i < e.values.size(); ++i) b.value(e.values[i], static_cast<std::int64_t>(i));
-    enums_[&e] = attaching_ ? &adopt_enum(b, "soml::" + qualified(e), e) : &define_enum(b);
+    enums_[&e] = &enum_for(b, "soml::" + qualified(e), e);
   });
 
   // 3. Class-like declarations, bases first.
@@ -222,13 +333,15 @@ void ProgramImpl::define(std::string name, std::string text) {
       all.push_back(&d.as<ClassDecl>());
   });
   std::unordered_map<const ClassDecl*, bool> placed;
-  std::function<void(const ClassDecl*)> order = [&](const ClassDecl* c) {
-    if (placed[c]) return;
-    placed[c] = true;
-    if (c->base.decl != nullptr) order(c->base.decl);
-    class_order_.push_back(c);
-  };
-  for (const ClassDecl* c : all) order(c);
+  std::vector<const ClassDecl*> chain;  // a class and its bases not placed yet (no recursion: chains of
+  for (const ClassDecl* c : all) {      // any length)
+    for (const ClassDecl* d = c; d != nullptr && !placed[d]; d = d->base.decl) {
+      placed[d] = true;
+      chain.push_back(d);
+    }
+    class_order_.insert(class_order_.end(), chain.rbegin(), chain.rend());
+    chain.clear();
+  }
 
   // Function shells first: the MetaMethods' invokers and the compiler refer to them by index.
   walk(root, [&](const Decl& d) {
@@ -247,7 +360,7 @@ void ProgramImpl::define(std::string name, std::string text) {
         const MetaType* t = storage_type(*this, reg, pd.type);
         if (t == nullptr) not_supported(*this, pd.loc, "a property of type '" + pd.type.name() + "'");
         b.property(pd.name, *t);
-        if (attaching_) adopted_props_.emplace_back(pd.name, t);
+        adopted_props_.emplace_back(pd.name, t);  // (what class_for compares with a class of that name)
       } else if (m->kind == DeclKind::Function && !m->as<FunctionDecl>().is_constructor) {
         const auto& fd = m->as<FunctionDecl>();
         std::vector<const MetaType*> args;
@@ -260,7 +373,7 @@ void ProgramImpl::define(std::string name, std::string text) {
             fd.result_type.kind == K::Void ? nullptr : storage_type(*this, reg, fd.result_type);
         const int fi = function_index_.at(&fd);
         std::weak_ptr<ProgramImpl> weak = weak_self_;
-        if (attaching_) adopted_methods_.push_back(AdoptedMethod{fd.name, args, result});
+        adopted_methods_.push_back(AdoptedMethod{fd.name, args, result});
         b.method(fd.name, std::move(args), result,
                  [weak, fi, fname = functions_[static_cast<std::size_t>(fi)]->name](
                      SimStateInstance& self, std::span<const Value> a) {
@@ -288,7 +401,7 @@ void ProgramImpl::define(std::string name, std::string text) {
       }
       ClassBuilder pb(cname + "::" + m->name, sb);
       add_members(pb, s);
-      scope_meta_[m.get()] = attaching_ ? &adopt_class(pb, cname + "::" + m->name, sb, s) : &define_class(pb);
+      scope_meta_[m.get()] = &class_for(pb, cname + "::" + m->name, sb, s);
     }
   };
   for (const ClassDecl* c : class_order_) {
@@ -312,9 +425,9 @@ void ProgramImpl::define(std::string name, std::string text) {
       const MetaType* t = storage_type(*this, reg, c->result_type);
       if (t == nullptr) not_supported(*this, c->loc, "a net result of type '" + c->result_type.name() + "'");
       b.property("result", *t);
-      if (attaching_) adopted_props_.emplace_back("result", t);
+      adopted_props_.emplace_back("result", t);
     }
-    ci->meta = attaching_ ? &adopt_class(b, cname, *base, *c) : &define_class(b);
+    ci->meta = &class_for(b, cname, *base, *c);
     scope_meta_[c] = ci->meta;
     by_meta_[ci->meta] = ci.get();
     member_classes(*c, cname);
@@ -332,7 +445,7 @@ void ProgramImpl::define(std::string name, std::string text) {
       const MetaInstance& sb = Transition::static_meta();
       ClassBuilder b(cname, sb);
       add_members(b, n);
-      scope_meta_[&n] = attaching_ ? &adopt_class(b, cname, sb, n) : &define_class(b);
+      scope_meta_[&n] = &class_for(b, cname, sb, n);
     }
     member_classes(n, cname);
   });
@@ -430,10 +543,22 @@ void ProgramImpl::define(std::string name, std::string text) {
           if (m->kind == DeclKind::Transition && m->as<TransitionDecl>().substituted != nullptr)
             expand_places(net, exps, m->as<TransitionDecl>(), map, depth + 1);
       };
+  // Each class's net holds its bases' places and transitions too: a long chain of classes with nets
+  // would hold the square of its length. Refused past this many copied (the input bounds nothing else).
+  constexpr std::size_t kMaxInherited = 4'000'000;
+  std::size_t inherited = 0;
+  auto inherit = [&](const ClassDecl& c, std::size_t n) {
+    inherited += n;
+    if (inherited > kMaxInherited)
+      not_supported(*this, c.loc,
+                    "nets this large through inheritance (the classes would hold more than " +
+                        std::to_string(kMaxInherited) + " places and transitions of their bases)");
+  };
   for (const ClassDecl* c : class_order_) {
     ClassInfo& ci = *class_info_.at(c);
     auto net = std::make_unique<NetClass>();
     if (ci.base != nullptr && ci.base->net) {
+      inherit(*c, ci.base->net->places.size());
       net->places = ci.base->net->places;
       net->place_holder = ci.base->net->place_holder;
       net->transitions = ci.base->net->transitions;
@@ -453,10 +578,15 @@ void ProgramImpl::define(std::string name, std::string text) {
       ci.start_place = top.count(c->start->place_decl) != 0 ? top.at(c->start->place_decl) : -1;
     if (!net->places.empty()) ci.net = std::move(net);
   }
+  // A place's index in a class's net, by a table made once per net (a search per arrow was quadratic in
+  // a net of many places: a PNML net of 100,000 places took seconds to load).
+  std::unordered_map<const NetClass*, std::unordered_map<const Decl*, int>> place_indices;
   auto place_index = [&](const NetClass& n, const Decl* d) {
-    for (std::size_t i = 0; i < n.places.size(); ++i)
-      if (n.places[i] == d) return static_cast<int>(i);
-    return -1;
+    auto [it, fresh] = place_indices.try_emplace(&n);
+    if (fresh)
+      for (std::size_t i = 0; i < n.places.size(); ++i) it->second.try_emplace(n.places[i], static_cast<int>(i));
+    const auto at = it->second.find(d);
+    return at == it->second.end() ? -1 : at->second;
   };
   for (const ClassDecl* c : class_order_) {
     ClassInfo& ci = *class_info_.at(c);
@@ -610,7 +740,12 @@ void ProgramImpl::define(std::string name, std::string text) {
             if (ti.in.back().object && !ti.in.back().inhibitor)
               ti.mark_in = static_cast<int>(ti.in.size() - 1);
           }
-          for (const ArrowDecl* a : t.outputs) ti.out.push_back(arrow_info(*a, a->to_decl));
+          for (const ArrowDecl* a : t.outputs) {
+            ti.out.push_back(arrow_info(*a, a->to_decl));
+            if (!ti.out.back().object &&
+                __builtin_add_overflow(ti.out_weight, ti.out.back().weight, &ti.out_weight))
+              ti.out_weight = std::numeric_limits<std::int64_t>::max();
+          }
           ti.guarded = ti.action >= 0 || ti.invoke != nullptr;
           for (const ArrowInfo& a : ti.out) ti.guarded = ti.guarded || a.cond >= 0;
           ci.net->transitions.push_back(std::move(ti));
@@ -646,6 +781,7 @@ void ProgramImpl::define(std::string name, std::string text) {
   for (const ClassDecl* c : class_order_) {
     ClassInfo& ci = *class_info_.at(c);
     if (ci.base == nullptr || !ci.base->net || !ci.net) continue;
+    inherit(*c, ci.base->net->transitions.size());
     std::vector<TransitionInfo> own = std::move(ci.net->transitions);
     ci.net->transitions = ci.base->net->transitions;
     const int offset = static_cast<int>(ci.net->transitions.size());
@@ -899,10 +1035,18 @@ std::vector<std::pair<const SimState*, std::weak_ptr<ProgramImpl>>>& programs_by
 }  // namespace
 
 void ProgramImpl::register_program() {
-  std::lock_guard lock(programs_mutex);
-  auto& all = programs_by_state();
-  std::erase_if(all, [](const auto& e) { return e.second.expired(); });
-  all.emplace_back(&state_, weak_self_);
+  {
+    std::lock_guard lock(programs_mutex);
+    auto& all = programs_by_state();
+    std::erase_if(all, [](const auto& e) { return e.second.expired(); });
+    all.emplace_back(&state_, weak_self_);
+  }
+  if (!counted_) {  // from now on a user of its classes (release_uses)
+    std::lock_guard lock(users_mutex);
+    for (const MetaInstance* m : used_classes_) ++users()[m];
+    for (const MetaType* t : used_enums_) ++users()[t];
+    counted_ = true;
+  }
 }
 
 Value ProgramImpl::dispatch(const std::weak_ptr<ProgramImpl>& weak, int fi, const std::string& fname,

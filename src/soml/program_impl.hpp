@@ -155,7 +155,13 @@ static_assert(sizeof(Ins) == 8);
 struct Function {
   std::string name;  // "Demo.time_to", "cell.go (condition)"
   std::vector<Ins> code;
-  std::vector<std::uint32_t> lines;
+  std::vector<std::uint32_t> lines;  // per instruction: its line as the debugger steps through them
+  // Per instruction: the line and column of the expression or statement it computes (its operator, its
+  // call's '(', its statement), which run-time errors name (file:line:col).
+  struct Pos {
+    std::uint32_t line = 0, column = 0;
+  };
+  std::vector<Pos> positions;
   std::vector<std::uint32_t> targets;  // jump targets by jump id
   int nparams = 0;
   int nregs = 0;
@@ -242,6 +248,10 @@ struct TransitionInfo {
   // It runs SOML++ code when it fires (action, invocation, output arrow conditions): it fires under a
   // savepoint, so that an error undoes it whole.
   bool guarded = false;
+  // The black tokens its output arrows give, summed (at most 2^63-1): a firing without a savepoint first
+  // checks that no place would pass 2^63-1 tokens only when some output place holds more than
+  // 2^63-1 - out_weight.
+  std::int64_t out_weight = 0;
 };
 
 // The net of a class-like declaration (its own places and transitions, bases' first).
@@ -293,7 +303,7 @@ inline std::size_t pc_index(const Frame& f) noexcept {
 
 class ProgramImpl {
  public:
-  ProgramImpl(SimState& state, RunOptions options) : state_(state), opt_(options) {}
+  ProgramImpl(SimState& state, RunOptions options);
   ~ProgramImpl();
 
   void load(std::string name, std::string text);
@@ -315,6 +325,28 @@ class ProgramImpl {
   void undefine_own() noexcept;
   const MetaInstance& define_class(ClassBuilder& b);
   const MetaType& define_enum(EnumBuilder& b);
+  // The run-time class (enum) of a declaration when loading: defined, or, when the Registry has one of
+  // that name — the same script loaded in another Environment on the same Registry, or a class whose
+  // instances outlive their program — shared if it has the same definition; another definition is an
+  // error naming what differs.
+  const MetaInstance& class_for(ClassBuilder& b, const std::string& name, const MetaInstance& base,
+                                const ScopeDecl& decl);
+  const MetaType& enum_for(EnumBuilder& b, const std::string& name, const EnumDecl& decl);
+  // Every run-time class and enum this program uses (defined or shared), in definition order. A program
+  // counts as a user of them once it is registered (register_program); when the last user goes, they go
+  // too (Registry::undefine; a class whose instances outlive its programs stays until a load replaces
+  // it). docs/soml.md 8.1.
+  std::vector<const MetaInstance*> used_classes_;
+  std::vector<const MetaType*> used_enums_;
+  bool counted_ = false;  // register_program counted this program's uses
+  // The state's Registry, kept apart: a program may outlive its state (an Environment destroys its states
+  // before its modules, which own the programs), never the Registry.
+  Registry& registry_;
+  // Stops using them: each whose last user this was is undefined when @p undefine (a reload undefines the
+  // running version's classes itself).
+  void release_uses(bool undefine) noexcept;
+  // Before a definition: undefines the SOML++ classes and enums no program uses and no instance holds.
+  void sweep_leftovers();
   // Program::load and Program::attach: define and populate, all or nothing (a refused load leaves the
   // Registry and the SimState as they were).
   void load_or_undo(std::string name, std::string text);
@@ -348,12 +380,21 @@ class ProgramImpl {
                                 const std::string* sargs, int nargs, const VecReg* vargs = nullptr,
                                 const Value* xargs = nullptr);
   [[noreturn]] void fail(const std::string& what);
+  // "integer overflow: a op b does not fit an int (64 bits)", and "what(a)" for unary operations.
+  [[noreturn, gnu::cold, gnu::noinline]] void int_overflow(std::int64_t a, const char* op, std::int64_t b);
+  [[noreturn, gnu::cold, gnu::noinline]] void int_overflow(const char* what, std::int64_t a);
 
   // ---- executor ----
   std::uint64_t step(std::uint64_t n);  // step_loop, then sync_state (also on an error)
   std::uint64_t step_loop(std::uint64_t n);
   bool refresh();  // re-tests dirty transitions; true when some is enabled
   void put_token(Place& p, SimStateInstance* obj, std::int64_t n);
+  // "place 'p' would hold more than 2^63-1 tokens": a token count never wraps.
+  // (produced by @p arrow, when given: its position ends the message)
+  [[noreturn, gnu::cold]] void too_many_tokens(const Place& p, std::int64_t n, const ArrowDecl* arrow = nullptr);
+  // For a firing without a savepoint: throws (before anything changed) when producing would take a place
+  // past 2^63-1 tokens, naming the arrow.
+  void check_token_room(NetInst& net, const TransitionInfo& t);
 
   std::weak_ptr<ProgramImpl> weak_self_;
   std::function<void()> on_dirty_;  // called when a transition needs a test (the Module triggers its task)
@@ -448,6 +489,25 @@ class ProgramImpl {
   std::vector<Frame> frames_;
   std::uint32_t top_ = 0;  // first free register of the outermost frame stack
   std::uint64_t budget_ = 0;
+  // The memory budget left to the call from outside under way (RunOptions::memory_budget): every
+  // instruction that makes memory grow takes its bytes from it first (charge), and a store, list append or
+  // creation also the record of the change when the state records (every guarded firing does).
+  std::uint64_t mem_left_ = 0;
+  static constexpr std::size_t kRecordBytes = 32;     // a recorded change, besides its values
+  static constexpr std::size_t kInstanceBytes = 256;  // an instance's id, index and record, besides its size
+  void charge(std::size_t bytes) {
+    if (bytes > mem_left_) memory_exhausted(bytes);
+    mem_left_ -= bytes;
+  }
+  // What grew from @p before to @p after bytes.
+  void grew(std::size_t before, std::size_t after) {
+    if (after > before) charge(after - before);
+  }
+  // A change recorded (when the state records) with values of @p value_bytes.
+  void charge_record(std::size_t value_bytes) {
+    if (state_.recording()) charge(kRecordBytes + 2 * value_bytes);
+  }
+  [[noreturn, gnu::cold, gnu::noinline]] void memory_exhausted(std::size_t bytes);
   int entry_depth_ = 0;
   std::vector<std::pair<std::uint64_t, const MetaProperty*>>* deps_ = nullptr;
   std::vector<int> vslot_default_;  // virtual slot -> function of the root declaration

@@ -36,16 +36,6 @@ static void to_registers(const MetaType& t, const void* addr, Val& v, std::strin
 
 namespace {
 
-inline std::int64_t wrap_add(std::int64_t a, std::int64_t b) {
-  return static_cast<std::int64_t>(static_cast<std::uint64_t>(a) + static_cast<std::uint64_t>(b));
-}
-inline std::int64_t wrap_sub(std::int64_t a, std::int64_t b) {
-  return static_cast<std::int64_t>(static_cast<std::uint64_t>(a) - static_cast<std::uint64_t>(b));
-}
-inline std::int64_t wrap_mul(std::int64_t a, std::int64_t b) {
-  return static_cast<std::int64_t>(static_cast<std::uint64_t>(a) * static_cast<std::uint64_t>(b));
-}
-
 void store_integer(const MetaProperty& p, SimStateInstance& o, std::int64_t v) {
   alignas(8) unsigned char buf[8] = {};
   const std::size_t n = p.type().size();
@@ -200,13 +190,65 @@ std::string ProgramImpl::stack_text(std::size_t from) const {
   for (std::size_t i = frames_.size(); i-- > from;) {
     const Frame& f = frames_[i];
     const std::size_t at = pc_index(f);
-    const std::uint32_t line = at < f.fn->lines.size() ? f.fn->lines[at] : 0;
-    s += "\n  at " + f.fn->name + " (" + checked_->source->name() + ":" + std::to_string(line) + ")";
+    const Function::Pos pos = at < f.fn->positions.size() ? f.fn->positions[at] : Function::Pos{};
+    s += "\n  at " + f.fn->name + " (" + checked_->source->name() + ":" + std::to_string(pos.line) + ":" +
+         std::to_string(pos.column) + ")";
   }
   return s;
 }
 
 void ProgramImpl::fail(const std::string& what) { throw Error("SOML++ run-time error: " + what); }
+
+void ProgramImpl::memory_exhausted(std::size_t bytes) {
+  fail("memory budget exhausted (" + std::to_string(opt_.memory_budget) +
+       " bytes of strings, vectors, values, stored changes and instances in one call; " +
+       std::to_string(bytes) + " more asked for): a runaway allocation?");
+}
+
+// The heap bytes of a register's value, as the memory budget counts them: buffers by their capacity;
+// a vector of strings also its strings' buffers; a Value its type's size and a vector's elements.
+static std::size_t heap_bytes(const VecReg& r) {
+  std::size_t n = r.v.capacity() * sizeof(Val) + r.s.capacity() * sizeof(std::string);
+  for (const std::string& x : r.s) n += x.capacity();
+  return n;
+}
+static std::size_t value_bytes(const MetaType& t, const void* addr) {
+  std::size_t n = t.size();
+  if (t.kind() == TypeKind::String) n += static_cast<const std::string*>(addr)->capacity();
+  if (t.kind() == TypeKind::Vector && t.element() != nullptr) n += t.vector_size(addr) * t.element()->size();
+  return n;
+}
+static std::size_t heap_bytes(const Value& v) { return v.type() != nullptr ? value_bytes(*v.type(), v.data()) : 0; }
+// The heap bytes of the register a value of type @p t goes to (to_registers): none for numbers.
+static std::size_t register_bytes(const MetaType& t, const std::string& s, const VecReg& v, const Value& x) {
+  switch (t.kind()) {
+    case TypeKind::Bool:
+    case TypeKind::Int:
+    case TypeKind::UInt:
+    case TypeKind::Enum:
+    case TypeKind::Flags:
+    case TypeKind::Float:
+    case TypeKind::Double:
+      return 0;
+    case TypeKind::String:
+      return s.capacity();
+    case TypeKind::Vector:
+      if (vector_elem_kind(t) != RK::None) return heap_bytes(v);
+      break;
+    default:
+      break;
+  }
+  return heap_bytes(x);
+}
+
+// int arithmetic never wraps: a result outside [-2^63, 2^63-1] is an error, like a division by zero.
+void ProgramImpl::int_overflow(std::int64_t a, const char* op, std::int64_t b) {
+  fail(std::string("integer overflow: ") + std::to_string(a) + " " + op + " " + std::to_string(b) +
+       " does not fit an int (64 bits)");
+}
+void ProgramImpl::int_overflow(const char* what, std::int64_t a) {
+  fail(std::string("integer overflow: ") + what + "(" + std::to_string(a) + ") does not fit an int (64 bits)");
+}
 
 Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* args,
                      const std::string* sargs, std::string* sresult, const VecReg* vargs, VecReg* vresult,
@@ -215,6 +257,7 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
   const std::size_t entry = frames_.size();
   if (entry == 0) {
     budget_ = opt_.instruction_budget == 0 ? 1 : opt_.instruction_budget;
+    mem_left_ = opt_.memory_budget;
     frames_.reserve(static_cast<std::size_t>(opt_.max_depth) + 8);
   }
   if (entry >= static_cast<std::size_t>(opt_.max_depth))
@@ -257,11 +300,24 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
 }
 
 // `new C(args)`, out of line (its argument arrays would weigh on the interpreter loop's frame).
+// Each instance it makes (the object, and the places, transitions and arrows of its net) takes its class's
+// size and kInstanceBytes from the memory budget: up front for the object, afterwards for the rest, which
+// its initialisers and constructor made (their own stores were charged as they ran).
 [[gnu::noinline]] std::uint64_t ProgramImpl::new_instance(const Ins in, const Frame& frame) {
   const Val* R = regs_.data() + frame.base;
   const std::string* S = sregs_.data() + frame.base;
   const ClassInfo* ci = classes_[in.b];
-  if (ci == nullptr) return state_.create(*class_metas_[in.b]).id();
+  const MetaInstance& cls = ci != nullptr ? *ci->meta : *class_metas_[in.b];
+  charge(cls.size() + kInstanceBytes);
+  const std::size_t before = state_.size() + 1;
+  auto rest = [&] {
+    if (state_.size() > before) charge((state_.size() - before) * kInstanceBytes);
+  };
+  if (ci == nullptr) {
+    const std::uint64_t id = state_.create(cls).id();
+    rest();
+    return id;
+  }
   const Function* ctor = ci->ctor >= 0 ? functions_[static_cast<std::size_t>(ci->ctor)].get() : nullptr;
   if (in.c > 8) fail("more than 8 constructor arguments");
   std::string sargs[8];
@@ -275,7 +331,9 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
     if (k == RK::X) xargs[i] = xregs_[frame.base + in.a + 1 + i];
     args[i] = R[in.a + 1 + i];
   }
-  return instantiate(*ci, nullptr, "", args, sargs, in.c, vargs, xargs).id();
+  const std::uint64_t id = instantiate(*ci, nullptr, "", args, sargs, in.c, vargs, xargs).id();
+  rest();
+  return id;
 }
 
 // find(path): names from the database down, separated by '/', as Node::path() writes them (a leading
@@ -341,9 +399,12 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
     return *o;
   };
   switch (in.op) {
-    case OP_MOVV:
+    case OP_MOVV: {
+      const std::size_t before = heap_bytes(V[in.a]);
       V[in.a] = V[in.b];
+      grew(before, heap_bytes(V[in.a]));
       break;
+    }
     case OP_VCLEAR: {
       VecReg& v = V[in.a];
       v.v.clear();
@@ -362,23 +423,30 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
       }
       const auto k = static_cast<std::size_t>(i);
       if (in.op == OP_VGET) {
-        if (in.x != 0)
+        if (in.x != 0) {
+          grew(S[in.a].capacity(), v.s[k].size());
           S[in.a] = v.s[k];
-        else
+        } else {
           R[in.a] = v.v[k];
+        }
       } else if (in.x != 0) {
+        grew(v.s[k].capacity(), S[in.c].size());
         v.s[k] = S[in.c];
       } else {
         v.v[k] = R[in.c];
       }
       break;
     }
-    case OP_VPUSH: {
+    case OP_VPUSH: {  // the new element, and the doubling of the buffer when it is full
       VecReg& v = V[in.a];
-      if (in.x != 0)
+      if (in.x != 0) {
+        charge(S[in.b].size() + (v.s.size() == v.s.capacity() ? std::max<std::size_t>(1, v.s.size()) : 0) *
+                                    sizeof(std::string));
         v.s.push_back(S[in.b]);
-      else
+      } else {
+        if (v.v.size() == v.v.capacity()) charge(std::max<std::size_t>(1, v.v.size()) * sizeof(Val));
         v.v.push_back(R[in.b]);
+      }
       break;
     }
     case OP_EQV: {
@@ -414,6 +482,8 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
       if (i < 0 || static_cast<std::size_t>(i) >= n) {
         fail("index " + std::to_string(i) + " out of range (size " + std::to_string(n) + ")");
       }
+      const MetaType& et = *p.type().element();
+      const std::size_t before = register_bytes(et, S[in.a], V[in.a], xregs_[frame.base + in.a]);
       if (value) {
         Value e(*p.type().element());
         p.type().vector_get(addr, static_cast<std::size_t>(i), e.data());
@@ -421,6 +491,7 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
       } else {
         vector_at(p.type(), addr, static_cast<std::size_t>(i), R[in.a], S[in.a]);
       }
+      grew(before, register_bytes(et, S[in.a], V[in.a], xregs_[frame.base + in.a]));
       break;
     }
     default:
@@ -536,13 +607,21 @@ static void from_registers(const MetaType& t, void* addr, const Val& v, const st
     if (v.type() == nullptr || v.type()->kind() != TypeKind::Vector) fail("not a vector");
     return *v.type();
   };
+  // What each writes grows by comes from the memory budget (measured after: the values are small or
+  // copies of what exists; a vector grows by one element at a time).
   switch (in.op) {
-    case OP_XDEF:
+    case OP_XDEF: {
+      const std::size_t before = heap_bytes(X[in.a]);
       X[in.a] = Value(*xtypes_[in.b]);
+      grew(before, heap_bytes(X[in.a]));
       break;
-    case OP_MOVX:
+    }
+    case OP_MOVX: {
+      const std::size_t before = heap_bytes(X[in.a]);
       X[in.a] = X[in.b];
+      grew(before, heap_bytes(X[in.a]));
       break;
+    }
     case OP_XGETF:
     case OP_XSETF: {
       Value& st = X[in.op == OP_XGETF ? in.b : in.a];
@@ -551,11 +630,15 @@ static void from_registers(const MetaType& t, void* addr, const Val& v, const st
       const MetaType::Field& f = t->fields()[in.x];
       if (in.op == OP_XGETF) {
         const Value fv = field_value(f, st.data());
+        const std::size_t before = register_bytes(*f.type, S[in.a], V[in.a], X[in.a]);
         to_registers(*f.type, fv.data(), R[in.a], S[in.a], V[in.a], X[in.a]);
+        grew(before, register_bytes(*f.type, S[in.a], V[in.a], X[in.a]));
       } else {
         Value fv(*f.type);
         from_registers(*f.type, fv.data(), R[in.b], S[in.b], V[in.b], X[in.b], "field '" + f.name + "'");
+        const std::size_t before = heap_bytes(st);
         set_field(f, st.data(), fv.data());
+        grew(before, heap_bytes(st));
       }
       break;
     }
@@ -571,7 +654,9 @@ static void from_registers(const MetaType& t, void* addr, const Val& v, const st
       const std::size_t i = index(vt, vec, R[in.c].i);
       Value e(*vt.element());
       vt.vector_get(vec.data(), i, e.data());
+      const std::size_t before = register_bytes(*vt.element(), S[in.a], V[in.a], X[in.a]);
       to_registers(*vt.element(), e.data(), R[in.a], S[in.a], V[in.a], X[in.a]);
+      grew(before, register_bytes(*vt.element(), S[in.a], V[in.a], X[in.a]));
       break;
     }
     case OP_XVSET:
@@ -581,10 +666,12 @@ static void from_registers(const MetaType& t, void* addr, const Val& v, const st
       const int from = in.op == OP_XVSET ? in.c : in.b;
       Value e(*vt.element());
       from_registers(*vt.element(), e.data(), R[from], S[from], V[from], X[from], "an element");
-      if (in.op == OP_XVSET)
+      if (in.op == OP_XVSET) {
         vt.vector_set(vec.data(), index(vt, vec, R[in.b].i), e.data());
-      else
+      } else {
+        charge(vt.element()->size());
         vt.vector_push(vec.data(), e.data());
+      }
       break;
     }
     default:
@@ -608,6 +695,16 @@ Val ProgramImpl::exec(std::size_t entry) {
     R = regs_.data() + fr->base;  \
     S = sregs_.data() + fr->base; \
   } while (0)
+// R[a] = x op y of ints, checked: one overflow flag test (a jump never taken), the error out of line.
+#define VSD_CHECKED(builtin, x, y, op)     \
+  do {                                     \
+    std::int64_t v_;                       \
+    if (builtin(x, y, &v_)) [[unlikely]] { \
+      VSD_SAVE();                          \
+      int_overflow(x, op, y);              \
+    }                                      \
+    R[in.a].i = v_;                        \
+  } while (0)
 
   auto obj = [&](std::uint64_t id) -> SimStateInstance& {
     SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
@@ -625,6 +722,13 @@ Val ProgramImpl::exec(std::size_t entry) {
     }
     return *p;
   };
+  // String register dst is about to hold @p size bytes: what its buffer grows by comes from the budget.
+  auto string_room = [&](const std::string& dst, std::size_t size) {
+    if (size > dst.capacity()) [[unlikely]] {
+      VSD_SAVE();
+      charge(size - dst.capacity());
+    }
+  };
 
   for (;;) {
     const Ins in = *pc++;
@@ -638,22 +742,24 @@ Val ProgramImpl::exec(std::size_t entry) {
         R[in.a].i = K[in.b];
         break;
       case OP_LOADS:
+        string_room(S[in.a], strings_[in.b].size());
         S[in.a] = strings_[in.b];
         break;
       case OP_MOV:
         R[in.a] = R[in.b];
         break;
       case OP_MOVS:
+        string_room(S[in.a], S[in.b].size());
         S[in.a] = S[in.b];
         break;
       case OP_ADDI:
-        R[in.a].i = wrap_add(R[in.b].i, R[in.c].i);
+        VSD_CHECKED(__builtin_add_overflow, R[in.b].i, R[in.c].i, "+");
         break;
       case OP_SUBI:
-        R[in.a].i = wrap_sub(R[in.b].i, R[in.c].i);
+        VSD_CHECKED(__builtin_sub_overflow, R[in.b].i, R[in.c].i, "-");
         break;
       case OP_MULI:
-        R[in.a].i = wrap_mul(R[in.b].i, R[in.c].i);
+        VSD_CHECKED(__builtin_mul_overflow, R[in.b].i, R[in.c].i, "*");
         break;
       case OP_DIVI:
       case OP_MODI: {
@@ -662,8 +768,12 @@ Val ProgramImpl::exec(std::size_t entry) {
           VSD_SAVE();
           fail("division by zero");
         }
-        if (y == -1) {
-          R[in.a].i = in.op == OP_DIVI ? wrap_sub(0, x) : 0;
+        if (y == -1) {  // x / -1 overflows for x = -2^63 only; x % -1 is 0 (representable) for every x
+          if (in.op == OP_DIVI && x == std::numeric_limits<std::int64_t>::min()) {
+            VSD_SAVE();
+            int_overflow(x, "/", y);
+          }
+          R[in.a].i = in.op == OP_DIVI ? -x : 0;
         } else {
           R[in.a].i = in.op == OP_DIVI ? x / y : x % y;
         }
@@ -681,11 +791,11 @@ Val ProgramImpl::exec(std::size_t entry) {
       case OP_DIVD:
         R[in.a].d = R[in.b].d / R[in.c].d;
         break;
-      case OP_ADDIK:
-        R[in.a].i = wrap_add(R[in.b].i, static_cast<std::int16_t>(in.c));
+      case OP_ADDIK:  // also ++, --, `i += 1` of a local and the counters of loops
+        VSD_CHECKED(__builtin_add_overflow, R[in.b].i, std::int64_t{static_cast<std::int16_t>(in.c)}, "+");
         break;
       case OP_MULIK:
-        R[in.a].i = wrap_mul(R[in.b].i, static_cast<std::int16_t>(in.c));
+        VSD_CHECKED(__builtin_mul_overflow, R[in.b].i, std::int64_t{static_cast<std::int16_t>(in.c)}, "*");
         break;
       case OP_DIVIK:
         R[in.a].i = R[in.b].i / static_cast<std::int16_t>(in.c);
@@ -694,7 +804,11 @@ Val ProgramImpl::exec(std::size_t entry) {
         R[in.a].i = R[in.b].i % static_cast<std::int16_t>(in.c);
         break;
       case OP_NEGI:
-        R[in.a].i = wrap_sub(0, R[in.b].i);
+        if (R[in.b].i == std::numeric_limits<std::int64_t>::min()) [[unlikely]] {
+          VSD_SAVE();
+          int_overflow("-", R[in.b].i);
+        }
+        R[in.a].i = -R[in.b].i;
         break;
       case OP_NEGD:
         R[in.a].d = -R[in.b].d;
@@ -751,6 +865,7 @@ Val ProgramImpl::exec(std::size_t entry) {
         R[in.a].i = S[in.b] != S[in.c];
         break;
       case OP_CONCAT: {
+        string_room(S[in.a], S[in.b].size() + S[in.c].size());  // before it is made: s = s + s doubles
         std::string t;
         t.reserve(S[in.b].size() + S[in.c].size());
         t += S[in.b];
@@ -904,6 +1019,7 @@ Val ProgramImpl::exec(std::size_t entry) {
             R[in.a].d = *static_cast<const double*>(addr);
             break;
           case PK::String:
+            string_room(S[in.a], static_cast<const std::string*>(addr)->size());
             S[in.a] = *static_cast<const std::string*>(addr);
             break;
           case PK::Int:
@@ -915,12 +1031,22 @@ Val ProgramImpl::exec(std::size_t entry) {
             R[in.a].id = t != nullptr ? t->id() : 0;
             break;
           }
-          case PK::Vector:
-            vector_load(ps.prop->type(), addr, vregs_[fr->base + in.a]);
+          case PK::Vector: {
+            VSD_SAVE();
+            VecReg& v = vregs_[fr->base + in.a];
+            const std::size_t before = heap_bytes(v);
+            vector_load(ps.prop->type(), addr, v);
+            grew(before, heap_bytes(v));
             break;
-          case PK::Value:
-            xregs_[fr->base + in.a] = Value(ps.prop->type(), addr);
+          }
+          case PK::Value: {
+            VSD_SAVE();
+            Value& x = xregs_[fr->base + in.a];
+            const std::size_t before = heap_bytes(x);
+            x = Value(ps.prop->type(), addr);
+            grew(before, heap_bytes(x));
             break;
+          }
           default:
             if (ps.prop->type().kind() == TypeKind::Float) {
               R[in.a].d = *static_cast<const float*>(addr);
@@ -940,6 +1066,23 @@ Val ProgramImpl::exec(std::size_t entry) {
         if (!o.meta().is_a(p.owner()))
           fail("instance of " + o.meta().name() + " has no property '" + p.name() + "'");
         if (p.has(ReadOnly)) fail("property '" + p.name() + "' is read-only");
+        // The memory budget first (nothing changed if it is exhausted): what the stored value grows by,
+        // and the record of the change.
+        switch (ps.kind) {
+          case PK::String:
+          case PK::Vector:
+          case PK::Value: {
+            const std::size_t now = value_bytes(p.type(), p.address(o));
+            const std::size_t next = ps.kind == PK::String   ? S[in.b].size()
+                                     : ps.kind == PK::Vector ? heap_bytes(vregs_[fr->base + in.b])
+                                                             : heap_bytes(xregs_[fr->base + in.b]);
+            grew(now, next);
+            charge_record(next);
+            break;
+          }
+          default:
+            charge_record(8);
+        }
         switch (ps.kind) {
           case PK::I64:
             p.set<std::int64_t>(o, R[in.b].i);
@@ -1029,9 +1172,12 @@ Val ProgramImpl::exec(std::size_t entry) {
         if (in.c == 0) {
           if (p.object_tokens()) fail("put(n) on a place of object tokens");
           if (R[in.b].i < 0) fail("put(" + std::to_string(R[in.b].i) + "): a negative number of tokens");
+          charge_record(8);
           put_token(p, nullptr, R[in.b].i);
         } else {
           if (!p.object_tokens()) fail("put(object) on a place of black tokens");
+          charge(sizeof(void*) * 2);  // an entry of the place's list
+          charge_record(8);
           put_token(p, &obj(R[in.b].id), 1);
         }
         VSD_REFRESH();
@@ -1040,6 +1186,7 @@ Val ProgramImpl::exec(std::size_t entry) {
       case OP_PCLEAR: {
         VSD_SAVE();
         Place& p = place_of(R[in.a].id);
+        charge_record(8 * static_cast<std::size_t>(p.object_tokens() ? p.objects().size() : 1));
         if (p.object_tokens())
           p.edit_objects().clear();
         else
@@ -1068,6 +1215,8 @@ Val ProgramImpl::exec(std::size_t entry) {
           const SimStateInstance* t = list.at(static_cast<std::size_t>(i));
           R[in.a].id = t != nullptr ? t->id() : 0;
         } else {
+          charge(sizeof(void*) * 2);  // the list's new entry
+          charge_record(8);
           o.list_insert(p, list.size(), obj(R[in.b].id));
           VSD_REFRESH();
         }
@@ -1145,7 +1294,9 @@ Val ProgramImpl::exec(std::size_t entry) {
           case RK::D:
             R[in.a].d = r.convert_to(meta_type<double>()).as<double>();
             break;
-          case RK::S:
+          case RK::S:  // a method's results are values in registers like any other (what it allocates
+                       // itself is its own)
+            string_room(S[in.a], r.as<std::string>().size());
             S[in.a] = r.as<std::string>();
             break;
           case RK::R: {
@@ -1155,12 +1306,20 @@ Val ProgramImpl::exec(std::size_t entry) {
             R[in.a].id = t != nullptr ? t->id() : 0;
             break;
           }
-          case RK::X:
-            xregs_[fr->base + in.a] = std::move(r);
+          case RK::X: {
+            Value& x = xregs_[fr->base + in.a];
+            const std::size_t before = heap_bytes(x);
+            x = std::move(r);
+            grew(before, heap_bytes(x));
             break;
-          case RK::V:
-            method_vector_result(m, r, vregs_[fr->base + in.a]);
+          }
+          case RK::V: {
+            VecReg& v = vregs_[fr->base + in.a];
+            const std::size_t before = heap_bytes(v);
+            method_vector_result(m, r, v);
+            grew(before, heap_bytes(v));
             break;
+          }
           default:
             break;
         }
@@ -1179,10 +1338,14 @@ Val ProgramImpl::exec(std::size_t entry) {
             a->d = std::ceil(a->d);
             break;
           case Builtin::Abs:
-            if (in.c != 0)
+            if (in.c != 0) {
               a->d = std::fabs(a->d);
-            else
-              a->i = a->i < 0 ? wrap_sub(0, a->i) : a->i;
+            } else if (a->i == std::numeric_limits<std::int64_t>::min()) {
+              VSD_SAVE();
+              int_overflow("abs", a->i);
+            } else {
+              a->i = a->i < 0 ? -a->i : a->i;
+            }
             break;
           case Builtin::Min:
             if (in.c != 0)
@@ -1286,10 +1449,14 @@ Val ProgramImpl::exec(std::size_t entry) {
         VSD_SAVE();
         value_op(in, *fr);
         break;
-      case OP_XOP:
+      case OP_XOP: {  // a struct (fixed size) into X, or its text into S
         VSD_SAVE();
+        const std::size_t before = heap_bytes(xregs_[fr->base + in.a]) + S[in.a].capacity();
         struct_op(in, *fr);
+        VSD_REFRESH();
+        grew(before, heap_bytes(xregs_[fr->base + in.a]) + S[in.a].capacity());
         break;
+      }
       default:
         VSD_SAVE();
         fail("bad instruction");
@@ -1298,6 +1465,7 @@ Val ProgramImpl::exec(std::size_t entry) {
 #undef VSD_SAVE
 #undef VSD_TARGET
 #undef VSD_REFRESH
+#undef VSD_CHECKED
 }
 
 }  // namespace vsd::soml

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -456,6 +457,125 @@ TEST(Explore, ReportsOfUnboundedAndIncompleteRuns) {
   EXPECT_NE(json2.str().find("\"status\": \"memory_limit\""), std::string::npos) << json2.str();
   EXPECT_NE(json2.str().find("\"bounded\": null"), std::string::npos);
   EXPECT_GE(an::default_memory_limit(), std::size_t{64} << 20);
+}
+
+// Resident memory from /proc/self/status (KiB -> bytes): "VmRSS" now, "VmHWM" the peak since the last
+// reset_peak_rss(). Empty where there is no such file, and in sanitizer builds (their shadow memory and
+// quarantine of freed blocks count as resident too).
+std::optional<std::size_t> resident(const std::string& key) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  (void)key;
+  return std::nullopt;
+#else
+  std::ifstream in("/proc/self/status");
+  std::string k;
+  std::size_t kib = 0;
+  std::string unit;
+  while (in >> k) {
+    if (k == key + ":" && in >> kib >> unit) return kib * 1024;
+    std::getline(in, unit);
+  }
+  return std::nullopt;
+#endif
+}
+bool reset_peak_rss() {
+  std::ofstream f("/proc/self/clear_refs");
+  f << "5";  // Linux: resets VmHWM to the current resident size
+  f.close();
+  return f.good() && resident("VmHWM").has_value();
+}
+
+TEST(Explore, TheMemoryLimitCoversEveryPhaseAndNothingGrowsPastIt) {
+  constexpr std::size_t kLimit = std::size_t{80} << 20;
+  constexpr std::size_t kSlack = std::size_t{8} << 20;  // the allocator's own bookkeeping and rounding
+  ExploreOptions o = quiet();
+  o.split_small_levels = false;
+  o.memory_limit = kLimit;
+  // 20,000 places and transitions: the place-bounds phase held dense rows, places x transitions (3.2 GB
+  // under a limit of 256 MiB); they are sparse now, and the whole run stays within the limit.
+  {
+    const PtNet ring = an::test::ring(20'000, 1);
+    const bool rss = reset_peak_rss();
+    const std::size_t before = resident("VmRSS").value_or(0);
+    const ExploreResult r = an::explore(ring, o);
+    EXPECT_TRUE(r.complete()) << r.message;
+    EXPECT_EQ(r.states, 20'000u);
+    EXPECT_EQ(r.edges, 20'000u);
+    EXPECT_EQ(r.bits_per_place, 1u);  // the bounds were found: one token in the ring
+    EXPECT_LE(r.peak_memory, kLimit);
+    if (rss) {
+      EXPECT_LE(*resident("VmHWM") - before, kLimit + kSlack);
+    }
+  }
+  // 200,000 places: a state takes 25 KB (200,000 bits); 200,000 places grew to 24 GB before. The run stops
+  // in the exploration, at the limit.
+  {
+    const PtNet ring = an::test::ring(200'000, 1);
+    const bool rss = reset_peak_rss();
+    const std::size_t before = resident("VmRSS").value_or(0);
+    const ExploreResult r = an::explore(ring, o);
+    EXPECT_EQ(r.status, ExploreResult::Status::memory_limit);
+    EXPECT_NE(r.message.find("memory limit of 80.0 MiB reached in the exploration after "), std::string::npos)
+        << r.message;
+    EXPECT_GT(r.states, 1000u);
+    EXPECT_LT(r.states, 200'000u);
+    EXPECT_LE(r.peak_memory, kLimit);
+    if (rss) {
+      EXPECT_LE(*resident("VmHWM") - before, kLimit + kSlack);
+    }
+    // A limit the compiled net alone passes: said before anything else is made.
+    o.memory_limit = std::size_t{1} << 20;
+    const ExploreResult tiny = an::explore(ring, o);
+    EXPECT_EQ(tiny.status, ExploreResult::Status::memory_limit);
+    EXPECT_NE(tiny.message.find("memory limit of 1.0 MiB reached while compiling the net (it needs at least "),
+              std::string::npos)
+        << tiny.message;
+    EXPECT_EQ(tiny.states, 0u);
+  }
+  // Workers each need two markings of the net: 1024 threads of 20,000 places pass 64 MiB before any state.
+  {
+    const PtNet ring = an::test::ring(20'000, 1);
+    o.memory_limit = std::size_t{64} << 20;
+    o.threads = 1024;
+    const ExploreResult r = an::explore(ring, o);
+    EXPECT_EQ(r.status, ExploreResult::Status::memory_limit);
+    EXPECT_NE(r.message.find("while preparing the exploration"), std::string::npos) << r.message;
+    EXPECT_EQ(r.threads, 1024u);
+  }
+}
+
+TEST(Explore, TransitionsSharingAPlaceNeedNoQuadraticTable) {
+  // n transitions take a mutex and n give it back. The transitions to test again after each firing,
+  // listed per transition, are 2n^2 entries (18 MB for n = 1500); past an eighth of the limit the list is
+  // not made and every transition is tested: the figures stay the same.
+  constexpr unsigned n = 1500;
+  PtNet net("mutex");
+  const auto m = net.add_place("m", {}, 1);
+  for (unsigned i = 0; i < n; ++i) {
+    const auto a = net.add_place("a" + std::to_string(i), {}, 1);
+    const auto b = net.add_place("b" + std::to_string(i));
+    const auto take = net.add_transition("take" + std::to_string(i));
+    net.add_input(take, a);
+    net.add_input(take, m);
+    net.add_output(take, b);
+    const auto give = net.add_transition("give" + std::to_string(i));
+    net.add_input(give, b);
+    net.add_output(give, a);
+    net.add_output(give, m);
+  }
+  for (const std::size_t limit : {std::size_t{16} << 20, std::size_t{0}}) {
+    SCOPED_TRACE(limit);
+    ExploreOptions o = quiet();
+    o.memory_limit = limit;
+    const ExploreResult r = an::explore(net, o);
+    EXPECT_TRUE(r.complete()) << r.message;
+    EXPECT_EQ(r.states, n + 1);
+    EXPECT_EQ(r.edges, 2u * n);
+    EXPECT_FALSE(r.deadlock);
+    if (limit != 0) {
+      EXPECT_LE(r.peak_memory, limit);
+    }
+  }
 }
 
 }  // namespace

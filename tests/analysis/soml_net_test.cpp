@@ -167,6 +167,29 @@ transition helper { do { fill(); } }
   EXPECT_NE(e.find("  transition go { when mark.ready; }\n"), std::string::npos) << e;
 }
 
+// Whether an action changes a marking through the functions it calls was found by recursing into each
+// callee: a chain of 100,000 functions overflowed the stack. The call graph is walked without recursion,
+// and a function that reaches a put through a cycle is found too.
+TEST(SomlNet, ACallChainOfAnyLengthIsFollowedWithoutRecursion) {
+  constexpr int kChain = 100'000;
+  std::string text = "place p = 1;\n";
+  for (int i = 0; i < kChain; ++i)
+    text += "void f" + std::to_string(i) + "() { f" + std::to_string(i + 1) + "(); }\n";
+  text += "void f" + std::to_string(kChain) + "() { p.put(1); }\ntransition t { do { f0(); } }\narrow p -> t;\n";
+  const std::string e = soml_net_error_of(text);
+  EXPECT_NE(e.find("s.soml:100003:21: error: the action of transition 't' changes a marking"), std::string::npos)
+      << e.substr(0, 400);
+  // g calls h before its own put, h calls g: both change a marking, whichever is asked about first.
+  const std::string cycle = soml_net_error_of(R"(place p = 1;
+void g() { h(); p.put(1); }
+void h() { g(); }
+transition a { do { h(); } }
+arrow p -> a;
+)");
+  EXPECT_NE(cycle.find("s.soml:4:21: error: the action of transition 'a' changes a marking"), std::string::npos)
+      << cycle;
+}
+
 TEST(SomlNet, NetsAndSubstitutionAndInvocationAreRefused) {
   const std::string e = soml_net_error_of(R"(net Relay(place in, place out) {
   transition pass;

@@ -311,7 +311,7 @@ int too_big() { vector<int32> ids; ids.push(5000000000); return arm.count(ids); 
   EXPECT_THAT(
       soml_test::error_of([&] { p.root().call("too_big", {}); }),
       HasSubstr("the value 5000000000 does not fit argument 1 of method 'count' (elements int32)\n  at "
-                "too_big (test.soml:13)"));
+                "too_big (test.soml:13:74)"));
 }
 
 TEST_F(EnumVectors, MistakesAreReportedWithTheirPosition) {

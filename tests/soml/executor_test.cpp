@@ -399,7 +399,7 @@ object client {
     FAIL() << "no error";
   } catch (const vsd::Error& e) {
     EXPECT_THAT(std::string(e.what()), HasSubstr("division by zero"));
-    EXPECT_THAT(std::string(e.what()), HasSubstr("at client.take (action) (net.soml:10)"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("at client.take (action) (net.soml:10:48)"));
   }
   // The first token that satisfies the arrow's condition was taken and is back in its position.
   const auto& outbox = p.place("outbox", server)->objects();
@@ -509,7 +509,7 @@ arrow t -> b;
     FAIL() << "no error";
   } catch (const vsd::Error& e) {
     EXPECT_THAT(std::string(e.what()), HasSubstr("division by zero"));
-    EXPECT_THAT(std::string(e.what()), HasSubstr("at t (action) (net.soml:5)"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("at t (action) (net.soml:5:31)"));
   }
   EXPECT_EQ(p.place("a")->tokens(), 1);
   EXPECT_EQ(p.place("b")->tokens(), 0);

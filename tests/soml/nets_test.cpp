@@ -484,7 +484,7 @@ arrow call -> done;
     FAIL() << "no error";
   } catch (const vsd::Error& e) {
     EXPECT_THAT(std::string(e.what()), HasSubstr("division by zero"));
-    EXPECT_THAT(std::string(e.what()), HasSubstr("at call (action) (net.soml:11)"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("at call (action) (net.soml:11:53)"));
   }
   // The instance is still there, not finished, its token back in its start place; nothing produced.
   ASSERT_EQ(invocations(p).size(), 1u);
@@ -512,7 +512,7 @@ arrow go -> call;
     FAIL() << "no error";
   } catch (const vsd::Error& e) {
     EXPECT_THAT(std::string(e.what()), HasSubstr("null reference"));
-    EXPECT_THAT(std::string(e.what()), HasSubstr("call (invocation arguments) (net.soml:5)"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("call (invocation arguments) (net.soml:5:37)"));
   }
   EXPECT_TRUE(invocations(p).empty());
   EXPECT_EQ(p.place("go")->tokens(), 1);

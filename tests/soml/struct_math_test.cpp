@@ -233,7 +233,7 @@ TEST_F(StructMath, MisuseIsAnErrorWithItsPosition) {
                     "turn.soml");
   EXPECT_THAT(
       soml_test::error_of([&] { p.root().call("turn", {Value(Vec3(0, 0, 0))}); }),
-      HasSubstr("Quaterniond::from_axis_angle: the axis is the zero vector\n  at turn (turn.soml:1)"));
+      HasSubstr("Quaterniond::from_axis_angle: the axis is the zero vector\n  at turn (turn.soml:1:70)"));
 }
 
 TEST_F(StructMath, StructsPrintAsTheyAreBuilt) {

@@ -161,19 +161,19 @@ void write_prop(int i) { ids[i] = 1; }
   EXPECT_EQ(root.call("outer", {vsd::Value(std::int64_t{0})}).as<std::int64_t>(), 3);
   std::string e = soml_test::error_of([&] { root.call("outer", {vsd::Value(std::int64_t{1})}); });
   EXPECT_THAT(e, HasSubstr("SOML++ run-time error: index 1 out of range (size 1)"));
-  EXPECT_THAT(e, HasSubstr("at at (test.soml:3)"));
-  EXPECT_THAT(e, HasSubstr("at outer (test.soml:8)"));
+  EXPECT_THAT(e, HasSubstr("at at (test.soml:3:11)"));
+  EXPECT_THAT(e, HasSubstr("at outer (test.soml:8:12)"));
   EXPECT_THAT(soml_test::error_of([&] { root.call("outer", {vsd::Value(std::int64_t{-1})}); }),
               HasSubstr("index -1 out of range (size 1)"));
   EXPECT_THAT(soml_test::error_of([&] { root.call("set_local", {vsd::Value(std::int64_t{1})}); }),
-              HasSubstr("index 1 out of range (size 1)\n  at set_local (test.soml:10)"));
+              HasSubstr("index 1 out of range (size 1)\n  at set_local (test.soml:10:57)"));
   EXPECT_THAT(soml_test::error_of([&] { root.call("read_prop", {vsd::Value(std::int64_t{0})}); }),
-              HasSubstr("index 0 out of range (size 0)\n  at read_prop (test.soml:11)"));
+              HasSubstr("index 0 out of range (size 0)\n  at read_prop (test.soml:11:34)"));
   int changes = 0;
   auto c = env.main_state().on_property_changed().connect(
       [&](vsd::SimStateInstance&, const vsd::MetaProperty&) { ++changes; });
   EXPECT_THAT(soml_test::error_of([&] { root.call("write_prop", {vsd::Value(std::int64_t{2})}); }),
-              HasSubstr("index 2 out of range (size 0)\n  at write_prop (test.soml:12)"));
+              HasSubstr("index 2 out of range (size 0)\n  at write_prop (test.soml:12:29)"));
   EXPECT_EQ(changes, 0) << "a failed element write changes nothing";
 }
 
@@ -184,7 +184,7 @@ void add(int v) { small.push(v); }
   p.root().call("add", {vsd::Value(std::int64_t{100})});
   EXPECT_THAT(soml_test::error_of([&] { p.root().call("add", {vsd::Value(std::int64_t{5000000000})}); }),
               HasSubstr("the value 5000000000 does not fit property 'small' (elements int32)\n"
-                        "  at add (test.soml:2)"));
+                        "  at add (test.soml:2:29)"));
   EXPECT_EQ(p.root().get<std::vector<std::int32_t>>("small"), (std::vector<std::int32_t>{100}));
 }
 

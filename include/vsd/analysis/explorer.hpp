@@ -22,8 +22,10 @@
  *    again forever. The exploration stops and reports the pair. Nets with structural bounds (above)
  *    skip this check. For nets with inhibitor arcs the test is sound but not complete (their boundedness
  *    is undecidable); the memory limit ends the rest.
- *  - Memory: the arena, hash set and frontier buffers are counted; exceeding the limit stops the run
- *    with Status::memory_limit and a message, instead of an out-of-memory kill.
+ *  - Memory: every phase (compiling the net, the place bounds, preparing the exploration, the
+ *    exploration itself) is held to the limit before it allocates: the place bounds give up rather than
+ *    pass it, the others stop the run with Status::memory_limit and a message that names the phase,
+ *    instead of an out-of-memory kill.
  */
 #pragma once
 
@@ -46,7 +48,8 @@ struct ExploreOptions {
   /// than the phased multi-threaded path on small state spaces; results are the same either way (tests
   /// set this to exercise the multi-threaded path on small nets).
   bool split_small_levels = false;
-  /// @brief Memory limit in bytes for the exploration's data; 0 = default_memory_limit().
+  /// @brief Memory limit in bytes for everything explore() makes (the compiled net, the place bounds,
+  /// the states, the hash set, the buffers, the result); 0 = default_memory_limit().
   std::size_t memory_limit = 0;
   /// @brief When the progress line (states, edges, level, states/s, memory) is written to stderr.
   enum class Progress { automatic, always, never };
@@ -79,7 +82,9 @@ struct ExploreResult {
   std::vector<std::uint32_t> unbounded_covering;  ///< The marking M' > M.
   std::uint32_t levels = 0;                       ///< Breadth-first levels (the longest shortest path + 1).
   unsigned bits_per_place = 0;                    ///< The marking encoding the run ended with.
-  std::size_t peak_memory = 0;                    ///< Peak bytes of the exploration's own data.
+  /// @brief The most bytes held or asked for at once: within the limit, unless the compiled net alone
+  /// passes it.
+  std::size_t peak_memory = 0;
   std::size_t memory_limit = 0;                   ///< The limit that applied.
   double seconds = 0;                             ///< Wall time of the exploration.
   unsigned threads = 1;                           ///< Threads used.

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <filesystem>
+#include <iosfwd>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -38,8 +39,13 @@ struct PnmlImport {
 /// single place/transition net, or inconsistent (duplicate ids, arcs to unknown nodes, bad numbers).
 PnmlImport read_pnml(std::string_view text, std::string_view source = "<pnml>");
 
-/// @brief Reads a PNML file (read_pnml() with the file name as source).
-/// @throws vsd::Error when the file cannot be read or its content is refused.
+/// @brief Reads PNML from @p in to its end (standard input, a pipe), then read_pnml().
+/// @throws vsd::Error "<source>: read error", or as read_pnml().
+PnmlImport read_pnml(std::istream& in, std::string_view source);
+
+/// @brief Reads a PNML file (read_pnml() with the file name as source); a named pipe is read like a file.
+/// @throws vsd::Error when the file cannot be read ("<path>: is a directory, not a file", "<path>: cannot
+/// open the file for reading (<reason>)") or its content is refused.
 PnmlImport read_pnml_file(const std::filesystem::path& path);
 
 /// @brief Writes @p net as a PNML place/transition net (one page). Arcs without an id get a fresh one;

@@ -129,6 +129,9 @@ class PtNet {
   // Id -> index, so that building a net of n nodes is O(n).
   std::unordered_map<std::string, std::uint32_t> place_index_;
   std::unordered_map<std::string, std::uint32_t> transition_index_;
+  // (transition << 32 | place) -> index of the arc in the transition's inputs, outputs, inhibitors, so
+  // that merging a parallel arc is O(1) and building a transition of n arcs O(n).
+  std::unordered_map<std::uint64_t, std::uint32_t> input_slot_, output_slot_, inhibitor_slot_;
 };
 
 }  // namespace vsd::analysis

@@ -26,6 +26,7 @@
 #pragma once
 
 #include <filesystem>
+#include <iosfwd>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -54,7 +55,12 @@ struct SomlNetImport {
 
 /// @brief Checks SOML++ @p text (shown as @p source in messages) and converts it (net_from_soml()).
 [[nodiscard]] SomlNetImport read_soml_net(std::string_view text, std::string_view source = "<soml>");
-/// @brief read_soml_net() on a file. @throws vsd::Error when it cannot be read, or as read_soml_net().
+/// @brief read_soml_net() on the text of @p in up to its end (standard input, a pipe).
+/// @throws vsd::Error "<source>: read error", or as read_soml_net().
+[[nodiscard]] SomlNetImport read_soml_net(std::istream& in, std::string_view source);
+/// @brief read_soml_net() on a file (a named pipe too).
+/// @throws vsd::Error when it cannot be read ("<path>: is a directory, not a file", ...), or as
+/// read_soml_net().
 [[nodiscard]] SomlNetImport read_soml_net_file(const std::filesystem::path& path);
 
 /// @brief Writes @p net as a SOML++ script (see the file comment).

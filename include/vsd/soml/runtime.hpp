@@ -38,6 +38,10 @@ namespace vsd::soml {
 /// @brief Limits and settings of a loaded program.
 struct RunOptions {
   std::uint64_t instruction_budget = 50'000'000;  ///< per call from outside (a call, a test, a firing)
+  /// @brief Bytes of memory the code may take per call from outside (docs/soml.md 8.2): string, vector
+  /// and value registers that grow, values stored in properties, instances created, references appended,
+  /// and the records of changes under a savepoint.
+  std::uint64_t memory_budget = std::uint64_t{256} << 20;
   int max_depth = 256;                            ///< nested SOML++ calls
   std::uint64_t seed = 1;                         ///< the choice among enabled transitions
   std::ostream* out = nullptr;                    ///< where print() writes (std::cout when null)
