@@ -1246,6 +1246,7 @@ struct Simulation::Impl {
   void advance(double seconds) {
     if (!(seconds >= 0.0) || !std::isfinite(seconds))
       detail_throw("advance: seconds must be finite and >= 0, got " + std::to_string(seconds));
+    sync();
     // Each world's step count, checked before anything moves: an absurd interval (1e6 s at the default
     // step would be 1e9 ODE steps, and beyond 2^64 steps the count would not even fit) is an error.
     for (auto& [k, w] : worlds) {
@@ -1258,7 +1259,6 @@ struct Simulation::Impl {
         detail_throw(msg.str());
       }
     }
-    sync();
     // Force accumulators: checked before anything moves.
     std::vector<BodyRec*> forced;
     for (BodyRec* b : order) {
