@@ -425,6 +425,28 @@ TEST_F(SimulationTest, TooManyContactPointsInOneStepAreAnError) {
   EXPECT_GT(sim().stats().contacts, 0u);
 }
 
+// The example model with primitive hulls (tests/scene/data/iiwa14_primitives.urdf): its inertials are the
+// original's, its hulls collide. Unpowered, the arm falls from upright onto its floor plate and comes to
+// rest on it — neither through it nor (as without hulls) through itself.
+TEST_F(SimulationTest, ThePrimitiveIiwaFallsOntoItsFloorAndRests) {
+  auto r = scene::load_urdf(s.database(), std::string(VSD_SCENE_TEST_DATA_DIR) + "/iiwa14_primitives.urdf");
+  EXPECT_TRUE(r.warnings.empty());
+  EXPECT_EQ(make_dynamic(*r.scene), 8u);
+  env.run_for(3.0);
+  EXPECT_EQ(sim().stats().geoms, 11u);
+  double lowest = 1e9;
+  for (const scene::Link* l : r.scene->links()) {
+    const RigidBody* b = l->find_extension<RigidBody>();
+    if (b == nullptr) continue;
+    EXPECT_LT(b->linear_velocity().norm(), 0.05) << l->name();
+    if (l->name() != "iiwa_link_0") lowest = std::min(lowest, l->world_frame().translation().z());
+  }
+  const double tip = r.scene->find_link("iiwa_link_7")->world_frame().translation().z();
+  EXPECT_LT(tip, 0.15);  // it lies down (1.27 m when upright)
+  EXPECT_GT(lowest, 0.02);  // every moving link's origin above the floor (the thinnest hull is 9 cm across)
+  EXPECT_GT(sim().stats().contacts, 0u);
+}
+
 TEST_F(SimulationTest, JointsWithLimitsAndMotors) {
   world->set_gravity(Eigen::Vector3d::Zero());
   auto& g = geometry(GeometryKind::Box, Eigen::Vector3d(1, 0.1, 0.1));

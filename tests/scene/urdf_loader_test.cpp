@@ -420,9 +420,28 @@ TEST_F(UrdfTest, ValuesAreValidated) {
   EXPECT_TRUE(any_contains(r.warnings, "joint 'j' <dynamics> damping: -2 is negative"));
 }
 
+// The example model with primitive hulls loads without a single warning: 8 links with the original's
+// inertials, 22 hulls (visual and collision alike), no mesh.
+TEST_F(UrdfTest, ThePrimitiveIiwaIsCompleteWithoutMeshes) {
+  const SceneReport r = load_urdf(s.database(), data_dir / "iiwa14_primitives.urdf");
+  EXPECT_TRUE(r.warnings.empty()) << r.warnings[0];
+  EXPECT_EQ(r.links, 11u);
+  EXPECT_EQ(r.joints, 10u);
+  EXPECT_EQ(r.hulls, 22u);
+  EXPECT_EQ(r.meshes_loaded, 0u);
+  const SceneReport original = load_urdf(s.database(), data_dir / "iiwa14.urdf");
+  for (const Link* l : original.scene->links()) {
+    const Link* p = r.scene->find_link(l->name());
+    ASSERT_NE(p, nullptr) << l->name();
+    EXPECT_EQ(p->mass(), l->mass()) << l->name();
+    EXPECT_TRUE(p->inertia().isApprox(l->inertia())) << l->name();
+    EXPECT_TRUE(p->world_frame().isApprox(l->world_frame())) << l->name();
+  }
+}
+
 // The shipped descriptions load without a validation message.
 TEST_F(UrdfTest, ShippedDescriptionsAreValid) {
-  for (const char* name : {"iiwa14.urdf", "ur5_robot.urdf"}) {
+  for (const char* name : {"iiwa14.urdf", "ur5_robot.urdf", "iiwa14_primitives.urdf"}) {
     UrdfOptions o;
     o.load_meshes = false;
     const SceneReport r = load_urdf(s.database(), data_dir / name, o);
