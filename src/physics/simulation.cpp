@@ -277,10 +277,14 @@ struct Simulation::Impl {
           meshes.erase(i.as<scene::Geometry>());
           dirty = true;
         }));
-    // Density decides derived masses; friction and restitution are read at contact time.
+    // Density decides derived masses; friction and restitution are read at contact time, but checked
+    // by the plan.
     connections.push_back(state->on_property_changed(scene::Material::static_meta(), true)
                               .connect([this](SimStateInstance&, const MetaProperty& p) {
-                                if (&p == &scene::Material::vsd_prop_density()) dirty = true;
+                                if (&p == &scene::Material::vsd_prop_density() ||
+                                    &p == &scene::Material::vsd_prop_friction() ||
+                                    &p == &scene::Material::vsd_prop_restitution())
+                                  dirty = true;
                               }));
   }
 
@@ -520,6 +524,19 @@ struct Simulation::Impl {
     return r;
   }
 
+  // Friction and restitution are read inside near_callback, where nothing can be refused: they are
+  // checked here, when the hull enters the plan (they used to be clamped silently).
+  static void check_material(const Hull& h) {
+    const scene::Material* m = h.material().get();
+    if (m == nullptr) return;
+    if (!(m->friction() >= 0.0) || !std::isfinite(m->friction()))
+      detail_throw("collision hull " + describe(h) + ": material friction must be finite and >= 0, got " +
+                   std::to_string(m->friction()));
+    if (!(m->restitution() >= 0.0 && m->restitution() <= 1.0))
+      detail_throw("collision hull " + describe(h) + ": material restitution must lie in [0, 1], got " +
+                   std::to_string(m->restitution()));
+  }
+
   static double density_of(const Hull& h) {
     const scene::Material* m = h.material().get();
     const double d = m != nullptr ? m->density() : 1000.0;
@@ -694,6 +711,7 @@ struct Simulation::Impl {
             planned_joints.insert(j);
           }
         if (auto* h = it.node->as<Hull>(); h != nullptr && h->role() == scene::HullRole::Collision) {
+          check_material(*h);
           Shape shape;
           if (shape_of(*h, body != npos, shape)) {
             if (body != npos) plan.bodies[body].geoms.push_back(plan.geoms.size());

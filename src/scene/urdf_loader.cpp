@@ -12,6 +12,7 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <new>
 #include <set>
 #include <sstream>
 #include <unordered_map>
@@ -39,14 +40,19 @@ class CollectingHandler : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char* /*filename*/,
            int /*line*/) override {
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
-      messages.push_back(text);
-    } else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN) {
-      warnings.push_back(text);
+    try {
+      if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
+        messages.push_back(text);
+      } else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN) {
+        warnings.push_back(text);
+      }
+    } catch (...) {  // nothing may leave a logging call inside urdfdom; an error is still an error
+      failed = true;
     }
   }
   std::vector<std::string> messages;
   std::vector<std::string> warnings;
+  bool failed = false;  // a message could not be kept (out of memory)
 };
 
 // urdfdom logs some errors and still returns a model (a mass of "heavy" becomes an inertial of 0 kg): any
@@ -57,16 +63,23 @@ urdf::ModelInterfaceSharedPtr parse(const std::string& xml, std::string_view ori
   urdf::ModelInterfaceSharedPtr model;
   {
     std::lock_guard lock(console_mutex);
-    console_bridge::useOutputHandler(&handler);
+    // Restored however parseURDF ends: the handler lives on this stack frame.
+    struct Install {
+      explicit Install(console_bridge::OutputHandler* h) { console_bridge::useOutputHandler(h); }
+      ~Install() { console_bridge::restorePreviousOutputHandler(); }
+      Install(const Install&) = delete;
+      Install& operator=(const Install&) = delete;
+    } install(&handler);
     try {
       model = urdf::parseURDF(xml);
+    } catch (const std::bad_alloc&) {
+      vsd::detail::throw_error(std::string(origin) + ": out of memory parsing the URDF");
     } catch (const std::exception& e) {  // urdfdom throws on some malformed numbers
       handler.messages.emplace_back(e.what());
     }
-    console_bridge::restorePreviousOutputHandler();
   }
   for (const auto& w : handler.warnings) warnings.push_back("urdfdom: " + w);
-  if (!model || !handler.messages.empty()) {
+  if (!model || !handler.messages.empty() || handler.failed) {
     std::string msg = std::string(origin) + ": not a valid URDF";
     for (const auto& m : handler.messages) msg += "\n  " + m;
     vsd::detail::throw_error(msg);

@@ -49,6 +49,24 @@ TEST_F(ContactTest, JointedBodiesDoNotCollide) {
   EXPECT_GT(sim().stats().contacts, 0u);
 }
 
+// Friction and restitution are used inside ODE's collision callback, where nothing can be refused: a
+// material outside their ranges is an error naming the hull when the hull enters the simulation (it was
+// clamped silently).
+TEST_F(ContactTest, MaterialValuesOutsideTheirRangesAreErrors) {
+  pair(geometry(GeometryKind::Box, Eigen::Vector3d(1, 1, 1)), Eigen::Vector3d(2, 0, 0), 0.0);
+  scene::Material& m = material(-0.3, 0.5);
+  second->set_material(&m);
+  EXPECT_THAT([&] { env.step(); },
+              ::testing::ThrowsMessage<vsd::Error>(::testing::HasSubstr("material friction must be finite and >= 0")));
+  m.set_friction(0.3);
+  m.set_restitution(1.5);
+  EXPECT_THAT([&] { env.step(); },
+              ::testing::ThrowsMessage<vsd::Error>(::testing::HasSubstr("restitution must lie in [0, 1], got 1.5")));
+  m.set_restitution(0.5);
+  env.step();
+  EXPECT_GT(sim().stats().steps, 0u);
+}
+
 TEST_F(ContactTest, DeepBoxBoxPenetrationIsResolvedWithoutACrash) {
   // Almost fully inside each other (centres 1 cm apart), rotated: a degenerate case for box/box.
   pair(geometry(GeometryKind::Box, Eigen::Vector3d(1, 1, 1)), Eigen::Vector3d(0.01, 0, 0), 0.3);
