@@ -126,9 +126,11 @@ MeshReport load_mesh(Geometry& geometry, const fs::path& path, const MeshOptions
       break;
   }
   const std::string bytes = detail::read_input(file, options.max_file_bytes, "mesh file");
-  if (ext == ".dae")
+  if (ext == ".dae") {
     detail::check_xml_shape(bytes, file.string(), "COLLADA mesh",
                             {max_mesh_xml_depth, max_mesh_xml_elements, options.max_file_bytes});
+    detail::check_collada_instances(bytes, file.string(), max_mesh_collada_nodes, max_mesh_collada_values);
+  }
 
   Assimp::Importer importer;
   auto* io = new ConfinedIOSystem(confinement, options.max_file_bytes, file.string(), bytes);

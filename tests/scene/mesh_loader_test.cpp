@@ -139,6 +139,49 @@ TEST_F(MeshLoaderTest, DeeplyNestedColladaIsRefusedBeforeAssimp) {
   EXPECT_EQ(g.facet_count(), 4u);
 }
 
+// assimp follows <instance_node> by recursion and copies what it instances: a node that instances itself
+// crashed it (SIGSEGV), and 40 nodes each instancing the one before twice (2^40 copies) never ended. Both
+// are refused before assimp sees them; instancing within bounds loads.
+TEST_F(MeshLoaderTest, ColladaInstancingIsBoundedBeforeAssimp) {
+  TempDir dir;
+  auto with_nodes = [&](const std::string& library, const std::string& in_scene) {
+    std::string dae = collada_tetrahedron;
+    dae.insert(dae.find("<library_visual_scenes>"), "<library_nodes>" + library + "</library_nodes>\n");
+    const std::string old_node = "<node id=\"n\"><translate>10 0 0</translate><instance_geometry url=\"#tet\"/></node>";
+    dae.replace(dae.find(old_node), old_node.size(), "<node id=\"n\">" + in_scene + "</node>");
+    return dae;
+  };
+  Geometry& g = s.create<Geometry>();
+  write(dir.path() / "self.dae",
+        with_nodes("<node id=\"a\"><instance_geometry url=\"#tet\"/><instance_node url=\"#a\"/></node>",
+                   "<instance_node url=\"#a\"/>"));
+  std::string what = error_of(g, dir.path() / "self.dae");
+  EXPECT_NE(what.find("self.dae:"), std::string::npos) << what;
+  EXPECT_NE(what.find("node 'a' contains itself through <instance_node> references"), std::string::npos) << what;
+  // A ring through nested nodes: b holds c, c instances b.
+  write(dir.path() / "ring.dae",
+        with_nodes("<node id=\"b\"><node id=\"c\"><instance_node url=\"#b\"/></node></node>",
+                   "<instance_node url=\"#b\"/>"));
+  what = error_of(g, dir.path() / "ring.dae");
+  EXPECT_NE(what.find("node 'b' contains itself"), std::string::npos) << what;
+  std::string doubling = "<node id=\"d0\"><instance_geometry url=\"#tet\"/></node>";
+  for (int k = 1; k <= 40; ++k)
+    doubling += "<node id=\"d" + std::to_string(k) + "\"><instance_node url=\"#d" + std::to_string(k - 1) +
+                "\"/><instance_node url=\"#d" + std::to_string(k - 1) + "\"/></node>";
+  write(dir.path() / "doubling.dae", with_nodes(doubling, "<instance_node url=\"#d40\"/>"));
+  what = error_of(g, dir.path() / "doubling.dae");
+  EXPECT_NE(what.find("its scene expands to 2199023255552 nodes"), std::string::npos) << what;
+  EXPECT_FALSE(g.has_mesh_data());
+  // Four levels of doubling: 16 tetrahedra at one place, joined into one.
+  std::string small = "<node id=\"d0\"><instance_geometry url=\"#tet\"/></node>";
+  for (int k = 1; k <= 4; ++k)
+    small += "<node id=\"d" + std::to_string(k) + "\"><instance_node url=\"#d" + std::to_string(k - 1) +
+             "\"/><instance_node url=\"#d" + std::to_string(k - 1) + "\"/></node>";
+  write(dir.path() / "small.dae", with_nodes(small, "<instance_node url=\"#d4\"/>"));
+  (void)load_mesh(g, dir.path() / "small.dae");
+  EXPECT_EQ(g.facet_count(), 64u);
+}
+
 TEST_F(MeshLoaderTest, OnlyStlObjColladaAndPlyAreRead) {
   TempDir dir;
   write(dir.path() / "cube.3ds", binary_stl());

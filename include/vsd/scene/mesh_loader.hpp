@@ -5,9 +5,12 @@
  *  the four above (by extension; assimp's other importers are not exposed), the file must be a regular
  *  file no larger than MeshOptions::max_file_bytes, a COLLADA file (XML) may nest elements at most
  *  max_mesh_xml_depth deep and hold at most max_mesh_xml_elements elements (assimp's XML reader recurses
- *  per level: 100,000 levels crash it), and every further file the format pulls in (an OBJ's `mtllib`)
- *  goes through the same rules and must lie in MeshOptions::allowed_roots. A file refused there is not
- *  read; the mesh loads without it and the report says so.
+ *  per level: 100,000 levels crash it), its nodes must not instance themselves and its scene must expand
+ *  to at most max_mesh_collada_nodes nodes and max_mesh_collada_values geometry values (assimp follows
+ *  <instance_node> by recursion: a cycle crashes it, a chain of doublings never ends), and every further
+ *  file the format pulls in (an OBJ's `mtllib`) goes through the same rules and must lie in
+ *  MeshOptions::allowed_roots. A file refused there is not read; the mesh loads without it and the report
+ *  says so.
  */
 #pragma once
 
@@ -27,6 +30,11 @@ inline constexpr std::uintmax_t default_max_mesh_bytes = std::uintmax_t{128} << 
 inline constexpr std::size_t max_mesh_xml_depth = 1000;
 /// Element limit of a COLLADA (XML) mesh file.
 inline constexpr std::size_t max_mesh_xml_elements = 4'000'000;
+/// Nodes a COLLADA scene may hold once every <instance_node> is expanded.
+inline constexpr std::size_t max_mesh_collada_nodes = 100'000;
+/// Geometry values (the counts of the <float_array>s of every geometry instance) a COLLADA scene may hold
+/// once every instance is expanded.
+inline constexpr std::size_t max_mesh_collada_values = 30'000'000;
 
 /// @brief How to read a mesh file.
 struct MeshOptions {
