@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <new>
 #include <iterator>
 #include <set>
 #include <sstream>
@@ -138,6 +139,7 @@ struct Entry {
   Id geometry = 0;  // the Geometry whose shape the object uses (0: none)
   std::unique_ptr<fcl::CollisionObjectd> object;
   bool in_manager = false;
+  bool pending = false;  // waiting in Impl::to_register for the broadphase
   bool plane = false;
   std::uint64_t stamp = 0;  // last sync that updated this entry's pose
   std::string problem;      // non-empty: left out of the broadphase
@@ -159,6 +161,8 @@ struct CollisionWorld::Impl {
   fcl::DynamicAABBTreeCollisionManagerd manager;
   std::unordered_map<const Hull*, std::unique_ptr<Entry>> entries;
   std::vector<Entry*> planes;                 // half-spaces: queried against the tree, not in it
+  // Hulls whose objects join the broadphase at the end of the current sync (see register_pending()).
+  std::vector<const Hull*> to_register;
   std::unordered_map<Id, ShapeEntry> shapes;  // by Geometry id, shared by the hulls using it
   std::unordered_set<const Entry*> troubled;  // entries with a problem (left out)
   std::vector<std::string> warnings;          // each once
@@ -211,6 +215,7 @@ struct CollisionWorld::Impl {
   void leave_manager(Entry& e) {
     if (e.in_manager) manager.unregisterObject(e.object.get());
     e.in_manager = false;
+    e.pending = false;
     if (e.plane) std::erase(planes, &e);
     e.plane = false;
   }
@@ -276,8 +281,36 @@ struct CollisionWorld::Impl {
       e->plane = true;
       planes.push_back(e);
     } else {
-      manager.registerObject(e->object.get());
-      e->in_manager = true;
+      e->pending = true;
+      to_register.push_back(&h);
+    }
+  }
+
+  // Brings the objects refreshed in this sync into the broadphase. FCL inserts one object by descending
+  // its tree towards the most similar box; among many equal boxes (hulls spawned at one spot) that walk
+  // is as long as the tree, and 20,000 of them took 20 s. So a batch at least half the size of the tree
+  // rebuilds it in one go, top down by medians (balanced whatever the boxes, n log n); a small batch is
+  // inserted.
+  void register_pending() {
+    if (to_register.empty()) return;
+    std::vector<fcl::CollisionObjectd*> batch;
+    for (const Hull* h : to_register) {
+      auto it = entries.find(h);
+      if (it == entries.end() || !it->second->pending) continue;  // removed or refreshed away since
+      Entry& e = *it->second;
+      e.pending = false;
+      e.in_manager = true;
+      batch.push_back(e.object.get());
+    }
+    to_register.clear();
+    if (batch.size() * 2 >= manager.size()) {
+      std::vector<fcl::CollisionObjectd*> all;
+      manager.getObjects(all);
+      all.insert(all.end(), batch.begin(), batch.end());
+      manager.clear();
+      manager.registerObjects(all);
+    } else {
+      for (fcl::CollisionObjectd* o : batch) manager.registerObject(o);
     }
   }
 
@@ -418,6 +451,7 @@ struct CollisionWorld::Impl {
       }
       if (!updated.empty()) manager.update(updated);
     }
+    register_pending();
   }
 
   // -- narrow phase -----------------------------------------------------------------------------------
@@ -427,9 +461,14 @@ struct CollisionWorld::Impl {
     Id a, b;
     Contact contact;
   };
+  // What a broadphase query collects. FCL calls collide_callback from its own frames, which must not be
+  // left by an exception: a failure (or too many contacts) is kept here, the callback tells FCL to stop,
+  // and update() acts on it once FCL has returned.
   struct CollideData {
     Impl* self;
     std::vector<std::string>* errors;
+    std::exception_ptr failure;
+    bool too_many = false;
   };
   fcl::CollisionRequestd request{4, true};
   std::vector<Found> found;  // reused by update()
@@ -467,10 +506,35 @@ struct CollisionWorld::Impl {
     }
   }
 
-  static bool collide_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
+  static bool collide_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) noexcept {
     auto* d = static_cast<CollideData*>(data);
-    d->self->collide_pair(o1, o2, *d->errors);
-    return false;  // go on
+    if (d->failure || d->too_many) return true;
+    try {
+      d->self->collide_pair(o1, o2, *d->errors);
+      d->too_many = d->self->found.size() > d->self->options.max_contacts;
+    } catch (...) {
+      d->failure = std::current_exception();
+    }
+    return d->failure || d->too_many;  // true: FCL stops the query
+  }
+
+  // After a query: a failure or too many contacts end update() here, before anything it keeps changes.
+  void check_query(CollideData& data) {
+    if (data.failure) {
+      found.clear();
+      try {
+        std::rethrow_exception(data.failure);
+      } catch (const std::bad_alloc&) {
+        throw Error("collision: out of memory computing contacts; contacts and pairs are those of the "
+                    "previous update");
+      }
+    }
+    if (data.too_many) {
+      found.clear();
+      throw Error("collision: more than " + std::to_string(options.max_contacts) +
+                  " contact points in one update (Options::max_contacts; hulls overlapping en masse?); "
+                  "contacts and pairs are those of the previous update");
+    }
   }
 
   void update() {
@@ -478,13 +542,15 @@ struct CollisionWorld::Impl {
     request.num_max_contacts = options.max_contacts_per_pair;
     found.clear();
     std::vector<std::string> errors;
-    CollideData data{this, &errors};
+    CollideData data{this, &errors, nullptr, false};
     manager.collide(&data, &collide_callback);
+    check_query(data);
     for (std::size_t i = 0; i < planes.size(); ++i) {
       manager.collide(planes[i]->object.get(), &data, &collide_callback);
+      check_query(data);
       // Half-space against half-space: FCL computes it, and two ground planes may well be meant to touch.
       for (std::size_t j = i + 1; j < planes.size(); ++j)
-        collide_pair(planes[i]->object.get(), planes[j]->object.get(), errors);
+        if (collide_callback(planes[i]->object.get(), planes[j]->object.get(), &data)) check_query(data);
     }
     std::stable_sort(found.begin(), found.end(),
                      [](const Found& x, const Found& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
@@ -555,6 +621,7 @@ CollisionWorld::CollisionWorld(SimState& state, Options options)
   m.watch();
   state.index().for_each(Hull::static_meta(), true,
                          [&](SimStateInstance& i) { m.refresh(static_cast<Hull&>(i)); });
+  m.register_pending();
   m.manager.setup();
 }
 

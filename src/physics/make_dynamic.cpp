@@ -1,4 +1,5 @@
 // make_dynamic(): a loaded URDF scene becomes rigid bodies and dynamic joints.
+#include <cmath>
 #include <string>
 
 #include "vsd/core/error.hpp"
@@ -20,11 +21,18 @@ bool below_world(const vsd::Node& n) {
 
 std::size_t make_dynamic(scene::Scene& scene, bool fix_base) {
   vsd::SimState& state = scene.state();
-  // Check every joint first, so that an unsupported one changes nothing.
+  // Check every joint and link first, so that an unsupported one changes nothing.
   for (scene::Joint* j : scene.joints())
     if (j->type() == scene::JointType::Planar || j->type() == scene::JointType::Unknown)
       throw vsd::Error("vsd::physics: joint '" + j->name() + "' of scene '" + scene.name() +
                        "' is planar or of unknown type, which ODE cannot simulate between two bodies");
+  // A negative mass is not "no body": silently leaving such a link out would move it with its parent
+  // as if it were a massless frame.
+  for (scene::Link* l : scene.links())
+    if (l->mass() < 0.0 || !std::isfinite(l->mass()))
+      throw vsd::Error("vsd::physics: link '" + l->name() + "' of scene '" + scene.name() + "' has a mass of " +
+                       std::to_string(l->mass()) + " kg; a link is a body with a positive mass or a massless "
+                       "frame with mass 0");
   std::size_t made = 0;
   for (scene::Link* l : scene.links()) {
     if (!(l->mass() > 0.0) || l->find_extension<RigidBody>() != nullptr) continue;

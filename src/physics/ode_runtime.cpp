@@ -31,12 +31,17 @@ std::string format(int num, const char* msg, va_list ap) {
 [[noreturn]] void on_debug(int num, const char* msg, va_list ap) {
   throw vsd::Error("ODE internal check failed: " + format(num, msg, ap));
 }
-void on_message(int num, const char* msg, va_list ap) {
-  std::string text = format(num, msg, ap);
-  if (message_sink != nullptr) {
-    message_sink->push_back(std::move(text));
-  } else if (orphan_messages.size() < 100) {
-    orphan_messages.push_back(std::move(text));
+// Called from inside ODE, which returns to its own frames: nothing may be thrown from here (a message
+// that cannot be kept for want of memory is dropped).
+void on_message(int num, const char* msg, va_list ap) noexcept {
+  try {
+    std::string text = format(num, msg, ap);
+    if (message_sink != nullptr) {
+      message_sink->push_back(std::move(text));
+    } else if (orphan_messages.size() < 100) {
+      orphan_messages.push_back(std::move(text));
+    }
+  } catch (...) {
   }
 }
 

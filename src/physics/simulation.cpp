@@ -6,6 +6,9 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <functional>
+#include <new>
 #include <limits>
 #include <memory>
 #include <set>
@@ -186,6 +189,20 @@ struct WorldPlan {
 };
 constexpr std::size_t npos = static_cast<std::size_t>(-1);
 
+// Two ODE bodies, in address order.
+struct BodyPair {
+  dBodyID a;
+  dBodyID b;
+  BodyPair(dBodyID x, dBodyID y) : a(std::less<>{}(x, y) ? x : y), b(std::less<>{}(x, y) ? y : x) {}
+  bool operator==(const BodyPair&) const = default;
+};
+struct BodyPairHash {
+  std::size_t operator()(const BodyPair& p) const noexcept {
+    const std::size_t h = std::hash<const void*>{}(p.a);
+    return h ^ (std::hash<const void*>{}(p.b) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2));
+  }
+};
+
 }  // namespace
 
 // =====================================================================================================
@@ -210,6 +227,10 @@ struct Simulation::Impl {
   std::vector<std::string> warnings;
   std::set<std::string> warned;
   std::vector<dContact> contact_buffer;
+  // Pairs of bodies joined by one of our joints (how many joints), so that near_callback skips them in
+  // O(1): ODE's dAreConnectedExcluding walks a body's joints, contact joints of the step included, which
+  // made a heap of touching bodies quadratic.
+  std::unordered_map<BodyPair, int, BodyPairHash> joined;
   SimulationStats stats;
 
   // What the mirror depends on. An at-once Watch whose callback only takes notes (layout dirty; node
@@ -250,8 +271,11 @@ struct Simulation::Impl {
         .all_properties(World::static_meta())
         .properties(Joint::static_meta(), joint_props)
         .all_properties(scene::Geometry::static_meta())
-        // Density decides derived masses; friction and restitution are read at contact time.
-        .properties(scene::Material::static_meta(), {&scene::Material::vsd_prop_density()});
+        // Density decides derived masses; friction and restitution are read at contact time, but checked
+        // by the plan.
+        .properties(scene::Material::static_meta(), {&scene::Material::vsd_prop_density(),
+                                                     &scene::Material::vsd_prop_friction(),
+                                                     &scene::Material::vsd_prop_restitution()});
   }
 
   void heard(SimStateInstance& inst, const MetaProperty* p, Changes what) {
@@ -317,6 +341,9 @@ struct Simulation::Impl {
 
   // ---- destroying ODE objects ----
   void drop_joint(JointRec& j) {
+    if (j.sig.other != nullptr)
+      if (auto it = joined.find({j.sig.owner->body, j.sig.other->body}); it != joined.end() && --it->second == 0)
+        joined.erase(it);
     if (!j.world->poisoned) dJointDestroy(j.joint);
     joints.erase(j.ext);
   }
@@ -508,6 +535,19 @@ struct Simulation::Impl {
     return r;
   }
 
+  // Friction and restitution are read inside near_callback, where nothing can be refused: they are
+  // checked here, when the hull enters the plan (they used to be clamped silently).
+  static void check_material(const Hull& h) {
+    const scene::Material* m = h.material().get();
+    if (m == nullptr) return;
+    if (!(m->friction() >= 0.0) || !std::isfinite(m->friction()))
+      detail_throw("collision hull " + describe(h) + ": material friction must be finite and >= 0, got " +
+                   std::to_string(m->friction()));
+    if (!(m->restitution() >= 0.0 && m->restitution() <= 1.0))
+      detail_throw("collision hull " + describe(h) + ": material restitution must lie in [0, 1], got " +
+                   std::to_string(m->restitution()));
+  }
+
   static double density_of(const Hull& h) {
     const scene::Material* m = h.material().get();
     const double d = m != nullptr ? m->density() : 1000.0;
@@ -527,6 +567,7 @@ struct Simulation::Impl {
     if (!finite(rb.center_of_mass()) || !finite(rb.inertia_diagonal()) || !finite(rb.inertia_products()))
       bad("centre of mass and inertia must be finite");
     MassProperties mp;
+    const auto* link = b.node->as<scene::Link>();
     if (!rb.inertia_diagonal().isZero(0.0)) {
       if (!(rb.mass() > 0.0)) bad("an explicit inertia needs an explicit mass > 0");
       mp.mass = rb.mass();
@@ -534,6 +575,19 @@ struct Simulation::Impl {
       const auto& d = rb.inertia_diagonal();
       const auto& o = rb.inertia_products();
       mp.inertia << d.x(), o.x(), o.y(), o.x(), d.y(), o.z(), o.y(), o.z(), d.z();
+    } else if (link != nullptr && link->mass() != 0.0) {
+      // The link's inertial data is what the description says the body is: it wins over the volume of
+      // its collision hulls, which are an approximation of its surface for contacts.
+      if (!(link->mass() > 0.0) || !std::isfinite(link->mass()))
+        bad("link " + describe(*link) + " has a mass of " + std::to_string(link->mass()) +
+            " kg; a body needs a positive, finite mass");
+      const double scale = rb.mass() > 0.0 ? rb.mass() / link->mass() : 1.0;
+      const Eigen::Matrix3d rot = link->inertial_frame().rotation();
+      mp.mass = link->mass() * scale;
+      mp.center = link->inertial_frame().translation();
+      mp.inertia = rot * link->inertia() * rot.transpose() * scale;
+      if (!mp.inertia.allFinite() || mp.inertia.isZero(0.0))
+        bad("link " + describe(*link) + " has a mass but no inertia");
     } else {
       dMass total;
       dMassSetZero(&total);
@@ -583,26 +637,15 @@ struct Simulation::Impl {
         dMassAdd(&total, &m);
         any = true;
       }
-      if (any) {
-        if (rb.mass() > 0.0) dMassAdjust(&total, rb.mass());
-        const Eigen::Vector3d c(total.c[0], total.c[1], total.c[2]);
-        dMassTranslate(&total, -c.x(), -c.y(), -c.z());  // inertia about the centre of mass
-        mp.mass = total.mass;
-        mp.center = c;
-        mp.inertia = from_ode(total.I);
-      } else if (const auto* link = b.node->as<scene::Link>(); link != nullptr && link->mass() > 0.0) {
-        const double scale = rb.mass() > 0.0 ? rb.mass() / link->mass() : 1.0;
-        const Eigen::Matrix3d rot = link->inertial_frame().rotation();
-        mp.mass = link->mass() * scale;
-        mp.center = link->inertial_frame().translation();
-        mp.inertia = rot * link->inertia() * rot.transpose() * scale;
-        if (!mp.inertia.allFinite() || mp.inertia.isZero(0.0))
-          bad("link " + describe(*link) + " has a mass but no inertia");
-      } else {
+      if (!any)
         bad("no mass: set RigidBody.mass and inertia_diagonal, or give the body collision hulls (role "
-            "Collision) "
-            "with primitive or closed mesh geometry");
-      }
+            "Collision) with primitive or closed mesh geometry");
+      if (rb.mass() > 0.0) dMassAdjust(&total, rb.mass());
+      const Eigen::Vector3d c(total.c[0], total.c[1], total.c[2]);
+      dMassTranslate(&total, -c.x(), -c.y(), -c.z());  // inertia about the centre of mass
+      mp.mass = total.mass;
+      mp.center = c;
+      mp.inertia = from_ode(total.I);
     }
     // ODE's own check (positive definite inertia, triangle inequalities of the principal moments).
     dMass check;
@@ -679,6 +722,7 @@ struct Simulation::Impl {
             planned_joints.insert(j);
           }
         if (auto* h = it.node->as<Hull>(); h != nullptr && h->role() == scene::HullRole::Collision) {
+          check_material(*h);
           Shape shape;
           if (shape_of(*h, body != npos, shape)) {
             if (body != npos) plan.bodies[body].geoms.push_back(plan.geoms.size());
@@ -1039,6 +1083,7 @@ struct Simulation::Impl {
         rec->world = wrec[p.world];
         rec->sig = sig;
         build_joint(*rec);
+        if (rec->sig.other != nullptr) ++joined[{rec->sig.owner->body, rec->sig.other->body}];
         it = joints.emplace(p.ext, std::move(rec)).first;
       } else {
         set_joint_params(*it->second);
@@ -1141,9 +1186,15 @@ struct Simulation::Impl {
   }
 
   // ---- stepping ----
+  // What one dSpaceCollide of one world collects. ODE calls near_callback through C frames: nothing may
+  // leave it by an exception, so a failure is kept here (and the remaining pairs skipped) and rethrown
+  // once dSpaceCollide has returned.
   struct CollideContext {
     Impl* self;
     WorldRec* world;
+    std::size_t contacts = 0;       // contact joints made in this step
+    bool too_many = false;          // max_contacts_per_step reached: the rest is skipped
+    std::exception_ptr failure;     // thrown inside the callback: the rest is skipped
   };
 
   static double friction_of(const GeomRec& g, const World& w) {
@@ -1155,18 +1206,33 @@ struct Simulation::Impl {
     return m != nullptr ? std::clamp(m->restitution(), 0.0, 1.0) : w.default_restitution();
   }
 
-  static void near_callback(void* data, dGeomID a, dGeomID b) {
+  static void near_callback(void* data, dGeomID a, dGeomID b) noexcept {
     auto* ctx = static_cast<CollideContext*>(data);
+    if (ctx->failure || ctx->too_many) return;
+    try {
+      collide_pair(*ctx, a, b);
+    } catch (...) {
+      ctx->failure = std::current_exception();
+    }
+  }
+
+  static void collide_pair(CollideContext& context, dGeomID a, dGeomID b) {
+    CollideContext* ctx = &context;
     dBodyID ba = dGeomGetBody(a);
     dBodyID bb = dGeomGetBody(b);
     if (ba == bb) return;  // static/static, or two hulls of one body
-    if (ba != nullptr && bb != nullptr && dAreConnectedExcluding(ba, bb, dJointTypeContact) != 0) return;
+    if (ba != nullptr && bb != nullptr && ctx->self->joined.contains({ba, bb})) return;  // jointed bodies
     Impl& self = *ctx->self;
     const World& w = *ctx->world->ext;
     auto& buf = self.contact_buffer;
     buf.resize(static_cast<std::size_t>(w.max_contacts()));
     const int n = dCollide(a, b, w.max_contacts(), &buf[0].geom, sizeof(dContact));
     if (n <= 0) return;
+    if (ctx->contacts + static_cast<std::size_t>(n) > max_contacts_per_step) {
+      ctx->too_many = true;
+      return;
+    }
+    ctx->contacts += static_cast<std::size_t>(n);
     const auto* ga = static_cast<const GeomRec*>(dGeomGetData(a));
     const auto* gb = static_cast<const GeomRec*>(dGeomGetData(b));
     // Combination rules: friction the geometric mean, restitution the larger of the two (a ball bounces
@@ -1210,6 +1276,18 @@ struct Simulation::Impl {
     if (!(seconds >= 0.0) || !std::isfinite(seconds))
       detail_throw("advance: seconds must be finite and >= 0, got " + std::to_string(seconds));
     sync();
+    // Each world's step count, checked before anything moves: an absurd interval (1e6 s at the default
+    // step would be 1e9 ODE steps, and beyond 2^64 steps the count would not even fit) is an error.
+    for (auto& [k, w] : worlds) {
+      const double steps = std::floor((w->pending + seconds) / w->ext->step() + 1e-9);
+      if (steps > static_cast<double>(max_steps_per_advance)) {
+        std::ostringstream msg;
+        msg << "advance(" << seconds << " s) would take " << steps << " steps of " << w->ext->step()
+            << " s in " << describe_ext(*w->ext) << "; at most " << max_steps_per_advance
+            << " per call (advance in shorter intervals, or make World.step larger)";
+        detail_throw(msg.str());
+      }
+    }
     // Force accumulators: checked before anything moves.
     std::vector<BodyRec*> forced;
     for (BodyRec* b : order) {
@@ -1245,9 +1323,19 @@ struct Simulation::Impl {
             dBodyAddForce(b->body, f.x(), f.y(), f.z());
             dBodyAddTorque(b->body, t.x(), t.y(), t.z());
           }
-          CollideContext ctx{this, w.get()};
+          CollideContext ctx{this, w.get(), 0, false, nullptr};
           try {
             dSpaceCollide(w->space, &ctx, &near_callback);
+            if (ctx.failure) std::rethrow_exception(ctx.failure);
+            if (ctx.too_many) {
+              dJointGroupEmpty(w->contacts);
+              dirty = true;  // worlds and steps before this one moved ODE's bodies; the database did not
+              std::ostringstream msg;
+              msg << "more than " << max_contacts_per_step << " contact points in one step of "
+                  << describe_ext(*w->ext)
+                  << " (hulls overlapping en masse?); the database keeps the last good state";
+              detail_throw(msg.str());
+            }
             if (w->ext->solver() == Solver::Exact) {
               dWorldStep(w->world, h);
             } else {
@@ -1255,10 +1343,16 @@ struct Simulation::Impl {
             }
             dJointGroupEmpty(w->contacts);
           } catch (const vsd::Error& e) {  // from ODE's error or debug handler
+            if (ctx.too_many) throw;
             w->poisoned = true;
             dirty = true;
             detail_throw(std::string(e.what()) + " (stepping " + describe_ext(*w->ext) +
                          "; the database keeps the last good state and ODE's world is rebuilt from it)");
+          } catch (const std::bad_alloc&) {
+            w->poisoned = true;
+            dirty = true;
+            detail_throw("out of memory stepping " + describe_ext(*w->ext) +
+                         "; the database keeps the last good state and ODE's world is rebuilt from it");
           }
           ++stats.steps;
           stepped = true;

@@ -3,6 +3,7 @@
 
 #include <Eigen/Cholesky>
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <numbers>
 
@@ -42,8 +43,9 @@ bool IkSolver::attempt(const Eigen::Isometry3d& target, Eigen::VectorXd& q, int&
   double err = e.squaredNorm();
   double lambda = options_.initial_damping;
   for (int it = 0;; ++it) {
-    pos_err = e.head<3>().norm();
-    rot_err = e.tail<3>().norm();
+    // stableNorm: a target 1e200 m away is that far, not infinitely (norm() squares and overflows).
+    pos_err = e.head<3>().stableNorm();
+    rot_err = e.tail<3>().stableNorm();
     if (pos_err <= options_.position_tolerance && rot_err <= options_.orientation_tolerance) return true;
     if (it >= options_.max_iterations || lambda > 1e12) return false;
     ++iterations;
@@ -73,6 +75,11 @@ IkResult IkSolver::solve(const Eigen::Isometry3d& target, std::span<const double
   if (seed.size() != static_cast<std::size_t>(n))
     throw vsd::Error("IkSolver: the seed has " + std::to_string(seed.size()) + " values; the model has " +
                      std::to_string(n));
+  if (!target.matrix().allFinite()) throw vsd::Error("IkSolver: the target pose is not finite");
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(seed[static_cast<std::size_t>(i)]))
+      throw vsd::Error("IkSolver: the seed value of '" + model_.layout()[static_cast<std::size_t>(i)].name +
+                       "' is not finite");
   using Clock = std::chrono::steady_clock;
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                            std::chrono::duration<double>(options_.time_budget));
@@ -84,7 +91,9 @@ IkResult IkSolver::solve(const Eigen::Isometry3d& target, std::span<const double
   for (int attempt_no = 0;; ++attempt_no) {
     double pe = 0, re = 0;
     const bool ok = attempt(target, q, r.iterations, pe, re);
-    if (ok || pe + re < best_err) {
+    // The first attempt always counts: its errors are the real ones even when they are huge (an error of
+    // infinity compared with the initial best of infinity used to leave the reported errors at 0).
+    if (ok || attempt_no == 0 || pe + re < best_err) {
       best = q;
       best_err = pe + re;
       r.position_error = pe;

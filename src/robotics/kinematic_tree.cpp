@@ -195,9 +195,13 @@ KinematicJointType type_of(scene::JointType t, std::string_view name, std::vecto
     case scene::JointType::Fixed:
       return KinematicJointType::Fixed;
     default:
-      if (warnings != nullptr)
-        warnings->push_back("joint '" + std::string(name) +
-                            "': floating, planar and unknown joints are kept fixed");
+      if (warnings != nullptr) {
+        const char* what = t == scene::JointType::Floating ? "a floating joint"
+                           : t == scene::JointType::Planar ? "a planar joint"
+                                                           : "a joint of unknown type";
+        warnings->push_back("joint '" + std::string(name) + "': " + what +
+                            " is kept fixed (vsd::robotics has rotary, prismatic, universal and fixed joints)");
+      }
       return KinematicJointType::Fixed;
   }
 }

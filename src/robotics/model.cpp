@@ -183,6 +183,13 @@ Model Model::build(std::span<const JointSpec> specs) {
       fail("joint '" + s.name + "': zero axis");
     if (s.type == KinematicJointType::Universal && !(s.axis2.norm() > 1e-12))
       fail("joint '" + s.name + "': zero second axis");
+    if (!s.placement.pre.matrix().allFinite() || !s.placement.post.matrix().allFinite() ||
+        !s.placement.axis.allFinite() || !s.axis2.allFinite())
+      fail("joint '" + s.name + "': its origin or axis is not finite");
+    if (s.has_limits && (!std::isfinite(s.lower) || !std::isfinite(s.upper)))
+      fail("joint '" + s.name + "': its limits are not finite (no limits: has_limits false)");
+    if (!std::isfinite(s.mimic_multiplier) || !std::isfinite(s.mimic_offset))
+      fail("joint '" + s.name + "': its mimic multiplier or offset is not finite");
     if (s.has_limits && !(s.lower <= s.upper))
       fail("joint '" + s.name + "': lower limit " + std::to_string(s.lower) + " above upper limit " +
            std::to_string(s.upper));
@@ -460,8 +467,18 @@ void Model::forward(std::span<const double> q, Data& data) const {
   if (q.size() != layout_.size())
     fail("joint vector has " + std::to_string(q.size()) + " values; the model has " +
          std::to_string(layout_.size()));
+  for (std::size_t i = 0; i < q.size(); ++i)
+    if (!std::isfinite(q[i])) fail("joint vector: the value of '" + layout_[i].name + "' is not finite");
   if (data.segment.size() != segments_.size() || data.sine.size() != segments_.size()) data = make_data();
   forward(q.data(), data);
+  // Finite values and origins can still overflow (1e308 m twice is infinite): say so instead of
+  // handing out infinite poses.
+  for (std::size_t b = 0; b < body_segment_.size(); ++b) {
+    const Frame& f = data.segment[static_cast<std::size_t>(body_segment_[b])];
+    if (!f.rotation.allFinite() || !f.translation.allFinite())
+      fail("forward kinematics: the pose of body '" + body_name_[b] +
+           "' is not finite (joint values or origins too large)");
+  }
 }
 
 void Model::forward(const double* q, Data& data) const noexcept {
@@ -670,6 +687,7 @@ void Model::general_segment(std::size_t i, Frame* out, const double* values, con
 void Model::jacobian(const Data& data, int body,
                      Eigen::Ref<Eigen::Matrix<double, 6, Eigen::Dynamic>> out) const noexcept {
   out.setZero();
+  if (body < 0) return;  // the base does not move
   const Eigen::Vector3d& tip =
       data.segment[static_cast<std::size_t>(body_segment_[static_cast<std::size_t>(body)])].translation;
   for (int i = body_segment_[static_cast<std::size_t>(body)]; i >= 0;

@@ -17,10 +17,13 @@ JointTrajectory JointTrajectory::plan(Interpolation shape, std::span<const doubl
     throw vsd::Error("JointTrajectory: " + std::to_string(n) + " start values but " +
                      std::to_string(goal.size()) + " goal values, " + std::to_string(vmax.size()) +
                      " speed and " + std::to_string(amax.size()) + " acceleration limits");
-  for (std::size_t i = 0; i < n; ++i)
+  for (std::size_t i = 0; i < n; ++i) {
     if (!(vmax[i] > 0) || !(amax[i] > 0) || !std::isfinite(vmax[i]) || !std::isfinite(amax[i]))
       throw vsd::Error("JointTrajectory: joint " + std::to_string(i) +
                        " needs positive, finite speed and acceleration limits");
+    if (!std::isfinite(start[i]) || !std::isfinite(goal[i]))
+      throw vsd::Error("JointTrajectory: joint " + std::to_string(i) + " needs a finite start and goal");
+  }
   JointTrajectory t;
   t.shape_ = shape;
   t.start_.assign(start.begin(), start.end());

@@ -1,21 +1,30 @@
-// URDF through urdfdom; the element scan for warnings through TinyXML (urdfdom's own XML library).
+// URDF through urdfdom, behind the shape check of xml_guard.hpp; the element scan for warnings through
+// TinyXML (urdfdom's own XML library); the values validated before anything is built.
 #include "vsd/scene/urdf_loader.hpp"
 
 #include <console_bridge/console.h>
 #include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
 
-#include <fstream>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <map>
 #include <mutex>
+#include <new>
 #include <set>
 #include <sstream>
+#include <unordered_map>
 
+#include "input_file.hpp"
+#include "path_confinement.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/core/sim_state.hpp"
 #include "vsd/scene/hull.hpp"
 #include "vsd/scene/mesh_loader.hpp"
 #include "vsd/scene/scene.hpp"
+#include "xml_guard.hpp"
 
 namespace vsd::scene {
 
@@ -31,14 +40,19 @@ class CollectingHandler : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char* /*filename*/,
            int /*line*/) override {
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
-      messages.push_back(text);
-    } else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN) {
-      warnings.push_back(text);
+    try {
+      if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
+        messages.push_back(text);
+      } else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN) {
+        warnings.push_back(text);
+      }
+    } catch (...) {  // nothing may leave a logging call inside urdfdom; an error is still an error
+      failed = true;
     }
   }
   std::vector<std::string> messages;
   std::vector<std::string> warnings;
+  bool failed = false;  // a message could not be kept (out of memory)
 };
 
 // urdfdom logs some errors and still returns a model (a mass of "heavy" becomes an inertial of 0 kg): any
@@ -49,19 +63,26 @@ urdf::ModelInterfaceSharedPtr parse(const std::string& xml, std::string_view ori
   urdf::ModelInterfaceSharedPtr model;
   {
     std::lock_guard lock(console_mutex);
-    console_bridge::useOutputHandler(&handler);
+    // Restored however parseURDF ends: the handler lives on this stack frame.
+    struct Install {
+      explicit Install(console_bridge::OutputHandler* h) { console_bridge::useOutputHandler(h); }
+      ~Install() { console_bridge::restorePreviousOutputHandler(); }
+      Install(const Install&) = delete;
+      Install& operator=(const Install&) = delete;
+    } install(&handler);
     try {
       model = urdf::parseURDF(xml);
+    } catch (const std::bad_alloc&) {
+      vsd::detail::throw_error(std::string(origin) + ": out of memory parsing the URDF");
     } catch (const std::exception& e) {  // urdfdom throws on some malformed numbers
       handler.messages.emplace_back(e.what());
     }
-    console_bridge::restorePreviousOutputHandler();
   }
   for (const auto& w : handler.warnings) warnings.push_back("urdfdom: " + w);
-  if (!model || !handler.messages.empty()) {
+  if (!model || !handler.messages.empty() || handler.failed) {
     std::string msg = std::string(origin) + ": not a valid URDF";
     for (const auto& m : handler.messages) msg += "\n  " + m;
-    detail::throw_error(msg);
+    vsd::detail::throw_error(msg);
   }
   return model;
 }
@@ -111,6 +132,156 @@ void scan_unsupported(const std::string& xml, std::vector<std::string>& warnings
                        " not supported, ignored");
 }
 
+
+// ---- validation: what urdfdom accepts but no body, joint or shape can be ---------------------------------
+
+std::string num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+class Validator {
+ public:
+  explicit Validator(const urdf::ModelInterface& model) : model_(model) {}
+
+  void run() {
+    for (const auto& [name, link] : model_.links_) {
+      if (link->inertial) inertial(name, *link->inertial);
+      int i = 0;
+      for (const auto& v : link->visual_array) geometry(where(name, "visual", i++), v->geometry);
+      i = 0;
+      for (const auto& c : link->collision_array) geometry(where(name, "collision", i++), c->geometry);
+    }
+    for (const auto& [name, joint] : model_.joints_) this->joint(name, *joint);
+    mimic_cycles();
+  }
+
+  std::vector<std::string> errors;
+  std::vector<std::string> warnings;
+
+ private:
+  static std::string where(const std::string& link, const char* what, int index) {
+    return "link '" + link + "' " + what + (index > 0 ? " " + std::to_string(index) : "");
+  }
+
+  void inertial(const std::string& link, const urdf::Inertial& in) {
+    const std::string at = "link '" + link + "' <inertial>";
+    if (in.mass < 0) errors.push_back(at + " <mass>: " + num(in.mass) + " kg is negative");
+    const std::pair<const char*, double> diagonal[] = {{"ixx", in.ixx}, {"iyy", in.iyy}, {"izz", in.izz}};
+    bool negative = false;
+    for (const auto& [field, v] : diagonal)
+      if (v < 0) {
+        errors.push_back(at + " <inertia> " + field + ": " + num(v) + " kg m^2 is negative");
+        negative = true;
+      }
+    if (negative || !(in.mass > 0)) return;
+    Eigen::Matrix3d inertia;
+    inertia << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+    const Eigen::Vector3d m = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(inertia).eigenvalues();
+    const double slack = 1e-9 * m.cwiseAbs().maxCoeff();
+    if (!(m.minCoeff() > 0)) {
+      warnings.push_back(at + " <inertia>: not positive definite (principal moments " + num(m(0)) + ", " +
+                         num(m(1)) + ", " + num(m(2)) + " kg m^2) for a mass of " + num(in.mass) +
+                         " kg; vsd::physics refuses this link as a body");
+    } else if (m(0) + m(1) + slack < m(2)) {
+      warnings.push_back(at + " <inertia>: principal moment " + num(m(2)) + " exceeds the sum of the others (" +
+                         num(m(0)) + " + " + num(m(1)) + " kg m^2), which no rigid body has; vsd::physics "
+                         "refuses this link as a body");
+    }
+  }
+
+  // A negative dimension is an error; zero a warning (collision and physics leave such a hull out).
+  void dimension(const std::string& at, const char* field, double v) {
+    if (v < 0) {
+      errors.push_back(at + ": " + field + " " + num(v) + " is negative");
+    } else if (v == 0) {
+      warnings.push_back(at + ": " + field + " is 0; the shape is degenerate (collision and physics leave it out)");
+    }
+  }
+
+  void geometry(const std::string& at, const urdf::GeometrySharedPtr& g) {
+    if (!g) return;  // the builder warns
+    switch (g->type) {
+      case urdf::Geometry::BOX: {
+        const auto& d = static_cast<const urdf::Box&>(*g).dim;
+        const std::pair<const char*, double> sides[] = {{"x", d.x}, {"y", d.y}, {"z", d.z}};
+        for (const auto& [axis, v] : sides) dimension(at + " <box>", (std::string("size ") + axis).c_str(), v);
+        break;
+      }
+      case urdf::Geometry::SPHERE:
+        dimension(at + " <sphere>", "radius", static_cast<const urdf::Sphere&>(*g).radius);
+        break;
+      case urdf::Geometry::CYLINDER: {
+        const auto& c = static_cast<const urdf::Cylinder&>(*g);
+        dimension(at + " <cylinder>", "radius", c.radius);
+        dimension(at + " <cylinder>", "length", c.length);
+        break;
+      }
+      case urdf::Geometry::MESH: {
+        const auto& sc = static_cast<const urdf::Mesh&>(*g).scale;
+        if (sc.x == 0 || sc.y == 0 || sc.z == 0)
+          warnings.push_back(at + " <mesh>: a scale of 0 flattens the mesh (collision and physics leave it out)");
+        break;
+      }
+    }
+  }
+
+  void joint(const std::string& name, const urdf::Joint& j) {
+    const std::string at = "joint '" + name + "'";
+    const bool moves = j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS ||
+                       j.type == urdf::Joint::PRISMATIC || j.type == urdf::Joint::PLANAR;
+    if (moves && j.axis.x == 0 && j.axis.y == 0 && j.axis.z == 0)
+      errors.push_back(at + " <axis>: the axis is zero");
+    if (j.limits) {
+      const urdf::JointLimits& l = *j.limits;
+      const bool bounded = j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::PRISMATIC;
+      if (bounded && l.lower > l.upper)
+        errors.push_back(at + " <limit>: lower " + num(l.lower) + " is above upper " + num(l.upper));
+      if (l.effort < 0) warnings.push_back(at + " <limit> effort: " + num(l.effort) + " is negative");
+      if (l.velocity < 0) warnings.push_back(at + " <limit> velocity: " + num(l.velocity) + " is negative");
+    }
+    if (j.dynamics) {
+      if (j.dynamics->damping < 0)
+        warnings.push_back(at + " <dynamics> damping: " + num(j.dynamics->damping) + " is negative");
+      if (j.dynamics->friction < 0)
+        warnings.push_back(at + " <dynamics> friction: " + num(j.dynamics->friction) + " is negative");
+    }
+  }
+
+  // A joint that mimics itself, or a ring of mimics: no value could satisfy it. Each joint mimics at most
+  // one other, so every walk along the mimics ends at a joint that mimics nobody (or an unknown one) or
+  // runs into a ring; joints already walked are not walked again (linear in the number of joints).
+  void mimic_cycles() {
+    enum class Mark { Unseen, OnPath, Done };
+    std::map<std::string, Mark> mark;
+    for (const auto& [start, ignored] : model_.joints_) {
+      std::vector<std::string> path;
+      std::string at = start;
+      for (;;) {
+        auto it = model_.joints_.find(at);
+        if (it == model_.joints_.end()) break;  // an unknown target: the builder warns
+        Mark& m = mark[at];
+        if (m == Mark::Done) break;
+        if (m == Mark::OnPath) {
+          std::string ring;
+          for (auto p = std::find(path.begin(), path.end(), at); p != path.end(); ++p)
+            ring += "'" + *p + "' -> ";
+          errors.push_back("joint '" + at + "' <mimic>: a mimic cycle " + ring + "'" + at + "'");
+          break;
+        }
+        m = Mark::OnPath;
+        path.push_back(at);
+        if (!it->second->mimic) break;
+        at = it->second->mimic->joint_name;
+      }
+      for (const auto& p : path) mark[p] = Mark::Done;
+    }
+  }
+
+  const urdf::ModelInterface& model_;
+};
+
 class Builder {
  public:
   Builder(vsd::Node& parent, const urdf::ModelInterface& model, fs::path base_dir, const UrdfOptions& options,
@@ -135,28 +306,38 @@ class Builder {
     add_subtree(*root, root_link);
     for (const auto& [name, j] : model_.joints_) {
       if (!j->mimic) continue;
-      Joint* self = scene_->find_joint(name);
-      Joint* target = scene_->find_joint(j->mimic->joint_name);
-      if (target == nullptr) {
+      auto self = joints_.find(name);
+      auto target = joints_.find(j->mimic->joint_name);
+      if (self == joints_.end()) continue;  // not in the tree (urdfdom rejects this already)
+      if (target == joints_.end()) {
         report_.warnings.push_back("joint '" + name + "': mimics unknown joint '" + j->mimic->joint_name +
                                    "'");
       } else {
-        self->set_mimic(target);
+        self->second->set_mimic(target->second);
       }
     }
     parent_.add_child(*scene_);
   }
 
  private:
-  void add_subtree(const urdf::Link& link, Link& node) {
-    for (const auto& j : link.child_joints) {
-      const urdf::LinkConstSharedPtr child = model_.getLink(j->child_link_name);
-      if (!child) continue;  // urdfdom rejects this already
-      Link& child_node = make_link(*child);
-      child_node.set_frame(to_frame(j->parent_to_joint_origin_transform));
-      node.add_child(child_node);
-      make_joint(*j, node, child_node);
-      add_subtree(*child, child_node);
+  // Depth first with an explicit stack: a chain of links may be deeper than the call stack.
+  void add_subtree(const urdf::Link& root, Link& root_node) {
+    std::vector<std::pair<const urdf::Link*, Link*>> todo{{&root, &root_node}};
+    while (!todo.empty()) {
+      const auto [link, node] = todo.back();
+      todo.pop_back();
+      std::vector<std::pair<const urdf::Link*, Link*>> children;
+      for (const auto& j : link->child_joints) {
+        const urdf::LinkConstSharedPtr child = model_.getLink(j->child_link_name);
+        if (!child) continue;  // urdfdom rejects this already
+        Link& child_node = make_link(*child);
+        child_node.set_frame(to_frame(j->parent_to_joint_origin_transform));
+        node->add_child(child_node);
+        make_joint(*j, *node, child_node);
+        children.emplace_back(child.get(), &child_node);
+      }
+      // Reversed onto the stack: links are still made in the file's order, depth first.
+      todo.insert(todo.end(), children.rbegin(), children.rend());
     }
   }
 
@@ -246,25 +427,39 @@ class Builder {
     out.set_scale(scale);
     meshes_[key.str()] = &out;
     if (!options_.load_meshes) return out;
-    std::vector<fs::path> searched;
-    const fs::path file = resolve_mesh_uri(m.filename, base_, options_.package_paths, &searched);
-    if (file.empty()) {
+    const MeshUriResolution found = resolve_mesh_uri(m.filename, base_, options_);
+    if (!found.refused.empty()) {
+      report_.warnings.push_back(where + ": mesh '" + m.filename + "' not read: " + found.refused);
+      return out;
+    }
+    if (found.file.empty()) {
       std::string msg = where + ": mesh '" + m.filename + "' not found";
-      if (!searched.empty()) {
+      if (!found.searched.empty()) {
         msg += " (searched";
-        for (const auto& s : searched) msg += " " + s.string();
+        for (const auto& s : found.searched) msg += " " + s.string();
         msg += ")";
       }
       report_.warnings.push_back(msg);
       return out;
     }
     try {
-      load_mesh(out, file);
+      const MeshReport mr = load_mesh(out, found.file, mesh_options());
+      for (const auto& w : mr.warnings) report_.warnings.push_back(where + ": mesh '" + m.filename + "': " + w);
       ++report_.meshes_loaded;
     } catch (const vsd::Error& e) {
       report_.warnings.push_back(where + ": " + e.what());
     }
     return out;
+  }
+
+  // Files a mesh pulls in obey the rule its own reference does: the URDF's folder and the package paths.
+  MeshOptions mesh_options() const {
+    MeshOptions o;
+    o.allowed_roots = options_.package_paths;
+    o.allowed_roots.insert(o.allowed_roots.begin(), base_.empty() ? fs::path(".") : base_);
+    o.allow_paths_outside = options_.allow_paths_outside;
+    o.max_file_bytes = options_.max_mesh_bytes;
+    return o;
   }
 
   Material& material(const urdf::Material& m) {
@@ -334,6 +529,7 @@ class Builder {
       out.set_mimic_offset(j.mimic->offset);
     }
     scene_->edit_joints().push_back(out);
+    joints_[j.name] = &out;
   }
 
  public:
@@ -358,42 +554,82 @@ class Builder {
   std::map<std::string, Geometry*> meshes_;
   std::map<std::string, Material*> materials_;
   std::map<const Material*, TextureMap*> textures_;
+  std::unordered_map<std::string, Joint*> joints_;
 };
 
 }  // namespace
 
-fs::path resolve_mesh_uri(std::string_view uri, const fs::path& base_dir,
-                          const std::vector<fs::path>& package_paths, std::vector<fs::path>* searched) {
+namespace {
+
+// "http", for "http://..."; empty when @p uri has no scheme (a plain path).
+std::string_view scheme_of(std::string_view uri) {
+  const auto colon = uri.find("://");
+  if (colon == std::string_view::npos || colon == 0) return {};
+  for (char c : uri.substr(0, colon))
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '+' && c != '-' && c != '.') return {};
+  return uri.substr(0, colon);
+}
+
+}  // namespace
+
+MeshUriResolution resolve_mesh_uri(std::string_view uri, const fs::path& base_dir, const UrdfOptions& options) {
+  MeshUriResolution r;
   std::vector<fs::path> candidates;
-  constexpr std::string_view package = "package://";
-  constexpr std::string_view file = "file://";
-  if (uri.starts_with(package)) {
-    const std::string_view rest = uri.substr(package.size());
+  const std::string_view scheme = scheme_of(uri);
+  const std::string_view rest = scheme.empty() ? uri : uri.substr(scheme.size() + 3);
+  if (scheme == "package") {
     const auto slash = rest.find('/');
     const std::string pkg(rest.substr(0, slash));
     const std::string inner(slash == std::string_view::npos ? std::string_view{} : rest.substr(slash + 1));
-    for (const auto& dir : package_paths) {
+    for (const auto& dir : options.package_paths) {
       candidates.push_back(dir / pkg / inner);
       if (dir.filename() == pkg) candidates.push_back(dir / inner);
     }
-  } else if (uri.starts_with(file)) {
-    candidates.emplace_back(std::string(uri.substr(file.size())));
+  } else if (scheme == "file") {
+    candidates.emplace_back(std::string(rest));
+  } else if (!scheme.empty()) {
+    r.refused = "URI scheme '" + std::string(scheme) + "' is not supported (package://, file:// and paths are)";
+    return r;
   } else {
     const fs::path p{std::string(uri)};
     candidates.push_back(p.is_absolute() ? p : base_dir / p);
   }
-  std::error_code ec;
-  for (const auto& c : candidates)
-    if (fs::is_regular_file(c, ec)) return c;
-  if (searched != nullptr) *searched = std::move(candidates);
-  return {};
+  std::vector<fs::path> roots = options.package_paths;
+  roots.insert(roots.begin(), base_dir.empty() ? fs::path(".") : base_dir);
+  const detail::PathConfinement confinement(roots, options.allow_paths_outside);
+  for (const auto& c : candidates) {
+    std::string why;
+    switch (confinement.admit(c, r.file, why)) {
+      case detail::PathConfinement::Verdict::Admitted:
+        r.refused.clear();
+        return r;
+      case detail::PathConfinement::Verdict::Refused:
+        if (r.refused.empty())
+          r.refused = why + (confinement.allows_outside() ? std::string()
+                                                            : "; UrdfOptions::allow_paths_outside permits it");
+        break;
+      case detail::PathConfinement::Verdict::Missing:
+        break;
+    }
+  }
+  if (r.refused.empty()) r.searched = std::move(candidates);
+  return r;
 }
 
 SceneReport load_urdf_text(vsd::Node& parent, std::string_view xml, std::string_view origin,
                            const fs::path& base_dir, const UrdfOptions& options) {
+  detail::check_xml_shape(xml, origin, "URDF", {max_urdf_depth, max_urdf_elements, max_urdf_bytes});
   const std::string text(xml);
   SceneReport report;
   const urdf::ModelInterfaceSharedPtr model = parse(text, origin, report.warnings);
+  Validator check(*model);
+  check.run();
+  if (!check.errors.empty()) {
+    std::string msg = std::string(origin) + ": not a valid URDF";
+    for (const auto& e : check.errors) msg += "\n  " + e;
+    vsd::detail::throw_error(msg);
+  }
+  report.warnings.insert(report.warnings.end(), check.warnings.begin(), check.warnings.end());
   scan_unsupported(text, report.warnings);
   Builder b(parent, *model, base_dir, options, report);
   b.build(origin);
@@ -402,11 +638,10 @@ SceneReport load_urdf_text(vsd::Node& parent, std::string_view xml, std::string_
 }
 
 SceneReport load_urdf(vsd::Node& parent, const fs::path& file, const UrdfOptions& options) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) detail::throw_error("'" + file.string() + "': cannot open URDF file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return load_urdf_text(parent, text.str(), file.string(), file.parent_path(), options);
+  const std::string text = detail::read_input(file, max_urdf_bytes, "URDF file");
+  const bool from_stdin = file == "-";
+  return load_urdf_text(parent, text, from_stdin ? std::string("standard input") : file.string(),
+                        from_stdin ? fs::path(".") : file.parent_path(), options);
 }
 
 }  // namespace vsd::scene

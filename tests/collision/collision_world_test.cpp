@@ -7,7 +7,9 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <new>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -361,6 +363,71 @@ TEST_F(CollisionTest, PairFilterExcludesPairs) {
   w.update();
   EXPECT_FALSE(w.in_contact(a, b));
   EXPECT_TRUE(w.in_contact(a, c));
+}
+
+// 20,000 overlapping boxes made update() collect contact points until std::bad_alloc, thrown inside FCL's
+// callback: std::terminate. The points of one update are bounded; beyond the bound the query stops and
+// update() throws a vsd::Error, leaving contacts, pairs and signals as the previous update left them.
+TEST_F(CollisionTest, TooManyContactPointsStopTheQueryAndKeepThePreviousContacts) {
+  Geometry& cube = box(1, 1, 1);
+  Hull& a = hull(cube, at(0), "a");
+  Hull& b = hull(cube, at(0.5), "b");
+  Options o;
+  o.max_contacts = 100;
+  CollisionWorld w(s, o);
+  int begun = 0;
+  auto c = w.on_contact_begin().connect([&](Hull&, Hull&) { ++begun; });
+  w.update();
+  ASSERT_EQ(w.contact_pairs().size(), 1u);
+  const std::size_t points = w.contacts().size();
+  for (int i = 0; i < 30; ++i) hull(cube, at(0.01 * i, 0.2), "heap");  // 435 more overlapping pairs
+  try {
+    w.update();
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("more than 100 contact points in one update"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(begun, 1);
+  EXPECT_EQ(w.contacts().size(), points);
+  EXPECT_TRUE(w.in_contact(a, b));
+}
+
+// Whatever the pair filter throws stops the query and comes out of update() as it is (never through
+// FCL); running out of memory there is a vsd::Error. The world works on afterwards.
+TEST_F(CollisionTest, AnExceptionInsideTheQueryLeavesThroughUpdateNotThroughFcl) {
+  Hull& a = hull(sphere(1), at(0), "a");
+  Hull& b = hull(sphere(1), at(1), "b");
+  hull(plane(), at(0, 0, -0.5), "ground");
+  int throw_what = 1;
+  Options o;
+  o.pair_filter = [&](const Hull&, const Hull&) {
+    if (throw_what == 1) throw std::runtime_error("filter broke");
+    if (throw_what == 2) throw std::bad_alloc();
+    return true;
+  };
+  CollisionWorld w(s, o);
+  EXPECT_THROW(
+      {
+        try {
+          w.update();
+        } catch (const std::runtime_error& e) {
+          EXPECT_STREQ(e.what(), "filter broke");
+          throw;
+        }
+      },
+      std::runtime_error);
+  throw_what = 2;
+  try {
+    w.update();
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("out of memory computing contacts"), std::string::npos) << e.what();
+  }
+  throw_what = 0;
+  w.update();
+  EXPECT_TRUE(w.in_contact(a, b));
+  EXPECT_EQ(w.contact_pairs().size(), 3u);  // a-b and both spheres on the ground
 }
 
 TEST_F(CollisionTest, DeletingAHullInContactEndsItsPairsAtOnce) {

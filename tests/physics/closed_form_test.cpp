@@ -1,10 +1,12 @@
-// vsd::physics against physics, not against itself: free fall, pendulum periods, Coulomb friction,
-// restitution, energy and momentum, each compared with its closed form. Every tolerance is derived from
-// the integrator (ODE's semi-implicit Euler: v += h a, then x += h v) and the step h, as explained where
-// it is used.
+// vsd::physics against physics, not against itself: free fall, pendulum periods (of bodies, and of a URDF
+// link with and without a collision hull), Coulomb friction, restitution, energy and momentum, each
+// compared with its closed form. Every tolerance is derived from the integrator (ODE's semi-implicit
+// Euler: v += h a, then x += h v) and the step h, as explained where it is used.
 #include <gmock/gmock.h>
 
 #include <cmath>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "fixture.hpp"
@@ -136,6 +138,63 @@ TEST_F(ClosedFormTest, PendulumPeriodAtLargeAmplitudeFollowsTheEllipticIntegral)
   // constraint errors per step) is ~40 times larger: 1e-3 relative.
   EXPECT_NEAR(p.period / p.expected, 1.0, 1e-3);
   EXPECT_LT(p.energy_drift, 0.01);
+}
+
+// A URDF pendulum: a massless base fixed in space, a link whose <inertial> is a small sphere of mass m at
+// distance L below the pivot (a continuous joint about y), started theta0 off its rest. A collision hull
+// of a quite different body (a rod from the pivot to the bob, of its own density) must not change the
+// swing: the URDF's inertial is what the link is, the hull only collides.
+std::string urdf_pendulum(double theta0, bool hull) {
+  const double m = 2.0, r = 0.05, L = 1.0;
+  const double ic = 0.4 * m * r * r;
+  std::ostringstream x;
+  x << "<robot name=\"pendulum\"><link name=\"base\"/><link name=\"bob\"><inertial><origin xyz=\""
+    << L * std::sin(theta0) << " 0 " << -L * std::cos(theta0) << "\"/><mass value=\"" << m
+    << "\"/><inertia ixx=\"" << ic << "\" iyy=\"" << ic << "\" izz=\"" << ic
+    << "\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>";
+  if (hull)
+    x << "<collision><origin xyz=\"" << 0.5 * L * std::sin(theta0) << " 0 " << -0.5 * L * std::cos(theta0)
+      << "\" rpy=\"0 " << theta0 << " 0\"/><geometry><box size=\"0.1 0.1 " << L << "\"/></geometry></collision>";
+  x << "</link><joint name=\"pivot\" type=\"continuous\"><parent link=\"base\"/><child link=\"bob\"/>"
+       "<axis xyz=\"0 1 0\"/></joint></robot>";
+  return x.str();
+}
+
+TEST_F(ClosedFormTest, UrdfPendulumSwingsWithItsInertialWithOrWithoutAHull) {
+  const double theta0 = 0.05, m = 2.0, L = 1.0, ic = 0.4 * m * 0.05 * 0.05;
+  const double expected = 4.0 * std::sqrt((m * L * L + ic) / (m * L) / g) * elliptic_k(std::sin(theta0 / 2));
+  for (bool with_hull : {false, true}) {
+    SCOPED_TRACE(with_hull ? "with a hull" : "without a hull");
+    vsd::Environment e;
+    e.use<Module>();
+    e.scheduler().set_base_step(h);
+    auto r = scene::load_urdf_text(e.main_state().database(), urdf_pendulum(theta0, with_hull), "p.urdf", ".");
+    ASSERT_TRUE(r.warnings.empty()) << r.warnings[0];
+    ASSERT_EQ(make_dynamic(*r.scene), 1u);
+    r.scene->find_extension<World>()->set_solver(Solver::Exact);  // as the pendulums above
+    Joint* pivot = r.scene->find_link("bob")->find_extension<Joint>();
+    RigidBody* rb = r.scene->find_link("bob")->find_extension<RigidBody>();
+    ASSERT_TRUE(pivot != nullptr && rb != nullptr);
+    Simulation& sim = e.module<Module>()->simulation();
+    sim.sync();
+    EXPECT_EQ(sim.stats().geoms, with_hull ? 1u : 0u);
+    EXPECT_DOUBLE_EQ(sim.mass_of(*rb).mass, m);
+    EXPECT_NEAR(sim.mass_of(*rb).inertia(1, 1), ic, 1e-15);
+    // Turning points (the rate changes sign from + to -): one per period, linearly interpolated.
+    std::vector<double> turns;
+    double prev = 0.0;
+    for (int n = 1; n * h < 4 * expected + 0.5; ++n) {
+      e.step();
+      const double rate = pivot->rate();
+      if (prev > 0.0 && rate <= 0.0) turns.push_back((n - 1 + prev / (prev - rate)) * h);
+      prev = rate;
+    }
+    ASSERT_GE(turns.size(), 3u);
+    const double period = (turns.back() - turns.front()) / static_cast<double>(turns.size() - 1);
+    // The tolerance of PendulumPeriodAtSmallAmplitude (1e-4 relative covers the integrator's frequency
+    // error and the interpolation); the rod of the hull alone would give sqrt(2/3) of the period.
+    EXPECT_NEAR(period / expected, 1.0, 1e-4);
+  }
 }
 
 TEST_F(ClosedFormTest, SlidingBoxStopsAfterVSquaredOverTwoMuG) {

@@ -1,5 +1,6 @@
-// Contacts from ODE's own collider: deep and near-touching box/box and box/cylinder pairs without a crash,
-// resting contact, and contact properties and shapes that follow the database.
+// Contacts from ODE's own collider: none between jointed bodies, deep and near-touching box/box and
+// box/cylinder pairs without a crash, resting contact, and contact properties and shapes that follow the
+// database.
 #include <gmock/gmock.h>
 
 #include <cmath>
@@ -32,6 +33,39 @@ class ContactTest : public PhysicsTest {
   scene::Hull* first = nullptr;
   scene::Hull* second = nullptr;
 };
+
+// Bodies joined by a joint do not collide with each other (a robot's neighbouring links overlap at their
+// joints); the test is a lookup in the joint records, not ODE's walk over every joint of a body.
+TEST_F(ContactTest, JointedBodiesDoNotCollide) {
+  pair(geometry(GeometryKind::Box, Eigen::Vector3d(1, 1, 1)), Eigen::Vector3d(0.5, 0, 0), 0.0);
+  auto& ball = s.create<Joint>();
+  ball.set_kind(JointKind::Ball);
+  ball.set_other(first);
+  second->add_extension(ball);
+  env.step();
+  EXPECT_EQ(sim().stats().contacts, 0u);
+  s.destroy(ball);
+  env.step();
+  EXPECT_GT(sim().stats().contacts, 0u);
+}
+
+// Friction and restitution are used inside ODE's collision callback, where nothing can be refused: a
+// material outside their ranges is an error naming the hull when the hull enters the simulation (it was
+// clamped silently).
+TEST_F(ContactTest, MaterialValuesOutsideTheirRangesAreErrors) {
+  pair(geometry(GeometryKind::Box, Eigen::Vector3d(1, 1, 1)), Eigen::Vector3d(2, 0, 0), 0.0);
+  scene::Material& m = material(-0.3, 0.5);
+  second->set_material(&m);
+  EXPECT_THAT([&] { env.step(); },
+              ::testing::ThrowsMessage<vsd::Error>(::testing::HasSubstr("material friction must be finite and >= 0")));
+  m.set_friction(0.3);
+  m.set_restitution(1.5);
+  EXPECT_THAT([&] { env.step(); },
+              ::testing::ThrowsMessage<vsd::Error>(::testing::HasSubstr("restitution must lie in [0, 1], got 1.5")));
+  m.set_restitution(0.5);
+  env.step();
+  EXPECT_GT(sim().stats().steps, 0u);
+}
 
 TEST_F(ContactTest, DeepBoxBoxPenetrationIsResolvedWithoutACrash) {
   // Almost fully inside each other (centres 1 cm apart), rotated: a degenerate case for box/box.

@@ -337,6 +337,86 @@ TEST_F(SimulationTest, MakeDynamicTurnsAUrdfIntoBodiesAndJoints) {
   EXPECT_EQ(bad.scene->find_link("arm")->find_extension<RigidBody>(), nullptr);
 }
 
+// A negative link mass used to make make_dynamic() skip the link silently (it then moved with its parent
+// as a massless frame). The URDF loader refuses it; set in the database, it is an error naming the link.
+TEST_F(SimulationTest, ANegativeLinkMassIsAnErrorNamingTheLink) {
+  auto r = scene::load_urdf_text(s.database(), two_link_urdf("revolute"), "two.urdf", ".");
+  scene::Link* arm = r.scene->find_link("arm");
+  arm->set_mass(-1.0);
+  EXPECT_THAT([&] { make_dynamic(*r.scene); },
+              ::testing::ThrowsMessage<vsd::Error>(HasSubstr("link 'arm' of scene 'r' has a mass of -1")));
+  EXPECT_EQ(r.scene->find_link("base")->find_extension<RigidBody>(), nullptr);  // nothing made
+  arm->set_mass(1.0);
+  ASSERT_EQ(make_dynamic(*r.scene), 2u);
+  sim().sync();
+  arm->set_mass(-1.0);  // after the fact: the next sync names it
+  EXPECT_THAT([&] { sim().sync(); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("has a mass of -1")));
+}
+
+// `vsd-physics --dt 1e6` hung (1e9 ODE steps per scheduler step) and `--dt 1e17` "simulated" after 0 steps
+// (the step count overflowed its integer): an interval that needs more than max_steps_per_advance steps
+// is an error, and nothing moves.
+TEST_F(SimulationTest, AnAbsurdIntervalIsAnErrorAndNothingMoves) {
+  auto& box = hull(geometry(GeometryKind::Box, Eigen::Vector3d(1, 1, 1)), at(0, 0, 5));
+  body(box);
+  const auto refused = [&](double seconds, double time) {
+    EXPECT_THAT([&] { sim().advance(seconds); },
+                ::testing::ThrowsMessage<vsd::Error>(HasSubstr("steps of 0.001 s in physics::World")))
+        << seconds;
+    EXPECT_TRUE(box.frame().isApprox(at(0, 0, 5 - 0.5 * 9.81 * time * time), 1e-3)) << seconds;
+    EXPECT_DOUBLE_EQ(world->time(), time);
+  };
+  refused(1e6, 0.0);  // the first call, before ODE holds anything
+  EXPECT_EQ(sim().stats().steps, 0u);
+  sim().advance(0.01);
+  for (double seconds : {1e6, 1e17, 1e300}) refused(seconds, 0.01);
+  EXPECT_EQ(sim().stats().steps, 10u);
+  // The limit is in steps: a larger World step allows a longer interval.
+  world->set_step(1.0);
+  sim().advance(1e4);
+  EXPECT_DOUBLE_EQ(world->time(), 0.01 + 1e4);
+}
+
+// Hulls overlapping en masse: the contact points of one step are bounded (each is an ODE contact joint);
+// beyond the bound the step is an error, never an exhausted memory or an exception through ODE's C frames.
+TEST_F(SimulationTest, TooManyContactPointsInOneStepAreAnError) {
+  auto& geo = geometry(GeometryKind::Box, Eigen::Vector3d(1, 1, 1));
+  std::vector<scene::Hull*> boxes;
+  for (int i = 0; i < 400; ++i) {  // 79,800 overlapping pairs, up to 8 contact points each
+    boxes.push_back(&hull(geo, at(0.001 * i, 0, 0)));
+    body(*boxes.back());
+  }
+  EXPECT_THAT([&] { sim().advance(0.001); },
+              ::testing::ThrowsMessage<vsd::Error>(HasSubstr("more than 100000 contact points in one step")));
+  EXPECT_TRUE(boxes[7]->frame().isApprox(at(0.007, 0, 0)));
+  // Fewer of them step again.
+  for (std::size_t i = 10; i < boxes.size(); ++i) s.destroy(*boxes[i]);
+  sim().advance(0.001);
+  EXPECT_GT(sim().stats().contacts, 0u);
+}
+
+// The example model with primitive hulls (tests/scene/data/iiwa14_primitives.urdf): its inertials are the
+// original's, its hulls collide. Unpowered, the arm falls from upright onto its floor plate and comes to
+// rest on it — neither through it nor (as without hulls) through itself.
+TEST_F(SimulationTest, ThePrimitiveIiwaFallsOntoItsFloorAndRests) {
+  auto r = scene::load_urdf(s.database(), std::string(VSD_SCENE_TEST_DATA_DIR) + "/iiwa14_primitives.urdf");
+  EXPECT_TRUE(r.warnings.empty());
+  EXPECT_EQ(make_dynamic(*r.scene), 8u);
+  env.run_for(4.0);
+  EXPECT_EQ(sim().stats().geoms, 11u);
+  double lowest = 1e9;
+  for (const scene::Link* l : r.scene->links()) {
+    const RigidBody* b = l->find_extension<RigidBody>();
+    if (b == nullptr) continue;
+    EXPECT_LT(b->linear_velocity().norm(), 0.1) << l->name();  // settling: contact order varies by run
+    if (l->name() != "iiwa_link_0") lowest = std::min(lowest, l->world_frame().translation().z());
+  }
+  const double tip = r.scene->find_link("iiwa_link_7")->world_frame().translation().z();
+  EXPECT_LT(tip, 0.15);  // it lies down (1.27 m when upright)
+  EXPECT_GT(lowest, 0.02);  // every moving link's origin above the floor (the thinnest hull is 9 cm across)
+  EXPECT_GT(sim().stats().contacts, 0u);
+}
+
 TEST_F(SimulationTest, JointsWithLimitsAndMotors) {
   world->set_gravity(Eigen::Vector3d::Zero());
   auto& g = geometry(GeometryKind::Box, Eigen::Vector3d(1, 0.1, 0.1));

@@ -61,6 +61,10 @@ TEST(Trajectory, BadLimitsAreErrors) {
   EXPECT_THROW(JointTrajectory::plan(Interpolation::Quintic, one, two, one, one), vsd::Error);
   EXPECT_THROW(JointTrajectory::plan(Interpolation::Trapezoidal, one, one, zero, std::vector<double>{1.0}),
                vsd::Error);
+  // Start and goal must be finite too (a NaN goal made every sample NaN).
+  const std::vector<double> nan{std::nan("")}, inf{INFINITY};
+  EXPECT_THROW(JointTrajectory::plan(Interpolation::Quintic, one, nan, one, one), vsd::Error);
+  EXPECT_THROW(JointTrajectory::plan(Interpolation::Trapezoidal, inf, one, one, one), vsd::Error);
 }
 
 struct Cell {

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <random>
 
 #include "test_util.hpp"
@@ -109,6 +111,31 @@ TEST(Ik, UnreachableTargetFailsWithinTheBudget) {
   EXPECT_FALSE(r.success);
   EXPECT_LT(r.restarts, 1000000);
   EXPECT_LT(took, 2.0);  // the budget plus one attempt, generously bounded for loaded and sanitizer builds
+}
+
+// IK that fails reports the error of the best joint vector it found: it printed `position_error 0` with
+// `success: false` when the error was too large to square (a target 1e200 m away).
+TEST(Ik, AFailureReportsTheRealError) {
+  Environment env;
+  const Model m = iiwa_chain(env);
+  IkOptions o;
+  o.time_budget = 0.0;
+  o.max_restarts = 1;
+  IkSolver ik(m, m.tip(), o);
+  for (double distance : {3.0, 1e200}) {
+    Eigen::Isometry3d far = Eigen::Isometry3d::Identity();
+    far.translation() = Eigen::Vector3d(distance, 0, 0);
+    const IkResult r = ik.solve(far, std::vector<double>(7, 0.0));
+    EXPECT_FALSE(r.success);
+    EXPECT_GT(r.position_error, 0.5 * distance) << distance;
+    EXPECT_TRUE(std::isfinite(r.position_error)) << distance;
+  }
+  Eigen::Isometry3d bad = Eigen::Isometry3d::Identity();
+  bad.translation().x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW((void)ik.solve(bad, std::vector<double>(7, 0.0)), vsd::Error);
+  std::vector<double> seed(7, 0.0);
+  seed[3] = std::numeric_limits<double>::infinity();
+  EXPECT_THROW((void)ik.solve(Eigen::Isometry3d::Identity(), seed), vsd::Error);
 }
 
 TEST(Ik, BadArgumentsAreErrors) {

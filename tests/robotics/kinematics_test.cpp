@@ -213,6 +213,25 @@ TEST(Kinematics, ReplicatedThroughTransactions) {
   EXPECT_TRUE(wrist->frame().isApprox(trees[0]->find_joint("wrist_3_joint")->motion_frame()));
 }
 
+// vsd::robotics has no floating or planar joint: they are kept fixed, and the caller is told so through
+// the warnings of build_kinematics() (vsd-robot printed nothing).
+TEST(Kinematics, FloatingAndPlanarJointsAreKeptFixedWithAWarning) {
+  Environment env;
+  env.use<Module>();
+  const std::string xml = R"(<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
+  <joint name="free" type="floating"><parent link="a"/><child link="b"/></joint>
+  <joint name="flat" type="planar"><parent link="b"/><child link="c"/><axis xyz="0 0 1"/></joint></robot>)";
+  const auto rep = scene::load_urdf_text(env.main_state().database(), xml, "r.urdf", ".");
+  std::vector<std::string> warnings;
+  KinematicTree& tree = build_kinematics(*rep.scene, &warnings);
+  EXPECT_EQ(tree.find_joint("free")->type(), KinematicJointType::Fixed);
+  EXPECT_EQ(tree.find_joint("flat")->type(), KinematicJointType::Fixed);
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_NE(warnings[0].find("joint 'free': a floating joint is kept fixed"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[1].find("joint 'flat': a planar joint is kept fixed"), std::string::npos) << warnings[1];
+  EXPECT_EQ(tree.model().dof(), 0);
+}
+
 TEST(Kinematics, SceneJointWithoutChildIsAnError) {
   Environment env;
   env.use<Module>();

@@ -243,6 +243,67 @@ TEST(Model, BadSpecificationsAreErrors) {
   EXPECT_THROW(m.forward(std::vector<double>{1, 2}, d), vsd::Error);
 }
 
+// A chain from a link to itself has no joints and no bodies: its FK is the base (tip() is -1). Before,
+// pose(tip()) read before the start of the model's arrays.
+TEST(Model, AChainOfNoJointsHasTheBaseAsItsPose) {
+  Loaded robot(read_text(robot_file("iiwa14.urdf")));
+  const Model same = robot.chain("iiwa_link_3", "iiwa_link_3");
+  EXPECT_EQ(same.dof(), 0);
+  EXPECT_EQ(same.body_count(), 0);
+  EXPECT_EQ(same.tip(), -1);
+  Model::Data d = same.make_data();
+  same.forward(std::vector<double>{}, d);
+  EXPECT_TRUE(same.pose(d, same.tip()).rotation.isIdentity(0.0));
+  EXPECT_TRUE(same.pose(d, same.tip()).translation.isZero(0.0));
+  Eigen::Matrix<double, 6, Eigen::Dynamic> j(6, 0);
+  same.jacobian(d, same.tip(), j);
+  // Through fixed joints only: no values, one body at the fixed joint's origin (0.045 m along z).
+  const Model fixed = robot.chain("iiwa_link_7", "iiwa_link_ee");
+  EXPECT_EQ(fixed.dof(), 0);
+  Model::Data df = fixed.make_data();
+  fixed.forward(std::vector<double>{}, df);
+  EXPECT_TRUE(fixed.pose(df, fixed.tip()).translation.isApprox(Eigen::Vector3d(0, 0, 0.045)));
+}
+
+// `vsd-robot fk` printed [inf, inf, inf]: finite origins and values can overflow (two origins of 1e308 m).
+// The checked forward() says so, naming the body; values that are not finite are refused before, and so
+// are non-finite origins, axes, limits and mimic factors when a model is built.
+TEST(Model, NonFiniteInputsAndOverflowingPosesAreErrors) {
+  const std::string far = R"(<robot name="far"><link name="a"/><link name="b"/><link name="c"/>
+  <joint name="j1" type="revolute"><parent link="a"/><child link="b"/><origin xyz="1e308 1e308 1e308"/>
+    <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <joint name="j2" type="prismatic"><parent link="b"/><child link="c"/><origin xyz="1e308 1e308 1e308"/>
+    <axis xyz="1 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>)";
+  Loaded robot(far);
+  const Model m = robot.chain("a", "c");
+  Model::Data d = m.make_data();
+  try {
+    m.forward(std::vector<double>{0, 0}, d);
+    FAIL();
+  } catch (const vsd::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the pose of body 'c' is not finite"), std::string::npos) << e.what();
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  try {
+    m.forward(std::vector<double>{0, nan}, d);
+    FAIL();
+  } catch (const vsd::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the value of 'j2' is not finite"), std::string::npos) << e.what();
+  }
+  const double inf = std::numeric_limits<double>::infinity();
+  auto specs = tree_specs();
+  specs[1].placement.pre.translation().x() = inf;
+  EXPECT_THROW((void)Model::build(specs), vsd::Error);
+  specs = tree_specs();
+  specs[0].has_limits = true;
+  specs[0].lower = -inf;
+  specs[0].upper = 1;
+  EXPECT_THROW((void)Model::build(specs), vsd::Error);
+  specs = tree_specs();
+  specs[3].mimic_multiplier = nan;
+  EXPECT_THROW((void)Model::build(specs), vsd::Error);
+}
+
 TEST(Model, TipNotBelowBaseIsAnError) {
   Loaded robot(read_text(robot_file("ur5_robot.urdf")));
   try {

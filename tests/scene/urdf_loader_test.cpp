@@ -1,14 +1,19 @@
-// URDF and mesh loading, save/load through vsd::io, replication.
+// URDF loading (limits, inputs, mesh paths, validation), save/load through vsd::io, replication.
 #include "vsd/scene/urdf_loader.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <sstream>
 #include <string>
+#include <thread>
 
+#include "files.hpp"
 #include "vsd/core.hpp"
 #include "vsd/io.hpp"
 #include "vsd/scene.hpp"
@@ -16,88 +21,9 @@
 namespace vsd::scene {
 namespace {
 
-namespace fs = std::filesystem;
+using namespace test;
+
 const fs::path data_dir = VSD_SCENE_TEST_DATA_DIR;
-
-bool any_contains(const std::vector<std::string>& v, std::string_view a, std::string_view b = {}) {
-  for (const auto& s : v)
-    if (s.find(a) != std::string::npos && s.find(b) != std::string::npos) return true;
-  return false;
-}
-
-class TempDir {
- public:
-  TempDir()
-      : path_(fs::temp_directory_path() /
-              ("vsd_scene_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter_++))) {
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  [[nodiscard]] const fs::path& path() const { return path_; }
-
- private:
-  static inline int counter_ = 0;
-  fs::path path_;
-};
-
-void write(const fs::path& p, const std::string& text) {
-  fs::create_directories(p.parent_path());
-  std::ofstream(p, std::ios::binary) << text;
-}
-
-// A unit cube as 12 triangles, corners at 0 and 1.
-const int cube_faces[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
-                               {2, 3, 7}, {2, 7, 6}, {1, 2, 6}, {1, 6, 5}, {0, 4, 7}, {0, 7, 3}};
-Eigen::Vector3d cube_corner(int i) {
-  return {double((i & 1) ^ ((i >> 1) & 1)), double((i >> 1) & 1), double(i >> 2)};
-}
-
-std::string ascii_stl() {
-  std::string s = "solid cube\n";
-  for (const auto& f : cube_faces) {
-    s += " facet normal 0 0 0\n  outer loop\n";
-    for (int i : f) {
-      const auto c = cube_corner(i);
-      s += "   vertex " + std::to_string(c.x()) + " " + std::to_string(c.y()) + " " + std::to_string(c.z()) +
-           "\n";
-    }
-    s += "  endloop\n endfacet\n";
-  }
-  return s + "endsolid cube\n";
-}
-
-std::string binary_stl() {
-  std::string s(80, ' ');
-  s.replace(0, 10, "binary cub");  // must not start with "solid"
-  auto put_u32 = [&](std::uint32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); };
-  auto put_f = [&](float v) { s.append(reinterpret_cast<const char*>(&v), 4); };
-  put_u32(12);
-  for (const auto& f : cube_faces) {
-    for (int k = 0; k < 3; ++k) put_f(0);
-    for (int i : f) {
-      const auto c = cube_corner(i);
-      put_f(float(c.x()));
-      put_f(float(c.y()));
-      put_f(float(c.z()));
-    }
-    s.append(2, '\0');
-  }
-  return s;
-}
-
-// A cube with quads (triangulated on load) and texture coordinates.
-std::string obj_cube() {
-  std::string s = "# cube\n";
-  for (int i = 0; i < 8; ++i) {
-    const auto c = cube_corner(i);
-    s += "v " + std::to_string(c.x()) + " " + std::to_string(c.y()) + " " + std::to_string(c.z()) + "\n";
-  }
-  s += "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 3 4 8 7\nf 2 3 7 6\nf 1 5 8 4\n";
-  return s;
-}
 
 class UrdfTest : public ::testing::Test {
  protected:
@@ -105,87 +31,6 @@ class UrdfTest : public ::testing::Test {
   Environment env;
   SimState& s = env.main_state();
 };
-
-TEST_F(UrdfTest, StlAsciiBinaryAndObjGiveTheCube) {
-  TempDir dir;
-  write(dir.path() / "a.stl", ascii_stl());
-  write(dir.path() / "b.stl", binary_stl());
-  write(dir.path() / "c.obj", obj_cube());
-  for (const char* name : {"a.stl", "b.stl", "c.obj"}) {
-    Geometry& g = s.create<Geometry>();
-    load_mesh(g, dir.path() / name);
-    EXPECT_EQ(g.kind(), GeometryKind::Mesh);
-    EXPECT_EQ(g.vertices().size(), 8u) << name;
-    EXPECT_EQ(g.facet_count(), 12u) << name;
-    EXPECT_EQ(g.normals().size(), 8u) << name;
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
-    for (const auto& v : g.vertices()) {
-      lo = lo.cwiseMin(v);
-      hi = hi.cwiseMax(v);
-    }
-    EXPECT_TRUE(lo.isApprox(Eigen::Vector3d::Zero())) << name;
-    EXPECT_TRUE(hi.isApprox(Eigen::Vector3d::Ones())) << name;
-    for (std::int32_t i : g.facets()) {
-      EXPECT_GE(i, 0);
-      EXPECT_LT(i, 8);
-    }
-  }
-}
-
-// A COLLADA file (what URDFs use for visual meshes): a tetrahedron in a node moved by 10 along x.
-const char* collada_tetrahedron = R"(<?xml version="1.0" encoding="utf-8"?>
-<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
-  <asset><unit name="meter" meter="1"/><up_axis>Z_UP</up_axis></asset>
-  <library_geometries>
-    <geometry id="tet" name="tet"><mesh>
-      <source id="tet-pos"><float_array id="tet-pos-array" count="12">0 0 0 1 0 0 0 1 0 0 0 1</float_array>
-        <technique_common><accessor source="#tet-pos-array" count="4" stride="3">
-          <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
-        </accessor></technique_common></source>
-      <vertices id="tet-vtx"><input semantic="POSITION" source="#tet-pos"/></vertices>
-      <triangles count="4"><input semantic="VERTEX" source="#tet-vtx" offset="0"/><p>0 2 1 0 1 3 0 3 2 1 2 3</p></triangles>
-    </mesh></geometry>
-  </library_geometries>
-  <library_visual_scenes>
-    <visual_scene id="scene"><node id="n"><translate>10 0 0</translate><instance_geometry url="#tet"/></node></visual_scene>
-  </library_visual_scenes>
-  <scene><instance_visual_scene url="#scene"/></scene>
-</COLLADA>
-)";
-
-TEST_F(UrdfTest, ColladaMeshWithNodeTransform) {
-  TempDir dir;
-  write(dir.path() / "tet.dae", collada_tetrahedron);
-  Geometry& g = s.create<Geometry>();
-  load_mesh(g, dir.path() / "tet.dae");
-  EXPECT_EQ(g.vertices().size(), 4u);
-  EXPECT_EQ(g.facet_count(), 4u);
-  double min_x = 1e9;
-  for (const auto& v : g.vertices()) min_x = std::min(min_x, v.x());
-  EXPECT_NEAR(min_x, 10.0, 1e-9);  // the node's transform is baked in
-}
-
-TEST_F(UrdfTest, BadMeshFilesAreErrorsNamingTheFile) {
-  TempDir dir;
-  Geometry& g = s.create<Geometry>();
-  try {
-    load_mesh(g, dir.path() / "missing.stl");
-    FAIL();
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("missing.stl"), std::string::npos) << e.what();
-  }
-  write(dir.path() / "junk.stl", "solid x\n facet normal 0 0 garbage\n");
-  write(dir.path() / "empty.obj", "# nothing\n");
-  for (const char* name : {"junk.stl", "empty.obj"}) {
-    try {
-      load_mesh(g, dir.path() / name);
-      FAIL() << name;
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
-    }
-  }
-  EXPECT_TRUE(g.vertices().empty());
-}
 
 TEST_F(UrdfTest, Iiwa14LoadsWithoutItsMeshes) {
   const SceneReport r = load_urdf(s.database(), data_dir / "iiwa14.urdf");
@@ -257,7 +102,7 @@ TEST_F(UrdfTest, PackagePathsResolveMeshes) {
   const std::string urdf = R"(<robot name="cuberobot">
   <material name="red"><color rgba="1 0 0 1"/></material>
   <link name="base">
-    <inertial><origin xyz="0 0 0.5"/><mass value="2"/><inertia ixx="1" ixy="0.1" ixz="0.2" iyy="2" iyz="0.3" izz="3"/></inertial>
+    <inertial><origin xyz="0 0 0.5"/><mass value="2"/><inertia ixx="2" ixy="0.1" ixz="0.2" iyy="2.5" iyz="0.3" izz="3"/></inertial>
     <visual><origin xyz="0 0 1"/><geometry><mesh filename="package://cuberobot/meshes/cube.stl" scale="2 2 2"/></geometry><material name="red"/></visual>
     <collision><geometry><mesh filename="package://cuberobot/meshes/cube.stl" scale="2 2 2"/></geometry></collision>
   </link>
@@ -390,6 +235,221 @@ TEST_F(UrdfTest, ReplicationThroughARecordedTransaction) {
   EXPECT_TRUE(rtool->world_frame().isApprox(tool->world_frame()));
   EXPECT_NEAR(rtool->world_frame().translation().y() - tool->frame().translation().y(), 3.0, 1.0);
   EXPECT_TRUE(replica.equals(s, &diff)) << diff;
+}
+
+
+// ---- limits, inputs, paths, validation ----------------------------------------------------------------
+
+std::string load_error(SimState& s, std::string_view xml, const fs::path& base = ".") {
+  try {
+    (void)load_urdf_text(s.database(), xml, "t.urdf", base);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// `depth` elements nested inside <robot> (which has one link), starting on line 2.
+std::string nested_urdf(int depth) {
+  std::string xml = "<robot name=\"r\"><link name=\"a\"/>\n";
+  xml.reserve(xml.size() + 8 * static_cast<std::size_t>(depth));
+  for (int i = 0; i < depth; ++i) xml += "<x>";
+  for (int i = 0; i < depth; ++i) xml += "</x>";
+  return xml + "</robot>\n";
+}
+
+// 100,000 levels crashed in urdfdom's XML parser (it recurses per level) and 20,000 took 3.5 s: the text
+// is refused before urdfdom sees it, at the element that crosses the limit.
+TEST_F(UrdfTest, DeeplyNestedXmlIsRefusedBeforeParsing) {
+  const std::string what = load_error(s, nested_urdf(100000));
+  EXPECT_NE(what.find("t.urdf:2:2998: URDF nests elements deeper than 1000 levels"), std::string::npos) << what;
+  // The limit itself is fine (<robot> is level 1): the unknown elements are a warning.
+  const SceneReport r = load_urdf_text(s.database(), nested_urdf(999), "ok.urdf", ".");
+  EXPECT_TRUE(any_contains(r.warnings, "<x>", "not supported"));
+  EXPECT_NE(load_error(s, nested_urdf(1000)).find("deeper than 1000"), std::string::npos);
+}
+
+TEST_F(UrdfTest, TooManyElementsOrBytesAreRefusedBeforeParsing) {
+  std::string many = "<robot name=\"r\"><link name=\"a\"/>";
+  for (std::size_t i = 0; i < max_urdf_elements; ++i) many += "<x/>";
+  many += "</robot>";
+  EXPECT_NE(load_error(s, many).find("URDF has more than 1000000 elements"), std::string::npos);
+  std::string big(max_urdf_bytes + 1, ' ');
+  EXPECT_NE(load_error(s, big).find("URDF of 67108865 bytes is larger than the limit of 67108864 bytes"),
+            std::string::npos);
+}
+
+// Markup inside comments, CDATA, processing instructions, declarations and attribute values is not
+// nesting: a document full of it loads.
+TEST_F(UrdfTest, MarkupInCommentsAndAttributesIsNotNesting) {
+  std::string xml = "<?xml version=\"1.0\"?>\n<!DOCTYPE robot>\n";
+  xml += "<robot name=\"r\">";
+  for (int i = 0; i < 2000; ++i) xml += "<!-- <a><a> --><?pi <a>?>";
+  xml += "<link name=\"a\"><visual name=\"<a><a>\"><geometry><box size=\"1 1 1\"/></geometry></visual></link>";
+  xml += "<x><![CDATA[<a><a><a>]]></x></robot>";
+  const SceneReport r = load_urdf_text(s.database(), xml, "ok.urdf", ".");
+  EXPECT_EQ(r.links, 1u);
+}
+
+TEST_F(UrdfTest, ADirectoryIsADirectory) {
+  TempDir dir;
+  try {
+    (void)load_urdf(s.database(), dir.path());
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is a directory, not a URDF file"), std::string::npos) << e.what();
+  }
+  try {
+    (void)load_urdf(s.database(), dir.path() / "absent.urdf");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot open the URDF file: No such file"), std::string::npos)
+        << e.what();
+  }
+}
+
+const char* small_urdf = R"(<robot name="small"><link name="a"/><link name="b"/>
+  <joint name="j" type="continuous"><parent link="a"/><child link="b"/></joint></robot>)";
+
+// The text is read whole before urdfdom parses it, so anything that reads like a file works: a FIFO
+// (a pipe, `<(...)` in a shell) and standard input as "-".
+TEST_F(UrdfTest, PipesAndStandardInputAreRead) {
+  TempDir dir;
+  const fs::path fifo = dir.path() / "robot.urdf";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&] { std::ofstream(fifo) << small_urdf; });
+  const SceneReport r = load_urdf(s.database(), fifo);
+  writer.join();
+  EXPECT_EQ(r.joints, 1u);
+  std::istringstream in(small_urdf);
+  std::streambuf* old = std::cin.rdbuf(in.rdbuf());
+  const SceneReport r2 = load_urdf(s.database(), "-");
+  std::cin.rdbuf(old);
+  EXPECT_EQ(r2.links, 2u);
+  EXPECT_EQ(r2.scene->source(), "standard input");
+}
+
+std::string mesh_urdf(const std::vector<std::string>& files) {
+  std::string xml = "<robot name=\"r\"><link name=\"a\">";
+  for (const auto& f : files) xml += "<visual><geometry><mesh filename=\"" + f + "\"/></geometry></visual>";
+  return xml + "</link></robot>";
+}
+
+// Mesh references were opened wherever they pointed. Now each must lead (after `..` and symbolic links)
+// into the URDF's folder or a package path, to a regular file; otherwise it is not read, with a warning.
+TEST_F(UrdfTest, MeshReferencesStayInsideTheUrdfFolderAndThePackagePaths) {
+  TempDir dir;
+  const fs::path robot = dir.path() / "robot";
+  write(dir.path() / "outside.stl", binary_stl());
+  write(robot / "inside.stl", binary_stl());
+  write(dir.path() / "pkgs" / "p" / "m.stl", binary_stl());
+  fs::create_symlink(dir.path() / "outside.stl", robot / "link.stl");
+  ASSERT_EQ(::mkfifo((robot / "fifo.stl").c_str(), 0600), 0);
+  const std::string out = (dir.path() / "outside.stl").string();
+  const std::vector<std::string> refused = {"../outside.stl",    out,
+                                            "file://" + out,     "link.stl",
+                                            "/etc/passwd",       "/proc/self/environ",
+                                            "package://p/../../outside.stl"};
+  std::vector<std::string> refs = refused;
+  refs.insert(refs.end(), {"fifo.stl", "http://example.com/m.stl", "inside.stl", "package://p/m.stl",
+                           "absent.stl"});
+  UrdfOptions o;
+  o.package_paths = {dir.path() / "pkgs"};
+  const SceneReport r = load_urdf_text(s.database(), mesh_urdf(refs), "r.urdf", robot, o);
+  EXPECT_EQ(r.meshes_loaded, 2u);  // inside.stl, package://p/m.stl
+  for (const auto& ref : refused)
+    EXPECT_TRUE(any_contains(r.warnings, "mesh '" + ref + "' not read: ", "is outside the folders")) << ref;
+  EXPECT_TRUE(any_contains(r.warnings, "mesh 'fifo.stl' not read: ", "is not a regular file"));
+  EXPECT_TRUE(any_contains(r.warnings, "mesh 'http://example.com/m.stl' not read: URI scheme 'http'"));
+  EXPECT_TRUE(any_contains(r.warnings, "mesh 'absent.stl' not found"));
+  EXPECT_TRUE(any_contains(r.warnings, "UrdfOptions::allow_paths_outside permits it"));
+  // The caller may allow it (regular files only, still).
+  o.allow_paths_outside = true;
+  const SceneReport all = load_urdf_text(s.database(), mesh_urdf({"../outside.stl", out, "link.stl", "fifo.stl"}),
+                                         "r.urdf", robot, o);
+  EXPECT_EQ(all.meshes_loaded, 3u);
+  EXPECT_TRUE(any_contains(all.warnings, "mesh 'fifo.stl' not read: ", "is not a regular file"));
+  // The files a mesh pulls in obey the same rule.
+  write(dir.path() / "secret.mtl", "newmtl red\nKd 1 0 0\n");
+  write(robot / "cube.obj", "mtllib ../secret.mtl\nusemtl red\n" + obj_cube());
+  const SceneReport obj = load_urdf_text(s.database(), mesh_urdf({"cube.obj"}), "r.urdf", robot);
+  EXPECT_EQ(obj.meshes_loaded, 1u);
+  EXPECT_TRUE(any_contains(obj.warnings, "mesh 'cube.obj': ", "secret.mtl' is outside the folders"));
+}
+
+// What no body, joint or shape can be is an error naming the link or joint and the field (all of them at
+// once, and nothing is created); what is legal but cannot be simulated as written is a warning.
+TEST_F(UrdfTest, ValuesAreValidated) {
+  const std::size_t before = s.size();
+  const std::string bad = R"(<robot name="bad">
+  <link name="heavy"><inertial><mass value="-1"/><inertia ixx="-0.1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+    <collision><geometry><cylinder radius="-0.5" length="1"/></geometry></collision>
+    <visual><geometry><box size="1 -2 1"/></geometry></visual>
+    <visual><geometry><sphere radius="-1"/></geometry></visual></link>
+  <link name="b"/><link name="c"/><link name="d"/>
+  <joint name="j1" type="revolute"><parent link="heavy"/><child link="b"/><axis xyz="0 0 1"/>
+    <limit lower="1" upper="-1" effort="1" velocity="1"/><mimic joint="j2"/></joint>
+  <joint name="j2" type="revolute"><parent link="b"/><child link="c"/><axis xyz="0 0 0"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/><mimic joint="j1"/></joint>
+  <joint name="j3" type="continuous"><parent link="c"/><child link="d"/><mimic joint="j3"/></joint>
+</robot>)";
+  const std::string what = load_error(s, bad);
+  for (const char* expected :
+       {"t.urdf: not a valid URDF", "link 'heavy' <inertial> <mass>: -1 kg is negative",
+        "link 'heavy' <inertial> <inertia> ixx: -0.1 kg m^2 is negative",
+        "link 'heavy' collision <cylinder>: radius -0.5 is negative", "link 'heavy' visual <box>: size y -2 is negative",
+        "link 'heavy' visual 1 <sphere>: radius -1 is negative", "joint 'j1' <limit>: lower 1 is above upper -1",
+        "joint 'j2' <axis>: the axis is zero", "<mimic>: a mimic cycle 'j1' -> 'j2' -> 'j1'",
+        "joint 'j3' <mimic>: a mimic cycle 'j3' -> 'j3'"})
+    EXPECT_NE(what.find(expected), std::string::npos) << expected << "\n" << what;
+  EXPECT_EQ(s.size(), before);
+  const std::string odd = R"(<robot name="odd">
+  <link name="flat"><inertial><mass value="1"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>
+    <collision><geometry><box size="1 0 1"/></geometry></collision></link>
+  <link name="rod"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="3"/></inertial>
+    <collision><geometry><sphere radius="0"/></geometry></collision></link>
+  <joint name="j" type="prismatic"><parent link="flat"/><child link="rod"/><axis xyz="1 0 0"/>
+    <limit lower="0" upper="1" effort="-1" velocity="1"/><dynamics damping="-2"/></joint>
+</robot>)";
+  const SceneReport r = load_urdf_text(s.database(), odd, "odd.urdf", ".");
+  EXPECT_TRUE(any_contains(r.warnings, "link 'flat' <inertial> <inertia>: not positive definite"));
+  EXPECT_TRUE(any_contains(r.warnings, "link 'rod' <inertial> <inertia>: principal moment 3 exceeds"));
+  EXPECT_TRUE(any_contains(r.warnings, "link 'flat' collision <box>: size y is 0"));
+  EXPECT_TRUE(any_contains(r.warnings, "link 'rod' collision <sphere>: radius is 0"));
+  EXPECT_TRUE(any_contains(r.warnings, "joint 'j' <limit> effort: -1 is negative"));
+  EXPECT_TRUE(any_contains(r.warnings, "joint 'j' <dynamics> damping: -2 is negative"));
+}
+
+// The example model with primitive hulls loads without a single warning: 8 links with the original's
+// inertials, 22 hulls (visual and collision alike), no mesh.
+TEST_F(UrdfTest, ThePrimitiveIiwaIsCompleteWithoutMeshes) {
+  const SceneReport r = load_urdf(s.database(), data_dir / "iiwa14_primitives.urdf");
+  EXPECT_TRUE(r.warnings.empty()) << r.warnings[0];
+  EXPECT_EQ(r.links, 11u);
+  EXPECT_EQ(r.joints, 10u);
+  EXPECT_EQ(r.hulls, 22u);
+  EXPECT_EQ(r.meshes_loaded, 0u);
+  const SceneReport original = load_urdf(s.database(), data_dir / "iiwa14.urdf");
+  for (const Link* l : original.scene->links()) {
+    const Link* p = r.scene->find_link(l->name());
+    ASSERT_NE(p, nullptr) << l->name();
+    EXPECT_EQ(p->mass(), l->mass()) << l->name();
+    EXPECT_TRUE(p->inertia().isApprox(l->inertia())) << l->name();
+    EXPECT_TRUE(p->world_frame().isApprox(l->world_frame())) << l->name();
+  }
+}
+
+// The shipped descriptions load without a validation message.
+TEST_F(UrdfTest, ShippedDescriptionsAreValid) {
+  for (const char* name : {"iiwa14.urdf", "ur5_robot.urdf", "iiwa14_primitives.urdf"}) {
+    UrdfOptions o;
+    o.load_meshes = false;
+    const SceneReport r = load_urdf(s.database(), data_dir / name, o);
+    for (const auto& w : r.warnings) {
+      EXPECT_EQ(w.find("<inertia>"), std::string::npos) << name << ": " << w;
+      EXPECT_EQ(w.find("<limit>"), std::string::npos) << name << ": " << w;
+    }
+  }
 }
 
 }  // namespace

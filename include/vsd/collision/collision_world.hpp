@@ -87,6 +87,9 @@ struct Options {
   bool include_visual = false;
   /// Contact points computed per pair of hulls (at least 1).
   std::size_t max_contacts_per_pair = 4;
+  /// Contact points one update() may find in all (hulls overlapping en masse would otherwise fill memory):
+  /// beyond it update() stops the query and throws vsd::Error, keeping the previous contacts.
+  std::size_t max_contacts = 100'000;
   /// Pairs for which this returns false are never in contact (e.g. hulls of one rigid body).
   std::function<bool(const scene::Hull&, const scene::Hull&)> pair_filter;
 };
@@ -114,7 +117,10 @@ class CollisionWorld {
   /// @brief Applies the pending changes (sync()), computes all contacts, and emits on_contact_end()
   /// then on_contact_begin() for the pairs that changed since the previous update().
   /// @throws vsd::Error naming the hulls, shapes and poses when a hull is degenerate (it is left out;
-  /// everything else is current and signalled) or when FCL fails on a pair.
+  /// everything else is current and signalled) or when FCL fails on a pair. When the contact points
+  /// exceed Options::max_contacts or memory runs out, vsd::Error too, but then contacts, pairs and
+  /// signals stay as the previous update() left them; an exception thrown by the pair filter stops the
+  /// query the same way and is rethrown as it is. Nothing is ever thrown through FCL.
   void update();
   /// @brief Applies the pending changes to poses, shapes and the broadphase without computing
   /// contacts. Queries call it themselves. Never throws for degenerate hulls (see problems()).

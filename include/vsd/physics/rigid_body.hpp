@@ -3,10 +3,13 @@
  *  vsd::physics. Its collision hulls are the Hulls of role Collision below the node (down to the next
  *  node with a RigidBody of its own), the node itself included when it is a Hull.
  *
- *  Mass: `mass` > 0 sets it; 0 derives it from the collision hulls (volume times the density of their
- *  Material) or, on a scene::Link with a mass, from the link's inertial data. `inertia_diagonal` and
- *  `inertia_products` (about `center_of_mass`, in node axes) override the derived tensor when non-zero.
- *  A body whose mass cannot be found this way is an error (vsd::Error from the next step).
+ *  Mass: on a scene::Link whose mass is not 0, the link's inertial data (mass, centre of mass, inertia —
+ *  a URDF's <inertial>) is what the body is, whatever collision hulls the link has (they only collide);
+ *  a negative or non-finite link mass is an error. Otherwise mass and inertia are derived from the
+ *  collision hulls (volume times the density of their Material). `mass` > 0 scales either to that mass.
+ *  `inertia_diagonal` and `inertia_products` (about `center_of_mass`, in node axes), when non-zero,
+ *  override both (with `mass` > 0). A body whose mass cannot be found this way is an error (vsd::Error
+ *  from the next step).
  *
  *  The velocities are written back after each step (world coordinates; the linear one is that of the
  *  centre of mass); a velocity set by anyone else is given to ODE before the next step. `force` and `torque`

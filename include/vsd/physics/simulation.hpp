@@ -31,6 +31,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -45,6 +46,11 @@ class Scene;
 }
 
 namespace vsd::physics {
+
+/// At most this many ODE steps per World in one Simulation::advance() (1000 s at the default step of 1 ms).
+inline constexpr std::uint64_t max_steps_per_advance = 1'000'000;
+/// At most this many contact points in one step of one World (each is an ODE contact joint).
+inline constexpr std::size_t max_contacts_per_step = 100'000;
 
 /// @brief The mass properties ODE uses for a body, in the body node's frame.
 struct MassProperties {
@@ -78,8 +84,10 @@ class Simulation {
   void sync();
   /// @brief Advances every world by @p seconds: sync(), as many fixed steps of each World's `step` as
   /// fit (the remainder is carried to the next call), then writes poses and velocities back.
-  /// @throws vsd::Error as sync(), and when a step produced a non-finite pose (the database keeps
-  /// the last good state; the next sync rebuilds ODE from it).
+  /// @throws vsd::Error for a negative or non-finite @p seconds and when a World would need more than
+  /// max_steps_per_advance steps for it (nothing changes then); as sync(); and when a step produced a
+  /// non-finite pose, more than max_contacts_per_step contact points or ran out of memory (the database
+  /// keeps the last good state; the next sync rebuilds ODE from it).
   void advance(double seconds);
   /// @brief Adds @p force (N, world) acting at @p point (world) to @p body's accumulators: the force,
   /// and the torque (point - centre of mass) x force. @throws vsd::Error when @p body is not simulated.

@@ -105,8 +105,10 @@ class Model {
 
   /// @brief Compiles the tree below @p base (every descendant Node3D; a node without a KinematicJoint is
   /// fixed at its `frame`), or, with @p tip, only the chain from @p base down to @p tip.
+  /// With @p tip == @p base the chain has no bodies and no joints: its FK is the base itself (tip() is
+  /// -1, see pose()).
   /// @throws vsd::Error when @p tip is not below @p base, or a joint is malformed (zero axis, lower > upper,
-  /// a DH universal joint, a mimic cycle).
+  /// a non-finite origin, axis, limit or mimic factor, a DH universal joint, a mimic cycle).
   static Model compile(const scene::Node3D& base, const scene::Node3D* tip = nullptr);
   /// @brief Builds a model from plain data (bodies in order; a parent precedes its children).
   /// @throws vsd::Error as compile() does, and for a parent index out of range.
@@ -124,7 +126,7 @@ class Model {
   }
   /// @brief Index of the body named @p name, or -1.
   [[nodiscard]] int find_body(std::string_view name) const noexcept;
-  /// @brief Index of the last body (the tip of a chain).
+  /// @brief Index of the last body (the tip of a chain); -1, the base, when the model has no bodies.
   [[nodiscard]] int tip() const noexcept { return body_count() - 1; }
 
   /// @brief A Data sized for this model.
@@ -135,14 +137,19 @@ class Model {
   /// elsewhere, or with the environment variable VSD_ROBOTICS_NO_AVX=1 set when the model is built, in
   /// the portable SSE2 form. Both give the same frames bit for bit.
   void forward(const double* q, Data& data) const noexcept;
-  /// @brief Forward kinematics; @throws vsd::Error when @p q does not have dof() values.
+  /// @brief Forward kinematics, checked: @throws vsd::Error when @p q does not have dof() values or holds
+  /// a value that is not finite (naming the joint), and when a resulting pose is not finite (values or
+  /// origins so large that the products overflow; naming the body) — @p data holds those poses then.
   void forward(std::span<const double> q, Data& data) const;
-  /// @brief Pose of body @p body in the base frame (after forward()).
+  /// @brief Pose of body @p body in the base frame (after forward()); body -1 is the base (identity).
   [[nodiscard]] const Frame& pose(const Data& data, int body) const noexcept {
+    static const Frame base{};
+    if (body < 0) return base;
     return data.segment[static_cast<std::size_t>(body_segment_[static_cast<std::size_t>(body)])];
   }
   /// @brief Geometric Jacobian of body @p body's origin in the base frame (after forward()): 6 x dof(),
-  /// linear velocity rows first, then angular. Columns of joints not on the body's path are zero.
+  /// linear velocity rows first, then angular. Columns of joints not on the body's path are zero (all of
+  /// them for body -1, the base).
   void jacobian(const Data& data, int body,
                 Eigen::Ref<Eigen::Matrix<double, 6, Eigen::Dynamic>> out) const noexcept;
   /// @brief Clamps @p q into the joint limits.
