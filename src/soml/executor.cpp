@@ -1,7 +1,7 @@
 // The SOML++ net executor (docs/soml.md, 5.2 and 5.3): transitions are re-tested only when something
 // they read changed — an input place (known from the arrows) or a property their condition or arrow
-// conditions read the last time they ran (recorded by the VM) — heard through the SimState's property
-// signal. Among the enabled transitions one is chosen with a seeded generator, so runs are
+// conditions read the last time they ran (recorded by the VM) — heard through a vsd::Watch that covers
+// just the class properties some test read. Among the enabled transitions one is chosen with a seeded generator, so runs are
 // reproducible. Every firing changes markings through the setters of the place nodes.
 #include <algorithm>
 #include <limits>
@@ -235,6 +235,7 @@ bool ProgramImpl::test(TI& ti) {
       whole_instance_deps_ = whole_instance_deps_ || prop == nullptr;
       ti.deps.push_back(DepKey{id, prop});
       auto& v = deps_map_[DepKey{id, prop}];
+      if (v.empty()) cover(id, prop);
       v.insert(std::upper_bound(v.begin(), v.end(), index), index);
     }
   }

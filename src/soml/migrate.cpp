@@ -473,8 +473,7 @@ MigrationReport migrate(ProgramImpl& old, ProgramImpl& nw, std::string name, std
   }
 
   MigrationReport report;
-  old.listener_.disconnect();
-  old.deleted_listener_.disconnect();
+  old.stop_listening();
   {
     Savepoint sp(state);
     try {
@@ -487,8 +486,7 @@ MigrationReport migrate(ProgramImpl& old, ProgramImpl& nw, std::string name, std
       } catch (const Error& r) {
         extra = "; rolling back failed too: " + std::string(r.what());
       }
-      nw.listener_.disconnect();
-      nw.deleted_listener_.disconnect();
+      nw.stop_listening();
       undefine_new();
       retired.restore();
       old.connect_listeners();
@@ -496,8 +494,7 @@ MigrationReport migrate(ProgramImpl& old, ProgramImpl& nw, std::string name, std
       throw Error(std::string(e.what()) + extra);
     } catch (...) {
       sp.rollback();
-      nw.listener_.disconnect();
-      nw.deleted_listener_.disconnect();
+      nw.stop_listening();
       undefine_new();
       retired.restore();
       old.connect_listeners();
@@ -578,8 +575,7 @@ void Program::follow_reload(std::string name, std::string text, const Transactio
 
   // The bundle creates the new version's instances and deletes the old ones (checked whole first: one
   // that does not apply changes nothing); then the new version attaches to what it made.
-  old.listener_.disconnect();
-  old.deleted_listener_.disconnect();
+  old.stop_listening();
   {
     Savepoint sp(state);
     bool applied = false;
@@ -590,8 +586,7 @@ void Program::follow_reload(std::string name, std::string text, const Transactio
       fresh->populate();
       sp.commit();
     } catch (const Error& e) {
-      fresh->listener_.disconnect();
-      fresh->deleted_listener_.disconnect();
+      fresh->stop_listening();
       std::string extra;
       try {
         sp.rollback();

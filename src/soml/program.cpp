@@ -42,8 +42,7 @@ ProgramImpl::ProgramImpl(SimState& state, RunOptions options)
     : registry_(state.environment().registry()), state_(state), opt_(options) {}
 
 ProgramImpl::~ProgramImpl() {
-  listener_.disconnect();
-  deleted_listener_.disconnect();
+  stop_listening();
   release_uses(true);
 }
 
@@ -103,8 +102,9 @@ void ProgramImpl::release_uses(bool undefine) noexcept {
 // program that went while its state lived on, whose instances are gone now — and go before a load, so
 // that a script loads again under its names (docs/soml.md 8.1). Repeated while it makes progress: a class
 // goes after its subclasses and after the classes whose properties name it.
-void ProgramImpl::sweep_leftovers() {
-  Registry& reg = registry_;
+void ProgramImpl::sweep_leftovers() { sweep_soml_leftovers(registry_); }
+
+void sweep_soml_leftovers(Registry& reg) {
   auto garbage_class = [&](const MetaInstance* m) {
     return m->is_runtime() && m->name().starts_with("soml::") && m->live_instances() == 0 && users_of(m) == 0;
   };
@@ -228,8 +228,7 @@ void ProgramImpl::load_or_undo(std::string name, std::string text) {
     sp.commit();
   } catch (...) {
     // The instances first (a class with instances cannot go), then the classes, subclasses first.
-    listener_.disconnect();
-    deleted_listener_.disconnect();
+    stop_listening();
     try {
       sp.rollback();
     } catch (const Error&) {  // NOLINT(bugprone-empty-catch): the load's error says more; classes with
@@ -803,9 +802,30 @@ void ProgramImpl::define(std::string name, std::string text) {
 }
 
 void ProgramImpl::connect_listeners() {
-  listener_ = state_.on_property_changed().connect(
-      [this](SimStateInstance& inst, const MetaProperty& p) { on_change(inst, p); });
-  deleted_listener_ = state_.on_deleted().connect([this](SimStateInstance& inst) { on_deleted(inst); });
+  watch_.emplace(state_, [this](SimStateInstance& inst, const MetaProperty* p, Changes what) {
+    if (what.has(Changes::deleted))
+      on_deleted(inst);
+    else if (p != nullptr)
+      on_change(inst, *p);
+  });
+  // Nets, places, transitions and the executor are nodes: a deletion of any of them stops a net.
+  watch_->deleted(Node::static_meta())
+      .properties(Place::static_meta(), {&Place::vsd_prop_tokens(), &Place::vsd_prop_objects()});
+  // What the tests read so far (a program that listens again after a failed live reload).
+  covered_properties_.clear();
+  covered_classes_.clear();
+  for (const auto& [key, watchers] : deps_map_) cover(key.id, key.prop);
+}
+
+void ProgramImpl::cover(std::uint64_t id, const MetaProperty* prop) {
+  if (!watch_) return;
+  if (prop != nullptr) {
+    if (covered_properties_.insert(prop).second) watch_->properties(prop->owner(), {prop});
+    return;
+  }
+  // A test called a C++ method of instance @p id, which may read any property of it.
+  const SimStateInstance* o = state_.find(id);
+  if (o != nullptr && covered_classes_.insert(&o->meta()).second) watch_->all_properties(o->meta());
 }
 
 std::vector<const MetaInstance*> ProgramImpl::runtime_classes() const {
@@ -1026,20 +1046,18 @@ void ProgramImpl::register_net(std::unique_ptr<NetInst> net, const ClassInfo& ci
 }
 
 namespace {
-// Every live program by the SimState it runs (a few per process: a linear search is enough).
-std::mutex programs_mutex;
-std::vector<std::pair<const SimState*, std::weak_ptr<ProgramImpl>>>& programs_by_state() {
-  static std::vector<std::pair<const SimState*, std::weak_ptr<ProgramImpl>>> all;
-  return all;
-}
+// The live programs of one state (in its context): a C++ call of a script method on an instance finds
+// the program that runs the instance's state there (dispatch). Expired entries are swept on registering.
+struct StatePrograms {
+  std::vector<std::weak_ptr<ProgramImpl>> programs;
+};
 }  // namespace
 
 void ProgramImpl::register_program() {
   {
-    std::lock_guard lock(programs_mutex);
-    auto& all = programs_by_state();
-    std::erase_if(all, [](const auto& e) { return e.second.expired(); });
-    all.emplace_back(&state_, weak_self_);
+    auto& all = state_.context().get_or_emplace<StatePrograms>().programs;
+    std::erase_if(all, [](const auto& w) { return w.expired(); });
+    all.push_back(weak_self_);
   }
   if (!counted_) {  // from now on a user of its classes (release_uses)
     std::lock_guard lock(users_mutex);
@@ -1056,16 +1074,13 @@ Value ProgramImpl::dispatch(const std::weak_ptr<ProgramImpl>& weak, int fi, cons
   // Another program runs this instance's state with the same classes (a replica's, or the program that
   // attached again after this one went): its function of the same name.
   std::shared_ptr<ProgramImpl> other;
-  {
-    std::lock_guard lock(programs_mutex);
-    for (const auto& [state, w] : programs_by_state()) {
-      if (state != &self.state()) continue;
+  if (const auto* live = self.state().context().find<StatePrograms>())
+    for (const auto& w : live->programs) {
       std::shared_ptr<ProgramImpl> q = w.lock();
       if (!q) continue;
       for (const auto& [decl, m] : q->scope_meta_)
         if (m == &self.meta()) other = q;
     }
-  }
   if (!other)
     throw Error("no SOML++ program runs the state of " + self.meta().name() + " #" +
                 std::to_string(self.id()) + " (its program was unloaded, or the state was never attached)");

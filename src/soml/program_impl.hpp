@@ -4,9 +4,11 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "vsd/core/meta_instance.hpp"
@@ -14,6 +16,7 @@
 #include "vsd/core/sim_state.hpp"
 #include "vsd/core/type_builder.hpp"
 #include "vsd/core/value.hpp"
+#include "vsd/core/watch.hpp"
 #include "vsd/soml/checker.hpp"
 #include "vsd/soml/net_classes.hpp"
 #include "vsd/soml/runtime.hpp"
@@ -301,6 +304,10 @@ inline std::size_t pc_index(const Frame& f) noexcept {
   return f.pc > fn.code.data() ? static_cast<std::size_t>(f.pc - fn.code.data()) - 1 : 0;
 }
 
+// Undefines the SOML++ run-time classes and enums of @p registry that no live program uses and no
+// instance holds (left by programs that went while their states lived on), subclasses first.
+void sweep_soml_leftovers(Registry& registry);
+
 class ProgramImpl {
  public:
   ProgramImpl(SimState& state, RunOptions options);
@@ -346,7 +353,7 @@ class ProgramImpl {
   // running version's classes itself).
   void release_uses(bool undefine) noexcept;
   // Before a definition: undefines the SOML++ classes and enums no program uses and no instance holds.
-  void sweep_leftovers();
+  void sweep_leftovers();  // sweep_soml_leftovers(registry_)
   // Program::load and Program::attach: define and populate, all or nothing (a refused load leaves the
   // Registry and the SimState as they were).
   void load_or_undo(std::string name, std::string text);
@@ -549,8 +556,14 @@ class ProgramImpl {
   std::unordered_map<DepKey, std::vector<std::uint32_t>, DepHash> deps_map_;
   bool whole_instance_deps_ = false;  // some test called a C++ method: deps_map_ has (id, null) keys
   std::vector<std::pair<std::uint64_t, const MetaProperty*>> dep_scratch_;
-  Connection listener_;
-  Connection deleted_listener_;
+  // What the executor hears (connect_listeners): markings of places, deletions of nodes, and the class
+  // properties that some test read (cover). Per class, so instances of classes no condition reads keep
+  // their one-branch setters while a program is loaded.
+  std::optional<Watch> watch_;
+  std::unordered_set<const MetaProperty*> covered_properties_;  // watched for some test
+  std::unordered_set<const MetaInstance*> covered_classes_;     // all properties watched (C++ methods)
+  void cover(std::uint64_t id, const MetaProperty* prop);
+  void stop_listening() noexcept { watch_.reset(); }
   std::unordered_map<std::uint64_t, NetInst*> node_net_;  // owner, place and transition ids -> net
   void on_deleted(SimStateInstance& inst);
   std::uint64_t rng_ = 1;
