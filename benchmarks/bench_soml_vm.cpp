@@ -8,6 +8,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <unordered_map>
 
 #include "vsd/core.hpp"
 #include "vsd/soml.hpp"
@@ -242,6 +243,111 @@ void BM_SomlRetestAfterChange(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_SomlRetestAfterChange)->Arg(1)->Arg(100)->Arg(10000);
+
+// ---- What a loaded program costs the setters of its state (issue 21) ----------------------------------
+// A program's executor hears changes through a per-class vsd::Watch of what its conditions read. A typed
+// set on an instance of a class no condition reads keeps the one-branch fast path: compare
+// BM_SomlSetUnwatched/0 (no program) with /1 (a program whose condition reads another class). A set of a
+// property a condition reads reaches the executor (BM_SomlSetWatched/0: the program's own watch) and is
+// compared with the path every set took before, a state-wide property listener doing the executor's
+// (instance, property) lookup (BM_SomlSetWatched/1: no program, that listener and lookup table alone — the
+// old executor's hearing, without its marking work, so the comparison favours the old path).
+class BenchTank : public vsd::Node {
+  VSD_INSTANCE(BenchTank, vsd::Node)
+  VSD_PROPERTY(double, level, 0.0)
+};
+
+constexpr const char* kReadsCounter = R"(
+object c {
+  int n = 0;
+  place a = 1;
+  place b;
+  transition t { when n > 1000000; }
+  arrow a -> t;
+  arrow t -> b;
+}
+)";
+
+constexpr const char* kReadsTank = R"(
+shared<BenchTank> tank;
+place a = 1;
+place b;
+transition t { when tank != null && tank.level > 1000000000000.0; }
+arrow a -> t;
+arrow t -> b;
+)";
+
+struct TankState {
+  vsd::Registry reg;
+  vsd::Environment env{0, reg};
+  BenchTank* tank = nullptr;
+  TankState() {
+    reg.add<BenchTank>();
+    tank = &env.main_state().create<BenchTank>();
+    env.main_state().database().add_child(*tank);
+  }
+};
+
+void BM_SomlSetUnwatched(benchmark::State& state) {
+  TankState t;
+  if (state.range(0) == 1) {
+    vsd::soml::Program& p = t.env.use<vsd::soml::Module>().load(t.env.main_state(), "bench.soml", kReadsCounter);
+    p.run_until_quiet();  // its condition has read c.n: the executor watches that class
+  }
+  double x = 1.0;
+  t.tank->set_level(x);  // the load's savepoint recorded: the first set finds nobody listens any more
+  if (t.tank->observed()) state.SkipWithError("the tank's class is watched");
+  for (auto _ : state) {
+    x += 1.0;
+    t.tank->set_level(x);
+    benchmark::ClobberMemory();
+  }
+  benchmark::DoNotOptimize(t.tank->level());
+}
+BENCHMARK(BM_SomlSetUnwatched)->Arg(0)->Arg(1);
+
+struct DepKey {
+  std::uint64_t id;
+  const vsd::MetaProperty* prop;
+  bool operator==(const DepKey&) const = default;
+};
+struct DepHash {
+  std::size_t operator()(const DepKey& k) const noexcept {
+    return std::hash<std::uint64_t>()(k.id * 0x9E3779B97F4A7C15ULL ^ reinterpret_cast<std::uintptr_t>(k.prop));
+  }
+};
+
+void BM_SomlSetWatched(benchmark::State& state) {
+  TankState t;
+  vsd::soml::Program* p = nullptr;
+  if (state.range(0) == 0) {
+    p = &t.env.use<vsd::soml::Module>().load(t.env.main_state(), "bench.soml", kReadsTank);
+    p->root().set("tank", vsd::Value(vsd::SharedRef<vsd::Node>(t.tank)));
+    p->run_until_quiet();  // the condition read tank.level: the executor watches BenchTank.level
+    if (!t.tank->observed()) state.SkipWithError("the executor does not watch the tank");
+  }
+  std::unordered_map<DepKey, std::vector<std::uint32_t>, DepHash> old_table;
+  std::uint64_t heard = 0;
+  vsd::Connection old_listener;
+  if (state.range(0) == 1) {
+    // The executor as it was: every set of every instance of the state came here.
+    old_table[DepKey{t.tank->id(), &BenchTank::vsd_prop_level()}] = {0};
+    old_listener = t.env.main_state().on_property_changed().connect(
+        [&](vsd::SimStateInstance& inst, const vsd::MetaProperty& prop) {
+          auto it = old_table.find(DepKey{inst.id(), &prop});
+          if (it != old_table.end()) heard += it->second.size();
+        });
+  }
+  double x = 0;
+  for (auto _ : state) {
+    x += 1.0;
+    t.tank->set_level(x);
+    benchmark::ClobberMemory();
+  }
+  benchmark::DoNotOptimize(heard);
+  if (p != nullptr && p->enabled_any()) state.SkipWithError("the transition became enabled");
+}
+BENCHMARK(BM_SomlSetWatched)->Arg(0)->Arg(1);
 
 // Checking and loading a script of about 10,000 lines.
 void BM_SomlLoad10kLines(benchmark::State& state) {

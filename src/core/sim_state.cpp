@@ -373,6 +373,7 @@ SimState::PropertySink SimState::on_property_changed(const MetaInstance& type, b
     slot->subtypes = include_subtypes;
     slot->signal.on_first_listener(&TypeSignal::hook, slot.get());
     ++type_signals_;
+    class_signals_.clear();  // a class's list may gain this one
   }
   return PropertySink(slot->signal);
 }
@@ -382,6 +383,34 @@ PropertySignal* SimState::type_signal(const MetaInstance& m, bool tree) const no
   if (m.index() >= table.size()) return nullptr;
   TypeSignal* s = table[m.index()].get();
   return s != nullptr && s->signal.has_listeners() ? &s->signal : nullptr;
+}
+
+const SimState::ClassSignals& SimState::signals_of_slow(const MetaInstance& cls) {
+  const std::size_t k = cls.index();
+  if (k >= class_signals_.size()) class_signals_.resize(k + 1);
+  ClassSignals& c = class_signals_[k];
+  auto add = [&](const std::vector<std::unique_ptr<TypeSignal>>& table, const MetaInstance& m) {
+    if (m.index() >= table.size() || !table[m.index()]) return;
+    if (c.count == c.signals.size()) {
+      c.deep = true;
+    } else {
+      c.signals[c.count++] = &table[m.index()]->signal;
+    }
+  };
+  add(type_exact_, cls);
+  for (const MetaInstance* m = &cls; m != nullptr; m = m->base()) add(type_tree_, *m);
+  c.known = true;
+  return c;
+}
+
+// The subtree signals of @p cls's chain past the eight that signals_of() keeps, in chain order.
+std::vector<PropertySignal*> SimState::deeper_signals(const MetaInstance& cls) const {
+  std::vector<PropertySignal*> out;  // only those with listeners
+  std::size_t seen = cls.index() < type_exact_.size() && type_exact_[cls.index()] ? 1 : 0;
+  for (const MetaInstance* m = &cls; m != nullptr; m = m->base())
+    if (m->index() < type_tree_.size() && type_tree_[m->index()] && ++seen > ClassSignals{}.signals.size())
+      if (PropertySignal* s = type_signal(*m, true)) out.push_back(s);
+  return out;
 }
 
 void SimState::emit_property(SimStateInstance& inst, const MetaProperty& p) {
@@ -395,37 +424,26 @@ void SimState::emit_property(SimStateInstance& inst, const MetaProperty& p) {
       inst.watch_ &= static_cast<std::uint8_t>(~SimStateInstance::own_watch);
     }
   }
-  PropertySignal* exact = nullptr;
-  std::array<PropertySignal*, 8> tree{};  // subtree listeners of the first ancestors
-  std::size_t trees = 0;
-  bool deep = false;  // more ancestors with listeners than the array holds
+  PropertySignal* typed[8];  // the class's exact signal, then subtree ones, that have listeners
+  std::size_t n = 0;
+  bool deep = false;  // more per-class signals in the chain than those eight (emit_deeper)
   if (type_signals_ != 0) {
-    exact = type_signal(inst.meta(), false);
-    for (const MetaInstance* m = &inst.meta(); m != nullptr; m = m->base()) {
-      if (PropertySignal* s = type_signal(*m, true)) {
-        if (trees < tree.size()) {
-          tree[trees++] = s;
-        } else {
-          deep = true;
-        }
-      }
-    }
+    const ClassSignals& c = signals_of(inst.meta());
+    for (std::size_t i = 0; i < c.count; ++i)
+      if (c.signals[i]->has_listeners()) typed[n++] = c.signals[i];
+    deep = c.deep;
   }
   const bool state_wide = property_changed_.has_listeners();
-  if (own == nullptr && exact == nullptr && trees == 0 && !state_wide && !recording_) {
+  if (own == nullptr && n == 0 && !state_wide && !recording_ && (!deep || deeper_signals(inst.meta()).empty())) {
     // Nobody is interested in this instance: back to the fast path until a signal gains a listener.
     inst.watch_ &= static_cast<std::uint8_t>(~(SimStateInstance::state_watch | SimStateInstance::class_watch));
     if (state_watch_ && !state_watch_wanted()) state_watch_ = false;
     return;
   }
   if (own != nullptr) own->emit(inst, p);
-  if (exact != nullptr) exact->emit(inst, p);
-  for (std::size_t i = 0; i < trees; ++i) tree[i]->emit(inst, p);
-  if (deep) {
-    std::size_t seen = 0;
-    for (const MetaInstance* m = &inst.meta(); m != nullptr; m = m->base())
-      if (PropertySignal* s = type_signal(*m, true); s != nullptr && ++seen > tree.size()) s->emit(inst, p);
-  }
+  for (std::size_t i = 0; i < n; ++i) typed[i]->emit(inst, p);
+  if (VSD_UNLIKELY(deep))
+    for (PropertySignal* s : deeper_signals(inst.meta())) s->emit(inst, p);  // collected before emitting
   if (state_wide) property_changed_.emit(inst, p);
 }
 

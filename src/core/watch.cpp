@@ -14,6 +14,7 @@ namespace vsd {
 // The properties of one class that a Watch follows: a bit per property index. A class's properties keep
 // their indexes in every subclass (inherited ones come first), so one bit set serves the whole subtree.
 struct Watch::Filter {
+  Watch* watch = nullptr;
   const MetaInstance* cls = nullptr;
   std::vector<std::uint64_t> bits;
   bool all = false;
@@ -23,12 +24,25 @@ struct Watch::Filter {
     const std::size_t i = p.index();
     return i / 64 < bits.size() && ((bits[i / 64] >> (i % 64)) & 1U) != 0;
   }
+  // Connected as a member (no allocation, one load less per change than a capturing lambda).
+  void heard(SimStateInstance& inst, const MetaProperty& p) {
+    if (matches(p)) watch->report(inst, &p, Changes::property);
+  }
 };
 
 Watch::Watch(SimState& state, Granularity granularity) : state_(&state), granularity_(granularity) {}
 
 Watch::Watch(SimState& state, Callback callback) : state_(&state), callback_(std::move(callback)) {
   if (!callback_) detail::throw_error("a Watch that reports at once needs a callback");
+  function_ = [](void* self, SimStateInstance& inst, const MetaProperty* p, Changes what) {
+    static_cast<Watch*>(self)->callback_(inst, p, what);
+  };
+  context_ = this;
+}
+
+Watch::Watch(SimState& state, Function function, void* context)
+    : state_(&state), function_(function), context_(context) {
+  if (function_ == nullptr) detail::throw_error("a Watch that reports at once needs a callback");
 }
 
 Watch::~Watch() = default;  // the connections go first (declared last), then the filters they point at
@@ -38,12 +52,10 @@ Watch::Filter& Watch::filter_of(const MetaInstance& cls) {
     if (f->cls == &cls) return *f;
   filters_.push_back(std::make_unique<Filter>());
   Filter* f = filters_.back().get();
+  f->watch = this;
   f->cls = &cls;
   f->bits.assign((cls.properties().size() + 63) / 64, 0);
-  connections_.push_back(state_->on_property_changed(cls, true).connect(
-      [this, f](SimStateInstance& inst, const MetaProperty& p) {
-        if (f->matches(p)) report(inst, &p, Changes::property);
-      }));
+  connections_.push_back(state_->on_property_changed(cls, true).connect<&Filter::heard>(*f));
   return *f;
 }
 
@@ -105,8 +117,8 @@ Watch& Watch::reparented(const MetaInstance& cls) {
 }
 
 void Watch::report(SimStateInstance& inst, const MetaProperty* p, Changes what) {
-  if (callback_) {
-    callback_(inst, p, what);
+  if (function_ != nullptr) {
+    function_(context_, inst, p, what);
   } else {
     queue(inst.id(), p, what);
   }

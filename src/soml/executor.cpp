@@ -14,19 +14,18 @@
 namespace vsd::soml {
 
 void ProgramImpl::on_change(SimStateInstance& inst, const MetaProperty& p) {
-  if (&p == &Place::vsd_prop_tokens() || &p == &Place::vsd_prop_objects()) {
+  if (&p == tokens_property_ || &p == objects_property_) {
     auto it = place_watch_.find(inst.id());
     if (it != place_watch_.end())
       for (std::uint32_t ti : it->second) mark_dirty(ti);
   }
   if (deps_map_.empty()) return;
-  auto it = deps_map_.find(DepKey{inst.id(), &p});
-  if (it != deps_map_.end())
-    for (std::uint32_t ti : it->second) mark_dirty(ti);
+  if (const auto* watchers = deps_map_.find(DepKey{inst.id(), &p}))
+    for (std::uint32_t ti : *watchers) mark_dirty(ti);
   if (!whole_instance_deps_) return;
-  it = deps_map_.find(DepKey{inst.id(), nullptr});  // tests that called a C++ method of the instance
-  if (it != deps_map_.end())
-    for (std::uint32_t ti : it->second) mark_dirty(ti);
+  // Tests that called a C++ method of the instance.
+  if (const auto* watchers = deps_map_.find(DepKey{inst.id(), nullptr}))
+    for (std::uint32_t ti : *watchers) mark_dirty(ti);
 }
 
 // A net whose owner, place or transition is deleted stops: its transitions leave the enabled set and
@@ -221,11 +220,10 @@ bool ProgramImpl::test(TI& ti) {
   if (!same) {
     const auto index = static_cast<std::uint32_t>(&ti - tis_.data());
     for (const DepKey& k : ti.deps) {
-      auto it = deps_map_.find(k);
-      if (it == deps_map_.end()) continue;
-      auto& v = it->second;
-      v.erase(std::remove(v.begin(), v.end(), index), v.end());
-      if (v.empty()) deps_map_.erase(it);
+      auto* v = deps_map_.find(k);
+      if (v == nullptr) continue;
+      v->erase(std::remove(v->begin(), v->end(), index), v->end());
+      if (v->empty()) deps_map_.erase(k);
     }
     ti.deps.clear();
     // Each watcher list is kept in transition order, not in the order of the tests that happened to
@@ -449,7 +447,7 @@ void ProgramImpl::compact_nets() {
     }
   };
   remap_all(place_watch_);
-  remap_all(deps_map_);
+  deps_map_.update_all([&](const DepKey&, DepTable::Watchers& w) { remap(w); });
   tis_ = std::move(kept);
   std::erase_if(net_order_, [](const NetInst* n) { return n->dead; });
   for (NetInst* n : net_order_) n->first_ti = before[n->first_ti];  // a net's entries are contiguous

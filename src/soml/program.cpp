@@ -802,25 +802,37 @@ void ProgramImpl::define(std::string name, std::string text) {
 }
 
 void ProgramImpl::connect_listeners() {
-  watch_.emplace(state_, [this](SimStateInstance& inst, const MetaProperty* p, Changes what) {
-    if (what.has(Changes::deleted))
-      on_deleted(inst);
-    else if (p != nullptr)
-      on_change(inst, *p);
-  });
+  watch_.emplace(state_, &ProgramImpl::heard, this);
   // Nets, places, transitions and the executor are nodes: a deletion of any of them stops a net.
   watch_->deleted(Node::static_meta())
       .properties(Place::static_meta(), {&Place::vsd_prop_tokens(), &Place::vsd_prop_objects()});
   // What the tests read so far (a program that listens again after a failed live reload).
   covered_properties_.clear();
   covered_classes_.clear();
-  for (const auto& [key, watchers] : deps_map_) cover(key.id, key.prop);
+  deps_map_.for_each([&](const DepKey& key, const DepTable::Watchers&) { cover(key.id, key.prop); });
+}
+
+void ProgramImpl::heard(void* self, SimStateInstance& inst, const MetaProperty* p, Changes what) {
+  auto* program = static_cast<ProgramImpl*>(self);
+  if (p != nullptr) {
+    program->on_change(inst, *p);
+  } else if (what.has(Changes::deleted)) {
+    program->on_deleted(inst);
+  }
 }
 
 void ProgramImpl::cover(std::uint64_t id, const MetaProperty* prop) {
   if (!watch_) return;
   if (prop != nullptr) {
-    if (covered_properties_.insert(prop).second) watch_->properties(prop->owner(), {prop});
+    const std::size_t cls = prop->owner().index();
+    const std::size_t i = prop->index();
+    if (cls >= covered_properties_.size()) covered_properties_.resize(cls + 1);
+    auto& row = covered_properties_[cls];
+    if (i / 64 >= row.size()) row.resize(i / 64 + 1, 0);
+    const std::uint64_t bit = std::uint64_t{1} << (i % 64);
+    if ((row[i / 64] & bit) != 0) return;
+    watch_->properties(prop->owner(), {prop});
+    row[i / 64] |= bit;
     return;
   }
   // A test called a C++ method of instance @p id, which may read any property of it.

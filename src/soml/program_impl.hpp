@@ -17,6 +17,7 @@
 #include "vsd/core/type_builder.hpp"
 #include "vsd/core/value.hpp"
 #include "vsd/core/watch.hpp"
+#include "dep_table.hpp"
 #include "vsd/soml/checker.hpp"
 #include "vsd/soml/net_classes.hpp"
 #include "vsd/soml/runtime.hpp"
@@ -529,11 +530,6 @@ class ProgramImpl {
   // an entry (a long run that creates and deletes objects with nets would grow without bound otherwise).
   // Only between firings: nothing may hold a TI index or a NetInst pointer across it.
   void compact_nets();
-  struct DepKey {
-    std::uint64_t id;
-    const MetaProperty* prop;
-    bool operator==(const DepKey&) const = default;
-  };
   struct TI {
     std::vector<DepKey> deps;  // what its last test read (sorted): where it is listed in deps_map_
     NetInst* net;
@@ -547,22 +543,21 @@ class ProgramImpl {
   std::vector<std::uint32_t> dirty_;
   std::vector<std::uint32_t> enabled_;
   std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> place_watch_;  // place id -> TIs
-  struct DepHash {
-    std::size_t operator()(const DepKey& k) const noexcept {
-      return std::hash<std::uint64_t>()(k.id * 0x9E3779B97F4A7C15ULL ^
-                                        reinterpret_cast<std::uintptr_t>(k.prop));
-    }
-  };
-  std::unordered_map<DepKey, std::vector<std::uint32_t>, DepHash> deps_map_;
+  DepTable deps_map_;
   bool whole_instance_deps_ = false;  // some test called a C++ method: deps_map_ has (id, null) keys
   std::vector<std::pair<std::uint64_t, const MetaProperty*>> dep_scratch_;
   // What the executor hears (connect_listeners): markings of places, deletions of nodes, and the class
   // properties that some test read (cover). Per class, so instances of classes no condition reads keep
   // their one-branch setters while a program is loaded.
   std::optional<Watch> watch_;
-  std::unordered_set<const MetaProperty*> covered_properties_;  // watched for some test
-  std::unordered_set<const MetaInstance*> covered_classes_;     // all properties watched (C++ methods)
+  const MetaProperty* tokens_property_ = &Place::vsd_prop_tokens();    // looked up once: on_change compares
+  const MetaProperty* objects_property_ = &Place::vsd_prop_objects();  // every change it hears with them
+  // What the Watch covers already, by class index: bit i of a class's row = its property of index i (a
+  // test's reads change with every token, so this is asked often and answered without hashing).
+  std::vector<std::vector<std::uint64_t>> covered_properties_;
+  std::unordered_set<const MetaInstance*> covered_classes_;  // all properties watched (C++ methods)
   void cover(std::uint64_t id, const MetaProperty* prop);
+  static void heard(void* self, SimStateInstance& inst, const MetaProperty* p, Changes what);
   void stop_listening() noexcept { watch_.reset(); }
   std::unordered_map<std::uint64_t, NetInst*> node_net_;  // owner, place and transition ids -> net
   void on_deleted(SimStateInstance& inst);

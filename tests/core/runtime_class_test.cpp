@@ -856,3 +856,43 @@ TEST(RuntimeClass, DefineTwiceFromOneBuilder) {
 }
 
 }  // namespace
+
+// A property change reaches the exact listener of the instance's class first, then the subtree listeners
+// of the class and of every base, most derived first — also past the eight that a class's list keeps,
+// and when listeners are added after the list was made.
+TEST(RuntimeClass, SubtreeSignalsOfADeepChainFireInChainOrder) {
+  std::vector<std::unique_ptr<Defined>> chain;
+  const vsd::MetaInstance* base = &vsd::Node::static_meta();
+  for (int k = 0; k < 12; ++k) {
+    auto b = vsd::ClassBuilder("RcDeep" + std::to_string(k), *base);
+    if (k == 0) b.property<double>("v", 0.0);
+    chain.push_back(std::make_unique<Defined>(b.define()));
+    base = &**chain.back();
+  }
+  {
+  vsd::Environment env;
+  auto& state = env.main_state();
+  vsd::SimStateInstance& x = state.create(*base);
+  std::vector<int> heard;
+  std::vector<vsd::Connection> keep;
+  auto listen = [&](int k) {
+    keep.emplace_back(state.on_property_changed(**chain[static_cast<std::size_t>(k)], true)
+                          .connect([&heard, k](vsd::SimStateInstance&, const vsd::MetaProperty&) { heard.push_back(k); }));
+  };
+  for (int k = 0; k < 12; k += 2) listen(k);
+  x.set("v", vsd::Value(1.0));
+  EXPECT_EQ(heard, (std::vector<int>{10, 8, 6, 4, 2, 0}));
+  heard.clear();
+  for (int k = 1; k < 12; k += 2) listen(k);  // the class's list is made again
+  keep.emplace_back(state.on_property_changed(*base, false).connect(
+      [&heard](vsd::SimStateInstance&, const vsd::MetaProperty&) { heard.push_back(-1); }));
+  x.set("v", vsd::Value(2.0));
+  EXPECT_EQ(heard, (std::vector<int>{-1, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0}));
+  heard.clear();
+  keep.clear();  // nobody listens: the instance is back on the fast path after its next set
+  x.set("v", vsd::Value(3.0));
+  EXPECT_TRUE(heard.empty());
+  EXPECT_FALSE(x.observed());
+  }
+  while (!chain.empty()) chain.pop_back();  // subclasses first
+}

@@ -251,6 +251,24 @@ class SimState : public Instance {
   std::unordered_map<const SimStateInstance*, std::unique_ptr<PropertySignal>> instance_signals_;
   std::vector<std::unique_ptr<TypeSignal>> type_exact_, type_tree_;
   std::vector<std::uint8_t> class_watch_;  // per class index: 0 not known yet, 1 unwatched, 2 watched
+  // Per class index: the per-class signals a property change of its instances goes to (its exact one,
+  // then the subtree ones of it and its bases, most derived first), so a set does not walk the class
+  // chain. Made on first use; forgotten when a per-class signal is made (signals are never destroyed
+  // before the state, so the pointers stay valid).
+  struct ClassSignals {
+    bool known = false;
+    bool deep = false;  // more than fit: emit_property walks the chain
+    std::uint8_t count = 0;
+    std::array<PropertySignal*, 8> signals{};
+  };
+  std::vector<ClassSignals> class_signals_;
+  const ClassSignals& signals_of(const MetaInstance& cls) {
+    const std::size_t k = cls.index();
+    if (VSD_LIKELY(k < class_signals_.size() && class_signals_[k].known)) return class_signals_[k];
+    return signals_of_slow(cls);
+  }
+  const ClassSignals& signals_of_slow(const MetaInstance& cls);
+  [[nodiscard]] std::vector<PropertySignal*> deeper_signals(const MetaInstance& cls) const;
   std::vector<SimStateInstance*> graveyard_;  // deleted during a dispatch, freed when it ends
   std::vector<SimStateInstance*>* cascade_ = nullptr;  // released instances still to delete (released())
   int dispatching_ = 0;

@@ -87,6 +87,10 @@ class Watch {
   explicit Watch(SimState& state, Granularity granularity = Granularity::instance);
   /// @brief A Watch of @p state that calls @p callback inside each change instead of queueing it.
   Watch(SimState& state, Callback callback);
+  /// @brief The same with a plain function and its context (`fn(context, instance, property, what)`):
+  /// one indirect call less per change, for a module on a hot path (the SOML++ executor).
+  using Function = void (*)(void* context, SimStateInstance& instance, const MetaProperty* property, Changes what);
+  Watch(SimState& state, Function function, void* context);
   Watch(const Watch&) = delete;
   Watch& operator=(const Watch&) = delete;
   ~Watch();
@@ -141,6 +145,8 @@ class Watch {
   SimState* state_;
   Granularity granularity_ = Granularity::instance;
   Callback callback_;
+  Function function_ = nullptr;  // at once: called with context_ (a Callback is called through it)
+  void* context_ = nullptr;
   std::function<void()> on_pending_;
   std::vector<Report> pending_;
   std::vector<std::uint32_t> table_;  // open addressing: index + 1 into pending_, 0 = empty
