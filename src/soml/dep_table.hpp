@@ -92,10 +92,11 @@ class DepTable {
     Watchers watchers;
   };
   [[nodiscard]] std::size_t slot(const DepKey& k) const noexcept {
-    std::uint64_t h = k.id * 0x9E3779B97F4A7C15ULL ^ reinterpret_cast<std::uintptr_t>(k.prop);
-    h ^= h >> 31;
-    h *= 0xBF58476D1CE4E5B9ULL;
-    return static_cast<std::size_t>(h >> 29) & mask_;
+    // Fibonacci hashing of both fields: ids are dense and properties 8-byte aligned; the product's
+    // upper half mixes every input bit.
+    const std::uint64_t h = (k.id ^ (reinterpret_cast<std::uintptr_t>(k.prop) >> 3) * 0xBF58476D1CE4E5B9ULL) *
+                            0x9E3779B97F4A7C15ULL;
+    return static_cast<std::size_t>(h >> 32) & mask_;
   }
   // Rebuilds with @p capacity slots (a power of two), leaving out entries without watchers.
   void rehash(std::size_t capacity) {

@@ -28,6 +28,17 @@ void ProgramImpl::on_change(SimStateInstance& inst, const MetaProperty& p) {
     for (std::uint32_t ti : *watchers) mark_dirty(ti);
 }
 
+// What the executor's Watch reports (connect_listeners), on_change inlined here: it runs for every change
+// of a property some test read.
+void ProgramImpl::heard(void* self, SimStateInstance& inst, const MetaProperty* p, Changes what) {
+  auto* program = static_cast<ProgramImpl*>(self);
+  if (p != nullptr) {
+    program->on_change(inst, *p);
+  } else if (what.has(Changes::deleted)) {
+    program->on_deleted(inst);
+  }
+}
+
 // A net whose owner, place or transition is deleted stops: its transitions leave the enabled set and
 // are never tested again (their nodes, which the executor holds by pointer, are going away).
 void ProgramImpl::on_deleted(SimStateInstance& inst) {

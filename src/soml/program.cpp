@@ -43,6 +43,7 @@ ProgramImpl::ProgramImpl(SimState& state, RunOptions options)
 
 ProgramImpl::~ProgramImpl() {
   stop_listening();
+  xregs_.clear();  // values of the program's struct and enum types go before those types may
   release_uses(true);
 }
 
@@ -54,6 +55,19 @@ std::mutex users_mutex;
 std::unordered_map<const void*, int>& users() {
   static std::unordered_map<const void*, int> all;
   return all;
+}
+// True when a method of a class still defined takes or returns @p t (or a vector of it). The Registry
+// refuses to undefine a type that a property uses, but does not look at method signatures: a class that
+// stays (its instances outlive the program) keeps the enums its methods name.
+bool used_by_methods(const Registry& reg, const MetaType& t) {
+  auto names = [&](const MetaType* x) { return x == &t || (x != nullptr && x->element() == &t); };
+  for (const MetaInstance* c : reg.classes())
+    for (const MetaMethod* m : c->methods()) {
+      if (names(m->result())) return true;
+      for (const MetaType* a : m->arguments())
+        if (names(a)) return true;
+    }
+  return false;
 }
 int users_of(const void* p) {
   std::lock_guard lock(users_mutex);
@@ -92,10 +106,11 @@ void ProgramImpl::release_uses(bool undefine) noexcept {
       reg.undefine(*m);
     } catch (const Error&) {  // NOLINT(bugprone-empty-catch): it stays (see above)
     }
-  for (auto it = enums.rbegin(); it != enums.rend(); ++it) try {
-      reg.undefine(**it);
-    } catch (const Error&) {  // NOLINT(bugprone-empty-catch)
-    }
+  for (auto it = enums.rbegin(); it != enums.rend(); ++it)
+    if (!used_by_methods(reg, **it)) try {
+        reg.undefine(**it);
+      } catch (const Error&) {  // NOLINT(bugprone-empty-catch)
+      }
 }
 
 // SOML++ classes and enums that no live program uses and no instance holds are garbage — left by a
@@ -121,11 +136,15 @@ void sweep_soml_leftovers(Registry& reg) {
       } catch (const Error&) {  // NOLINT(bugprone-empty-catch): a subclass or a property still names it
       }
   }
+  std::vector<const MetaType*> enums;  // collected first: undefining changes what types() walks
   for (const MetaType* t : reg.types())
-    if (t->kind() == TypeKind::Enum && t->name().starts_with("soml::") && reg.owns(*t) && users_of(t) == 0) try {
-        reg.undefine(*t);
-      } catch (const Error&) {  // NOLINT(bugprone-empty-catch): a class still uses it
-      }
+    if (t->kind() == TypeKind::Enum && t->name().starts_with("soml::") && reg.owns(*t) && users_of(t) == 0 &&
+        !used_by_methods(reg, *t))
+      enums.push_back(t);
+  for (const MetaType* t : enums) try {
+      reg.undefine(*t);
+    } catch (const Error&) {  // NOLINT(bugprone-empty-catch): a class still uses it
+    }
 }
 
 const MetaInstance& ProgramImpl::class_for(ClassBuilder& b, const std::string& name, const MetaInstance& base,
@@ -810,15 +829,6 @@ void ProgramImpl::connect_listeners() {
   covered_properties_.clear();
   covered_classes_.clear();
   deps_map_.for_each([&](const DepKey& key, const DepTable::Watchers&) { cover(key.id, key.prop); });
-}
-
-void ProgramImpl::heard(void* self, SimStateInstance& inst, const MetaProperty* p, Changes what) {
-  auto* program = static_cast<ProgramImpl*>(self);
-  if (p != nullptr) {
-    program->on_change(inst, *p);
-  } else if (what.has(Changes::deleted)) {
-    program->on_deleted(inst);
-  }
 }
 
 void ProgramImpl::cover(std::uint64_t id, const MetaProperty* prop) {

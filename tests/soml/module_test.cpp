@@ -116,3 +116,32 @@ TEST_F(SomlModuleTest, AProgramWatchesOnlyWhatItsConditionsRead) {
 }
 
 }  // namespace
+
+namespace {
+
+// A program that goes while its instances stay (its state lives on) leaves its classes defined, and with
+// them the enums their methods name: the Registry checks properties, not method signatures. Once the
+// instances are gone, the module sweeps both when it goes.
+TEST(SomlModuleLifetime, EnumsNamedByMethodsOfClassesThatStayStayToo) {
+  vsd::Registry reg;
+  {
+    vsd::Environment env{0, reg};
+    auto& soml = env.use<vsd::soml::Module>();
+    vsd::SimState& other = env.create_state("other");
+    env.set_service(soml, other, Service::stepped);
+    soml.load(other, "modes.soml", R"(
+enum Mode { Idle, Busy }
+object m {
+  int n = 0;
+  Mode flip(Mode x) { if (x == Mode::Idle) return Mode::Busy; return Mode::Idle; }
+}
+)");
+    env.set_service(soml, other, Service::none);  // the program goes, its objects stay
+    ASSERT_NE(reg.find_class_exact("soml::m"), nullptr);
+    EXPECT_NE(reg.find_type("soml::Mode"), nullptr) << "the class that stays names it in flip()";
+  }
+  EXPECT_EQ(reg.find_class_exact("soml::m"), nullptr) << "swept when the module went";
+  EXPECT_EQ(reg.find_type("soml::Mode"), nullptr);
+}
+
+}  // namespace
