@@ -226,6 +226,9 @@ Inspector::Inspector(Environment& env, SimState& state, const Options& options, 
   const MetaInstance& all = SimStateInstance::static_meta();
   watch_.all_properties(all).created(all).deleted(all);
   watch_.reparented(Node::static_meta()).reparented(Extension::static_meta());
+  // The nets view reads the enabled transitions from the state: make them current for a program that
+  // was loaded but not stepped yet.
+  refresh_programs(env, state);
   last_stats_ = std::chrono::steady_clock::now();
   stats_steps_ = env.scheduler().steps();
   stats_firings_ = firings(env, state);

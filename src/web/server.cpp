@@ -310,6 +310,12 @@ void Server::start() {
   d.find_files();
   d.http.new_task_queue = [] { return new httplib::ThreadPool(Impl::max_streams + 8); };
   d.http.set_payload_max_length(d.options.max_body);
+  // SO_REUSEADDR only: httplib's default adds SO_REUSEPORT, which would let a second server (another
+  // process of the same user) bind our port and take half of the connections.
+  d.http.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    (void)::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
   d.http.set_keep_alive_timeout(5);
   d.http.set_read_timeout(10, 0);
   d.http.set_write_timeout(10, 0);
@@ -343,6 +349,9 @@ void Server::start() {
   d.stopping = false;
   d.listening = true;
   d.listener = std::thread([this] { impl_->http.listen_after_bind(); });
+  // httplib's stop() does nothing until the accept loop runs: wait for it, so that a stop() right after
+  // start() is not lost.
+  for (int i = 0; i < 5000 && !d.http.is_running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
 }
 
 void Server::stop() noexcept {

@@ -71,7 +71,7 @@ class Server {
   Server& operator=(const Server&) = delete;
 
   /// @brief Binds and listens on a thread of its own. @throws vsd::Error when the address cannot be
-  /// bound, when a non-loopback address has no token, or when the page's assets are missing.
+  /// bound, or when a non-loopback address has no token. Without the page's files (docs/web.md) the API works.
   void start();
   /// @brief Stops listening and ends run(); safe from any thread and from a signal handler's thread.
   void stop() noexcept;
@@ -93,8 +93,10 @@ class Server {
   /// @brief True while the page (or pause()) paused the simulation; run() does not step then. A program
   /// with a loop of its own checks this.
   [[nodiscard]] bool paused() const noexcept;
+  /// @brief Pauses or resumes run(); safe from any thread.
   void pause(bool on) noexcept;
 
+  /// @brief Figures so far; call it on the simulation thread.
   [[nodiscard]] Stats stats() const;
   [[nodiscard]] SimState& state() const noexcept;
 
