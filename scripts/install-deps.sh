@@ -12,10 +12,13 @@
 #   dist        vsd::dist: Cyclone DDS (C API) and its IDL compiler idlc
 #   collision   vsd::collision: FCL 0.7 and libccd
 #   physics     vsd::physics: ODE 0.16 (through pkg-config)
-#   modules     all of the five above
+#   web         vsd::web: cpp-httplib; npm (the page's JavaScript libraries come from the npm registry,
+#               pinned by src/web/page/package-lock.json) unless an npm is installed already
+#   modules     all of the six above
 #   tests       GoogleTest and GoogleMock; Orocos KDL (the robotics tests' reference), gnuplot (the
 #               examples' plots), python3 (the docs' C++ blocks are compiled by a test), ccache (the
-#               packaging tests' builds reuse the Release tree's objects)
+#               packaging tests' builds reuse the Release tree's objects), Chromium (the inspector's
+#               page is tested in headless Chromium; playwright-core comes from npm)
 #   benchmarks  Google Benchmark and the peers the benchmarks compare with: RTTR, Qt 5, Boost.Signals2,
 #               libsigc++ 3, Lua 5.4
 #   fuzzing     clang and libFuzzer's runtime
@@ -33,10 +36,11 @@ GROUP[scene]="liburdfdom-dev libassimp-dev"
 GROUP[dist]="cyclonedds-dev cyclonedds-tools"
 GROUP[collision]="libfcl-dev libccd-dev"
 GROUP[physics]="libode-dev pkg-config"
-GROUP[tests]="libgtest-dev libgmock-dev liborocos-kdl-dev gnuplot-nox python3 ccache"
+GROUP[web]="libcpp-httplib-dev pkg-config @npm"
+GROUP[tests]="libgtest-dev libgmock-dev liborocos-kdl-dev gnuplot-nox python3 ccache chromium"
 GROUP[benchmarks]="libbenchmark-dev librttr-dev qtbase5-dev libboost-dev libsigc++-3.0-dev liblua5.4-dev"
 GROUP[fuzzing]="clang libclang-rt-14-dev"
-MODULES="analysis scene dist collision physics"
+MODULES="analysis scene dist collision physics web"
 ALL="core $MODULES tests benchmarks fuzzing"
 
 if [[ "${VSD_SKIP_DEPS:-0}" == "1" ]]; then
@@ -44,7 +48,7 @@ if [[ "${VSD_SKIP_DEPS:-0}" == "1" ]]; then
   exit 0
 fi
 if [[ $# -eq 0 ]]; then
-  echo "usage: install-deps.sh GROUP... (core analysis scene dist collision physics modules tests benchmarks fuzzing all)" >&2
+  echo "usage: install-deps.sh GROUP... (core analysis scene dist collision physics web modules tests benchmarks fuzzing all)" >&2
   exit 2
 fi
 
@@ -68,6 +72,17 @@ for g in "${groups[@]}"; do
   read -r -a more <<<"${GROUP[$g]}"
   packages+=("${more[@]}")
 done
+# "@npm": Debian's nodejs and npm, unless some npm is on the PATH already (NodeSource's nodejs carries its
+# own npm and conflicts with Debian's npm package).
+resolved=()
+for pkg in "${packages[@]}"; do
+  if [[ "$pkg" == "@npm" ]]; then
+    if ! command -v npm >/dev/null 2>&1; then resolved+=(nodejs npm); fi
+  else
+    resolved+=("$pkg")
+  fi
+done
+packages=("${resolved[@]}")
 mapfile -t packages < <(printf '%s\n' "${packages[@]}" | awk '!seen[$0]++')
 
 missing=()

@@ -336,17 +336,10 @@ TEST_F(Server, TheFireButtonFiresAnEnabledTransitionOnly) {
 
 /// Reads the event stream of @p port until @p until is in what arrived (or 5 s pass).
 std::string read_events(int port, const std::string& host, const std::string& until, std::atomic<bool>& connected) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<std::uint16_t>(port));
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  timeval tv{5, 0};
-  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  const int fd = connect_local(port, 5);
   std::string all;
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0) {
-    const std::string req = http_text("GET", "/api/events", host, "", {});
-    (void)::send(fd, req.data(), req.size(), MSG_NOSIGNAL);
+  if (fd >= 0) {
+    (void)send_all(fd, http_text("GET", "/api/events", host, "", {}));
     char buf[4096];
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
     for (ssize_t n; std::chrono::steady_clock::now() < deadline && (n = ::recv(fd, buf, sizeof buf, 0)) > 0;) {
@@ -354,8 +347,8 @@ std::string read_events(int port, const std::string& host, const std::string& un
       if (all.find("event: hello") != std::string::npos) connected = true;
       if (all.find(until) != std::string::npos) break;
     }
+    ::close(fd);
   }
-  ::close(fd);
   return all;
 }
 
