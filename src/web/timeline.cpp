@@ -9,6 +9,7 @@
 namespace vsd::web::detail {
 
 Timeline::Timeline(SimState& state, std::size_t max_bytes) : state_(state), max_bytes_(max_bytes) {
+  if (max_bytes == 0) return;  // off: no recording for us, no entries
   bundles_ = state.on_bundle().connect([this](const Transaction& t) { heard(t); });
   if (!state.recording()) {
     state.start_recording();
@@ -25,18 +26,28 @@ Timeline::~Timeline() {
 void Timeline::cut(std::uint64_t step, double time) {
   step_ = step;
   time_ = time;
-  if (state_.recording()) (void)state_.take_recording();  // heard() receives it (and every other reader)
+  if (max_bytes_ == 0 || !state_.recording()) return;
+  // Every other reader hears the bundle (on_bundle); we keep the one we took, moved, not a copy of it.
+  cutting_ = true;
+  Transaction t = state_.take_recording();
+  cutting_ = false;
+  if (!seeking_) add(std::move(t));
 }
 
 void Timeline::heard(const Transaction& t) {
-  if (seeking_ || t.empty()) return;
+  if (cutting_ || seeking_) return;
+  add(Transaction(t));  // a bundle another reader cut (vsd::dist at its poll): ours to keep too
+}
+
+void Timeline::add(Transaction t) {
+  if (t.empty()) return;
   // A change made while scrubbed back forks the history: the undone entries are gone for good.
   while (position_ < end()) {
     bytes_ -= entries_.back().bundle.bytes().size();
     entries_.pop_back();
   }
   bytes_ += t.bytes().size();
-  entries_.push_back(Entry{step_, time_, t});
+  entries_.push_back(Entry{step_, time_, std::move(t)});
   while (bytes_ > max_bytes_ && entries_.size() > 1) {
     bytes_ -= entries_.front().bundle.bytes().size();
     entries_.pop_front();
@@ -46,6 +57,7 @@ void Timeline::heard(const Transaction& t) {
 }
 
 void Timeline::seek(std::uint64_t position, std::uint64_t step, double time) {
+  if (max_bytes_ == 0) throw Error("timeline: it is off (Options::timeline_bytes is 0)");
   if (position < first_ || position > end())
     throw Error("timeline: position " + std::to_string(position) + " is outside the entries kept [" +
                 std::to_string(first_) + ", " + std::to_string(end()) + "]");
@@ -72,7 +84,7 @@ void Timeline::seek(std::uint64_t position, std::uint64_t step, double time) {
 
 void Timeline::write(JsonWriter& out, std::size_t limit) const {
   out.begin_object();
-  out.member("first", first_).member("position", position_).member("end", end()).member("live", live());
+  out.member("enabled", max_bytes_ != 0).member("first", first_).member("position", position_).member("end", end()).member("live", live());
   out.key("entries").begin_array();
   const std::size_t from = entries_.size() > limit ? entries_.size() - limit : 0;
   for (std::size_t i = from; i < entries_.size(); ++i) {

@@ -53,6 +53,7 @@ class Timeline {
     Transaction bundle;
   };
   void heard(const Transaction& t);
+  void add(Transaction t);
   SimState& state_;
   std::size_t max_bytes_;
   std::size_t bytes_ = 0;
@@ -62,6 +63,7 @@ class Timeline {
   std::uint64_t step_ = 0;  // what cut() was told, for the entries heard meanwhile
   double time_ = 0.0;
   bool seeking_ = false;    // bundles of our own seeks are not entries
+  bool cutting_ = false;    // our own cut: kept from take_recording(), not from the signal
   bool started_recording_ = false;
   Connection bundles_;
 };

@@ -295,6 +295,23 @@ TEST_F(Server, TheTimelineScrubsBackAndForwardAndForksOnAnEdit) {
   EXPECT_FALSE(server->paused());
 }
 
+TEST_F(Server, WithTheTimelineOffNothingIsRecordedAndSeekIsRefused) {
+  build_scene();
+  vsd::web::Options o;
+  o.timeline_bytes = 0;
+  start(o);
+  EXPECT_FALSE(state.recording());
+  link->set_mass(3);
+  env.step();
+  const HttpReply t = get("/api/timeline");
+  EXPECT_EQ(member(t.body, "enabled"), "false");
+  EXPECT_TRUE(items(t.body, "entries").empty());
+  const HttpReply seek = post("/api/timeline/seek", "{\"index\": 0}");
+  EXPECT_EQ(seek.status, 400);
+  EXPECT_NE(member(seek.body, "error").find("off"), std::string::npos);
+  EXPECT_DOUBLE_EQ(link->mass(), 3.0);
+}
+
 constexpr const char* cell_script = R"(
 object webcell {
   int done = 0;

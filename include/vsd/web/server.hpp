@@ -42,7 +42,8 @@ struct Options {
   std::size_t client_backlog = 64;
   /// How long a request waits for the simulation thread before it gets 503.
   std::chrono::milliseconds request_timeout{5000};
-  /// Memory the timeline's recorded bundles may use; the oldest entries go first.
+  /// Memory the timeline's recorded bundles may use; the oldest entries go first. 0 switches the timeline
+  /// off: the server then does not record the state (recording is most of what a server costs a step).
   std::size_t timeline_bytes = std::size_t{64} << 20;
   /// Largest request body accepted (413 beyond).
   std::size_t max_body = std::size_t{1} << 20;
