@@ -14,18 +14,24 @@
 // `arrived`, `touched`, `resting`) and commands it only through methods (γ: move_to, grasp, release) of
 // two small C++ classes below, Robot and Box. Its conditions are re-tested when those properties change.
 //
-//   vsd_workcell IIWA14.URDF [workcell.soml] [OUTDIR]
+//   vsd_workcell IIWA14.URDF [workcell.soml] [OUTDIR] [--serve [PORT]]
 //
 // Prints a log of what the supervisor commands and what the plant reports, writes OUTDIR/workcell.csv
 // (robot tool tip and box positions over time; with gnuplot also OUTDIR/workcell.png, the heights), and
 // ends with check lines; exit code 0 when every box rests on its slot of the target area and every job
-// token reached `done`.
+// token reached `done`. With --serve (and vsd::web built), the cell runs in real time and is shown in the
+// browser (docs/web.md) on 127.0.0.1:PORT (8080 by default; 0 picks a free port) while it runs and after,
+// until Ctrl-C or SIGTERM; the page can pause it, edit it and fire the supervisor's transitions.
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -34,6 +40,9 @@
 #include "vsd/physics.hpp"
 #include "vsd/robotics.hpp"
 #include "vsd/soml.hpp"
+#ifdef VSD_WORKCELL_WEB
+#include "vsd/web.hpp"
+#endif
 
 #ifndef VSD_WORKCELL_SCRIPT
 #define VSD_WORKCELL_SCRIPT "workcell.soml"
@@ -166,15 +175,45 @@ std::string where(const Node3D& n) {
 
 }  // namespace cell
 
+namespace {
+std::atomic<bool> interrupted{false};  // Ctrl-C or SIGTERM while serving
+extern "C" void on_stop_signal(int) { interrupted = true; }
+}  // namespace
+
 int main(int argc, char** argv) try {
   using namespace cell;
   using vsd::scene::GeometryKind;
-  if (argc < 2) {
-    std::cerr << "usage: vsd_workcell IIWA14.URDF [workcell.soml] [OUTDIR]\n";
+  // Positional arguments, and --serve [PORT] anywhere.
+  std::vector<std::string> args;
+  int serve_port = -1;  // -1: not serving
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a != "--serve") {
+      args.push_back(a);
+      continue;
+    }
+    serve_port = 8080;
+    if (i + 1 < argc && std::string(argv[i + 1]).find_first_not_of("0123456789") == std::string::npos) {
+      serve_port = std::atoi(argv[++i]);
+      if (serve_port > 65535) {
+        std::cerr << "vsd_workcell: --serve: port " << serve_port << " is not in 0..65535\n";
+        return 2;
+      }
+    }
+  }
+  if (args.empty() || args.size() > 3) {
+    std::cerr << "usage: vsd_workcell IIWA14.URDF [workcell.soml] [OUTDIR] [--serve [PORT]]\n";
     return 2;
   }
-  const std::string script = argc > 2 ? argv[2] : VSD_WORKCELL_SCRIPT;
-  const std::filesystem::path out = argc > 3 ? argv[3] : ".";
+#ifndef VSD_WORKCELL_WEB
+  if (serve_port >= 0) {
+    std::cerr << "vsd_workcell: --serve needs vsd::web, which this build left out (see the configure messages)\n";
+    return 2;
+  }
+#endif
+  const std::string urdf_path = args[0];
+  const std::string script = args.size() > 1 ? args[1] : VSD_WORKCELL_SCRIPT;
+  const std::filesystem::path out = args.size() > 2 ? args[2] : ".";
   std::filesystem::create_directories(out);
 
   vsd::Environment env;
@@ -189,7 +228,7 @@ int main(int argc, char** argv) try {
   // --- The robot: the URDF (no meshes needed) with its kinematics and a Cartesian controller.
   vsd::scene::UrdfOptions urdf_options;
   urdf_options.load_meshes = false;
-  auto urdf = vsd::scene::load_urdf(s.database(), argv[1], urdf_options);
+  auto urdf = vsd::scene::load_urdf(s.database(), urdf_path, urdf_options);
   auto& tree = vsd::robotics::build_kinematics(*urdf.scene);
   auto& controller = s.create<vsd::robotics::JointController>();
   urdf.scene->add_extension(controller);
@@ -198,7 +237,7 @@ int main(int argc, char** argv) try {
   controller.set_cartesian_gain(8.0);        // 1/s: smooth approach, no overshoot
   controller.set_cartesian_tolerance(5e-4);  // m and rad: "arrived"
   Node3D* flange = urdf.scene->find_link("iiwa_link_ee_kuka");
-  if (flange == nullptr) throw vsd::Error(std::string(argv[1]) + ": no link iiwa_link_ee_kuka");
+  if (flange == nullptr) throw vsd::Error(urdf_path + ": no link iiwa_link_ee_kuka");
 
   // --- The cell: one subtree for what collision detection watches (the room and the gripper pad);
   // the room, with the table and the boxes, is one physics world. The robot stays outside both (its
@@ -363,7 +402,34 @@ int main(int argc, char** argv) try {
   vsd::soml::Place* done = net.place("done", supervisor);
   constexpr double time_limit = 60.0;
   bool nudged = false;
+#ifdef VSD_WORKCELL_WEB
+  // --serve: the cell in the browser. The server answers between steps (its scheduler tasks); the loop
+  // keeps real time and waits while the page has paused it.
+  std::unique_ptr<vsd::web::Server> server;
+  if (serve_port >= 0) {
+    vsd::web::Options web_options;
+    web_options.port = serve_port;
+    server = std::make_unique<vsd::web::Server>(env, s, web_options);
+    server->start();
+    std::signal(SIGINT, on_stop_signal);
+    std::signal(SIGTERM, on_stop_signal);
+    std::printf("web: serving %s (write token %s); Ctrl-C stops\n", server->url().c_str(), server->token().c_str());
+    std::fflush(stdout);
+  }
+  const auto wall_start = std::chrono::steady_clock::now();
+  double paused_for = 0;  // wall-clock seconds spent paused, not owed to real time
+#endif
   while (env.time() < time_limit && done->count() < static_cast<std::int64_t>(boxes.size())) {
+#ifdef VSD_WORKCELL_WEB
+    if (server) {
+      if (interrupted) break;
+      const auto pause_start = std::chrono::steady_clock::now();
+      while (server->paused() && !interrupted) server->serve_for(std::chrono::milliseconds(20));
+      paused_for += std::chrono::duration<double>(std::chrono::steady_clock::now() - pause_start).count();
+      const double ahead = env.time() - (std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count() - paused_for);
+      if (ahead > 0) server->serve_for(std::chrono::milliseconds(static_cast<long>(ahead * 1000)));
+    }
+#endif
     // The scenario's disturbance (the plant's, not the supervisor's): while the robot comes down onto
     // box2, an operator slides the box 7 cm aside. The descent then ends without a contact, and the
     // supervisor has to notice and try again.
@@ -433,6 +499,15 @@ int main(int argc, char** argv) try {
   const bool marked = done->count() == static_cast<std::int64_t>(boxes.size()) &&
                       net.place("robot_free", supervisor)->count() == 1;
   std::printf("check: final marking %s\n", marked ? "all jobs done, robot free" : "NOT complete");
+#ifdef VSD_WORKCELL_WEB
+  if (server) {
+    std::printf("web: the cell stays on %s until Ctrl-C\n", server->url().c_str());
+    std::fflush(stdout);
+    server->pause(true);
+    while (!interrupted) server->serve_for(std::chrono::milliseconds(100));
+    std::printf("web: stopped\n");
+  }
+#endif
   return all && marked && net.condition_errors().empty() ? 0 : 1;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "vsd_workcell: %s\n", e.what());
