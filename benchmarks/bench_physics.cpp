@@ -330,8 +330,8 @@ BENCHMARK(BM_PhysicsStep_Mujoco)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 // step. World::step is DART's whole step: collision, its boxed-LCP constraint solver (Dantzig, PGS as the
 // fallback), integration. Collision through DART's ODE detector (argument 0: the like-for-like figure,
 // ODE's own box, sphere and plane tests) or its FCL detector (argument 1: FCL with DART's default of meshed
-// primitives, the ground a box). The contact cap is raised from DART's default of 1000, past which bodies sink. Poses and
-// velocities are read back after each step, as the plain ODE loop does.
+// primitives, the ground a box). The contact cap is raised from DART's default of 1000, past which bodies
+// sink. Poses and velocities are read back after each step, as the plain ODE loop does.
 struct DartScene {
   dart::simulation::WorldPtr world = dart::simulation::World::create();
   std::vector<dart::dynamics::BodyNode*> bodies;
@@ -367,7 +367,9 @@ struct DartScene {
         shape = std::make_shared<BoxShape>(Eigen::Vector3d::Constant(2 * half));
       else
         shape = std::make_shared<SphereShape>(half);
-      body->createShapeNodeWith<CollisionAspect, DynamicsAspect>(shape)->getDynamicsAspect()->setFrictionCoeff(mu);
+      body->createShapeNodeWith<CollisionAspect, DynamicsAspect>(shape)
+          ->getDynamicsAspect()
+          ->setFrictionCoeff(mu);
       const double mass = density * shape->getVolume();
       body->setInertia(Inertia(mass, Eigen::Vector3d::Zero(), shape->computeInertia(mass)));
       Eigen::Isometry3d tf = Eigen::Isometry3d::Identity();
@@ -384,7 +386,8 @@ struct DartScene {
     double* out = poses.data();
     for (auto* b : bodies) {
       const Eigen::Isometry3d& tf = b->getWorldTransform();
-      const Eigen::Vector6d v = b->getSpatialVelocity(dart::dynamics::Frame::World(), dart::dynamics::Frame::World());
+      const Eigen::Vector6d v =
+          b->getSpatialVelocity(dart::dynamics::Frame::World(), dart::dynamics::Frame::World());
       for (int k = 0; k < 3; ++k) *out++ = tf.translation()[k];
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) *out++ = tf.linear()(r, c);
@@ -400,7 +403,9 @@ void BM_PhysicsStep_Dart(benchmark::State& state) {
     scene.do_step();
     benchmark::DoNotOptimize(scene.poses.back());
   }
-  if (!all_resting(state, [&](int i) { return scene.bodies[static_cast<std::size_t>(i)]->getWorldTransform().translation().z(); }))
+  if (!all_resting(state, [&](int i) {
+        return scene.bodies[static_cast<std::size_t>(i)]->getWorldTransform().translation().z();
+      }))
     return;
   state.counters["contacts"] = static_cast<double>(scene.world->getLastCollisionResult().getNumContacts());
   state.SetItemsProcessed(state.iterations() * body_count);

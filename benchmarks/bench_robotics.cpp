@@ -10,6 +10,11 @@
 //                                    vsd's IkSolver (LM-damped least squares, limits respected, 5 ms budget)
 //                                    vs KDL's ChainIkSolverPos_LMA (default settings, no limits)
 //
+//   BM_Robotics_{Fk,Jacobian}_{Mujoco,Dart}, BM_Robotics_Ik_Dart: the same with MuJoCo 2.2 and DART 6, when
+//                                    found at configure time, loading the same URDF (see MujocoArm, DartArm
+//                                    and each benchmark for what its call covers); max_diff_vs_vsd is the
+//                                    largest difference of tip pose and Jacobian from vsd's (checked < 1e-9)
+//
 // Joint vectors cycle through 1024 random configurations within the limits (fixed seed), so nothing is
 // constant-folded and both libraries see the same inputs. The IK benchmarks time every solve on its own
 // and report median_us, p99_us and success (the fraction solved); items/s is solves per second.
@@ -38,6 +43,7 @@
 #ifdef VSD_BENCH_HAVE_DART
 #include <dart/dynamics/BodyNode.hpp>
 #include <dart/dynamics/InverseKinematics.hpp>
+#include <dart/dynamics/SimpleFrame.hpp>
 #include <dart/dynamics/Skeleton.hpp>
 #include <dart/utils/urdf/DartLoader.hpp>
 #endif
@@ -134,7 +140,7 @@ void BM_Robotics_Jacobian_Kdl(benchmark::State& state) {
 }
 BENCHMARK(BM_Robotics_Jacobian_Kdl);
 
-// ---- MuJoCo and DART: the same chain, loaded from the same URDF --------------------------------------------
+// ---- MuJoCo and DART: the same chain, loaded from the same URDF -----------------------------------------
 #if defined(VSD_BENCH_HAVE_MUJOCO) || defined(VSD_BENCH_HAVE_DART)
 // The iiwa14 URDF without its <visual> and <collision> elements: their meshes are not in the test data, and
 // no benchmark here needs them (vsd loads the file with load_meshes = false).
@@ -210,8 +216,9 @@ bool mujoco_ok(benchmark::State& state, const MujocoArm& arm) {
     state.SkipWithError("MuJoCo's model of the iiwa14 is not the 7-joint chain with iiwa_link_ee");
     return false;
   }
-  static const double diff = max_difference_from_vsd(
-      [&arm](const std::vector<double>& q, Eigen::Isometry3d& pose, Eigen::Matrix<double, 6, Eigen::Dynamic>& j) {
+  static const double diff =
+      max_difference_from_vsd([&arm](const std::vector<double>& q, Eigen::Isometry3d& pose,
+                                     Eigen::Matrix<double, 6, Eigen::Dynamic>& j) {
         double jp[21], jr[21];
         arm.set(q);
         arm.jacobian(jp, jr);
@@ -286,8 +293,9 @@ bool dart_ok(benchmark::State& state, DartArm& arm) {
     state.SkipWithError("DART's model of the iiwa14 is not the 7-joint chain with iiwa_link_ee");
     return false;
   }
-  static const double diff = max_difference_from_vsd(
-      [&arm](const std::vector<double>& q, Eigen::Isometry3d& pose, Eigen::Matrix<double, 6, Eigen::Dynamic>& j) {
+  static const double diff =
+      max_difference_from_vsd([&arm](const std::vector<double>& q, Eigen::Isometry3d& pose,
+                                     Eigen::Matrix<double, 6, Eigen::Dynamic>& j) {
         arm.skel->setPositions(Eigen::Map<const Eigen::VectorXd>(q.data(), 7));
         pose = arm.tip->getWorldTransform();
         const dart::math::Jacobian dj = arm.tip->getWorldJacobian();  // angular rows first
@@ -316,7 +324,8 @@ void BM_Robotics_Fk_Dart(benchmark::State& state) {
 }
 BENCHMARK(BM_Robotics_Fk_Dart);
 
-// setPositions, then the tip's world Jacobian (which brings the transforms of the bodies above it up to date).
+// setPositions, then the tip's world Jacobian (which brings the transforms of the bodies above it up to
+// date).
 void BM_Robotics_Jacobian_Dart(benchmark::State& state) {
   DartArm arm;
   if (!dart_ok(state, arm)) return;
@@ -407,6 +416,43 @@ void BM_Robotics_Ik_Kdl(benchmark::State& state) {
   report(state, us, ok);
 }
 BENCHMARK(BM_Robotics_Ik_Kdl);
+
+#ifdef VSD_BENCH_HAVE_DART
+// DART's InverseKinematics on the tip, with its defaults but for the DOF (the skeleton's 7), gradient descent
+// within the joint limits, solved when every component of the 6D error is within 1e-6 (vsd's tolerances are
+// 1e-6 m and 1e-6 rad). Seeded by setting the skeleton's positions; findSolution does not apply the result.
+// (MuJoCo has no IK; DART's ikfast plugin needs solver code generated for the robot, which the iiwa14
+// does not come with.)
+void BM_Robotics_Ik_Dart(benchmark::State& state) {
+  DartArm arm;
+  if (!dart_ok(state, arm)) return;
+  const auto& cases = ik_cases();
+  const auto& ik = arm.tip->getIK(true);
+  auto target = std::make_shared<dart::dynamics::SimpleFrame>(dart::dynamics::Frame::World(), "target");
+  ik->setTarget(target);
+  ik->setDofs(std::vector<std::size_t>{0, 1, 2, 3, 4, 5, 6});  // useChain(), the default, finds none here
+  Eigen::VectorXd out(7);
+  std::vector<double> us;
+  std::size_t ok = 0, i = 0;
+  for (auto _ : state) {
+    const IkCase& c = cases[i++ & 1023];
+    arm.skel->setPositions(Eigen::Map<const Eigen::VectorXd>(c.seed.data(), 7));
+    target->setTransform(c.target);
+    const auto t0 = std::chrono::steady_clock::now();
+    const bool solved = ik->findSolution(out);
+    us.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
+    // Solved means: its answer puts the tip on the target (checked here, not timed).
+    arm.skel->setPositions(out);
+    const Eigen::Isometry3d reached = arm.tip->getWorldTransform();
+    const bool on_target = (reached.translation() - c.target.translation()).norm() < 1e-5 &&
+                           Eigen::AngleAxisd(reached.linear().transpose() * c.target.linear()).angle() < 1e-5;
+    ok += solved && on_target ? 1 : 0;
+    benchmark::DoNotOptimize(out.data());
+  }
+  report(state, us, ok);
+}
+BENCHMARK(BM_Robotics_Ik_Dart);
+#endif
 
 }  // namespace
 

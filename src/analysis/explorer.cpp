@@ -785,7 +785,8 @@ class Explorer {
         const std::uint64_t frag = h & 0x7FFFFFFFull;
         const std::uint64_t* mk = ch.markings.data() + i * L.words;
         if (contains<0>(sh, frag, mk, L.words)) continue;
-        if (states_ >= kMaxStates) vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
+        if (states_ >= kMaxStates)
+          vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
         std::uint32_t id = 0;
         if (!ensure_slot(sh) || !add_state(mk, ch.parents[i], ch.firings[i], id)) return false;
         put_slot(sh, h, frag << 32 | id);
@@ -902,10 +903,12 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
   const bool unpack_states = !(use_masks && use_ops);
   // For the whole attempt: the net compiled for the layout, each worker's two unpacked markings, and the
   // result's markings (a dead one, an unbounded pair).
-  attempt_fixed_ = pk.bytes() + std::size_t{threads_} * (P * 8 + kBatch * L.words * 8) + std::size_t{3} * P * 4;
+  attempt_fixed_ =
+      pk.bytes() + std::size_t{threads_} * (P * 8 + kBatch * L.words * 8) + std::size_t{3} * P * 4;
   if (fixed_ + attempt_fixed_ > limit_) {
-    over_limit(r, "while preparing the exploration (the net compiled for " + std::to_string(bits) +
-                      " bit(s) per place, " + std::to_string(threads_) + " worker(s))",
+    over_limit(r,
+               "while preparing the exploration (the net compiled for " + std::to_string(bits) +
+                   " bit(s) per place, " + std::to_string(threads_) + " worker(s))",
                fixed_ + attempt_fixed_);
     return true;
   }
@@ -1134,10 +1137,11 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
             std::size_t need = 1;
             if (!fused) {
               need = k0;
-              for (std::uint32_t wd = 0; wd < tw_; ++wd) need += static_cast<std::size_t>(std::popcount(en[wd]));
+              for (std::uint32_t wd = 0; wd < tw_; ++wd)
+                need += static_cast<std::size_t>(std::popcount(en[wd]));
             }
-            if (!shared && (!fit(ch.markings, need * words) || !fit(ch.hashes, need) || !fit(ch.parents, need) ||
-                            !fit(ch.firings, need))) {
+            if (!shared && (!fit(ch.markings, need * words) || !fit(ch.hashes, need) ||
+                            !fit(ch.parents, need) || !fit(ch.firings, need))) {
               stop.store(true, std::memory_order_relaxed);
               break;
             }
@@ -1242,9 +1246,9 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
       if (too_many_.load()) vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
       close_shared_level(ws, workers, L, !stop.load());
     }
-    if (stop.load() ||
-        (!fused && !(shared ? drain_stash(workers, L) : phases_b_to_d(nchunks, L)))) {  // no room (the only other stop, an
-      end_phase();                                                // overflow, returned above)
+    // No room (the only other stop, an overflow, returned above):
+    if (stop.load() || (!fused && !(shared ? drain_stash(workers, L) : phases_b_to_d(nchunks, L)))) {
+      end_phase();
       check_memory(r);
       break;
     }
