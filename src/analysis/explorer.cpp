@@ -1,7 +1,9 @@
 // Breadth-first exploration of a PtNet's reachable markings. See explorer.hpp for the design; the
 // comments here say why each piece is the way it is.
 //
-// One level of the breadth-first search runs in four phases:
+// A level of a net with structural bounds is either fused (one worker, small hash set) or shared (the
+// workers insert into the hash set themselves: insert_shared). A level of another net, when not fused,
+// runs in four phases:
 //   A (parallel over chunks of the frontier): enabled sets (incrementally from the parent's), counts,
 //     and the successor markings ("candidates") in per-chunk buffers, each with its hash;
 //   B (parallel over hash-set shards): each candidate is looked up in, or inserted into, its shard;
@@ -948,8 +950,8 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     // One worker and a small hash set: each successor is looked up (and a new one numbered) as soon as it is
     // made, in the order phases B and C would have used, so the numbering is the same; no successor buffers,
     // and phases B to D fall away. Chunk 0 serves as scratch. Only while the hash set is small enough to stay
-    // in cache: on a larger one the lookups are cache misses, which phase B hides by prefetching a few
-    // candidates ahead (the ring of 490 314 states ran 25 % slower fused).
+    // in cache: on a larger one the lookups are cache misses, which shared levels and phase B hide by
+    // prefetching a few candidates ahead (the ring of 490 314 states ran 25 % slower fused than phased).
     std::size_t table_bytes = 0;
     for (const auto& sh : shards_) table_bytes += sh.slots.size() * 8;
     const bool small_table = table_bytes <= kFusedTableBytes;
