@@ -16,7 +16,7 @@
 #include <memory>
 #include <vector>
 #ifdef VSD_BENCH_HAVE_MUJOCO
-#include <mujoco/mujoco.h>
+#include "mujoco_peer.hpp"
 
 #include <cstring>
 #include <sstream>
@@ -281,14 +281,7 @@ struct MujocoScene {
     }
     x << "</worldbody></mujoco>";
     const std::string xml = x.str();
-    auto vfs = std::make_unique<mjVFS>();  // ~2 MB: not on the stack
-    mj_defaultVFS(vfs.get());
-    mj_makeEmptyFileVFS(vfs.get(), "bodies.xml", static_cast<int>(xml.size()));
-    std::memcpy(vfs->filedata[mj_findFileVFS(vfs.get(), "bodies.xml")], xml.data(), xml.size());
-    char error[1000] = "";
-    m = mj_loadXML("bodies.xml", vfs.get(), error, sizeof error);
-    mj_deleteVFS(vfs.get());
-    if (m == nullptr) throw std::runtime_error(std::string("MuJoCo could not load the scene: ") + error);
+    m = vsd_bench::load_mujoco("bodies.xml", xml);
     m->opt.solver = solver == 0 ? mjSOL_NEWTON : mjSOL_PGS;
     d = mj_makeData(m);
     poses.resize(static_cast<std::size_t>(m->nq + m->nv));

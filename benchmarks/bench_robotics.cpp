@@ -38,7 +38,7 @@
 #include <stdexcept>
 #endif
 #ifdef VSD_BENCH_HAVE_MUJOCO
-#include <mujoco/mujoco.h>
+#include "mujoco_peer.hpp"
 #endif
 #ifdef VSD_BENCH_HAVE_DART
 #include <dart/dynamics/BodyNode.hpp>
@@ -183,14 +183,7 @@ struct MujocoArm {
     std::string xml = bare_urdf();
     xml.insert(xml.find('>', xml.find("<robot")) + 1,
                R"(<mujoco><compiler fusestatic="false" discardvisual="true"/></mujoco>)");
-    auto vfs = std::make_unique<mjVFS>();  // ~2 MB: not on the stack
-    mj_defaultVFS(vfs.get());
-    mj_makeEmptyFileVFS(vfs.get(), "iiwa14.urdf", static_cast<int>(xml.size()));
-    std::memcpy(vfs->filedata[mj_findFileVFS(vfs.get(), "iiwa14.urdf")], xml.data(), xml.size());
-    char error[1000] = "";
-    m = mj_loadXML("iiwa14.urdf", vfs.get(), error, sizeof error);
-    mj_deleteVFS(vfs.get());
-    if (m == nullptr) throw std::runtime_error(std::string("MuJoCo could not load the iiwa14: ") + error);
+    m = vsd_bench::load_mujoco("iiwa14.urdf", xml);
     d = mj_makeData(m);
     tip = mj_name2id(m, mjOBJ_BODY, "iiwa_link_ee");
   }
