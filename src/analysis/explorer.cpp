@@ -648,11 +648,13 @@ class Explorer {
   }
 
   // ---- shared levels: all workers insert into the hash set at once --------------------------------
-  // A slot is claimed by a compare-and-swap from empty to "busy" (kPendingBit and the hash fragment), then
-  // the new state gets the next index from next_id_, its record is written, and the slot is published
-  // (release) as fragment and index. A worker that meets a busy slot with its fragment waits for it.
-  // Shards cannot grow while workers probe them: they are sized before the level (reserve_slots), and a
-  // successor whose shard is three quarters full is left in the worker's stash for drain_stash().
+  // A worker that finds no entry for a marking writes its record at the worker's next state index, then
+  // claims the empty slot with a compare-and-swap to fragment and index (release: the record is there for
+  // whoever finds the slot); if another worker got there first it looks at that entry instead and keeps
+  // the index for its next new state. Shards cannot grow while workers probe them, nor can the list of
+  // arena blocks move: both are sized before the level (reserve_slots, blocks_ capacity), and a successor
+  // that finds its shard three quarters full or the list at its capacity is left in the worker's stash
+  // for drain_stash().
 
   // Capacity in shard s for `extra` more entries at a load of at most one half; false without room.
   bool reserve_slots(Shard& s, std::size_t extra) {
@@ -665,14 +667,15 @@ class Explorer {
     release(old);
     return true;
   }
-  // The record of new state id (its arena block made if need be), or nullptr without room. blocks_ has
-  // capacity for every block of the level (reserved before it), so it never moves while workers read it.
+  // The record of new state id (its arena block made if need be), or nullptr without room (full_ set) or
+  // when blocks_ is at its capacity: it must not move while workers read it.
   std::uint64_t* new_record(std::uint32_t id) {
     const std::size_t b = id >> block_bits_;
     if (b >= blocks_ready_.load(std::memory_order_acquire)) {
       std::lock_guard<std::mutex> lock(blocks_mutex_);
       while (blocks_.size() <= b) {
-        if (blocks_.size() == blocks_.capacity() || !room(block_bytes())) return nullptr;
+        if (blocks_.size() == blocks_.capacity()) return nullptr;
+        if (!room(block_bytes())) return nullptr;
         blocks_.emplace_back(new std::uint64_t[(std::size_t{1} << block_bits_) * layout_.record]);
       }
       blocks_ready_.store(blocks_.size(), std::memory_order_release);
@@ -682,11 +685,10 @@ class Explorer {
   enum class Insert { found, added, stashed, failed };
   // Looks mk up and adds it if new, concurrently with other workers (see above).
   Insert insert_shared(WorkerStats& st, const std::uint64_t* mk, std::uint32_t words, std::uint64_t h,
-                       std::uint32_t par, std::uint32_t t, const std::atomic<bool>& stop) {
+                       std::uint32_t par, std::uint32_t t) {
     const std::size_t si = h >> (64 - kShardBits);
     Shard& sh = shards_[si];
     const std::uint64_t frag = h & 0x7FFFFFFFull;
-    const std::uint64_t busy = kPendingBit | frag << 32;
     std::uint64_t* const slots = sh.slots.data();
     const std::size_t mask = sh.slots.size() - 1;
     for (std::size_t pos = frag & mask;; pos = (pos + 1) & mask) {
@@ -709,32 +711,30 @@ class Explorer {
             }
             st.credits[si] = take;
           }
-          if (!slot.compare_exchange_strong(v, busy, std::memory_order_acquire))
-            continue;  // v is what another worker put there: look at it
-          --st.credits[si];
+          // The record first, at the worker's next index, then the slot (release): whoever finds the slot
+          // finds the record. If another worker takes the slot first, the index stays for the next one.
           if (st.id_next == st.id_end) {
             st.id_next = next_id_.fetch_add(kCredit, std::memory_order_relaxed);
             st.id_end = st.id_next + kCredit;
           }
-          const std::uint64_t id = st.id_next++;
-          std::uint64_t* rec = id < kMaxStates ? new_record(static_cast<std::uint32_t>(id)) : nullptr;
-          if (rec == nullptr) {
-            if (id >= kMaxStates) too_many_.store(true, std::memory_order_relaxed);
-            lost_.fetch_add(1, std::memory_order_relaxed);
-            return Insert::failed;  // the slot stays busy: the run stops, nothing probes it again
+          const std::uint64_t id = st.id_next;
+          if (id >= kMaxStates) {
+            too_many_.store(true, std::memory_order_relaxed);
+            return Insert::failed;
           }
+          std::uint64_t* rec = new_record(static_cast<std::uint32_t>(id));
+          if (rec == nullptr)  // no room (the run stops), or blocks_ is at its capacity: after the level
+            return full_.load(std::memory_order_relaxed) ? Insert::failed : Insert::stashed;
           std::memcpy(rec, mk, words * 8);
           rec[words] = (std::uint64_t{par} << 32) | t;
-          slot.store(frag << 32 | id, std::memory_order_release);
+          if (!slot.compare_exchange_strong(v, frag << 32 | id, std::memory_order_acq_rel,
+                                            std::memory_order_acquire))
+            continue;  // v is what another worker put there: look at it
+          --st.credits[si];
+          ++st.id_next;
           return Insert::added;
         }
         if (((v >> 32) & 0x7FFFFFFFull) != frag) break;
-        if (v & kPendingBit) {  // being added: its record is not there yet
-          if (stop.load(std::memory_order_relaxed)) return Insert::failed;
-          std::this_thread::yield();
-          v = slot.load(std::memory_order_acquire);
-          continue;
-        }
         if (same(record(static_cast<std::uint32_t>(v & 0xFFFFFFFFull)), mk, words)) return Insert::found;
         break;
       }
@@ -758,7 +758,7 @@ class Explorer {
       st.id_next = st.id_end = 0;
     }
     const std::uint64_t count = end - holes.size();
-    states_ = count - lost_.load();
+    states_ = count;
     if (!compact) return;
     std::sort(holes.begin(), holes.end());
     std::size_t next_hole = 0;
@@ -865,10 +865,9 @@ class Explorer {
   std::vector<std::uint64_t> prev_enabled_, cur_enabled_;
   std::uint64_t states_ = 0;
   std::uint64_t edges_ = 0;
-  // Shared levels (insert_shared): the next state index, states lost to a failed insert, 2^32-2 passed;
-  // blocks_ entries made (new_record makes more under blocks_mutex_).
+  // Shared levels (insert_shared): the next state index, 2^32-2 passed; blocks_ entries made (new_record
+  // makes more under blocks_mutex_).
   std::atomic<std::uint64_t> next_id_{0};
-  std::atomic<std::uint64_t> lost_{0};
   std::atomic<bool> too_many_{false};
   std::atomic<std::size_t> blocks_ready_{0};
   std::mutex blocks_mutex_;
@@ -972,15 +971,14 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     const std::uint64_t new_lo = states_;
     begin_phase();
     if (shared) {  // room for the level's new states: arena block list, hash shards (see insert_shared)
-      const std::uint64_t bound =
-          std::min<std::uint64_t>(n * c_.transitions, kMaxStates - std::min(kMaxStates, states_)) +
-          std::uint64_t{workers} * kCredit + 1;
-      const std::size_t list = static_cast<std::size_t>((states_ + bound) >> block_bits_) + 2;
       // Expected new states: the frontier grew by n / prev_n last level; half as much again for the
       // variation among shards. More goes to the stashes.
       const double grow = prev_n == 0 ? 1.0 : static_cast<double>(n) / static_cast<double>(prev_n);
       const auto per_shard = static_cast<std::size_t>(static_cast<double>(n) * std::max(1.0, grow) * 1.5 /
                                                       static_cast<double>(kShards)) + 16;
+      // Arena blocks for as many, and the workers' unused index ranges (kCredit each).
+      const std::size_t list = static_cast<std::size_t>(
+          (states_ + per_shard * kShards + std::uint64_t{workers} * kCredit) >> block_bits_) + 2;
       bool ok = blocks_.capacity() >= list || fit(blocks_, list);
       for (auto& sh : shards_) ok = ok && reserve_slots(sh, per_shard);
       if (!ok) {
@@ -990,7 +988,6 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
       }
       blocks_ready_.store(blocks_.size());
       next_id_.store(states_);
-      lost_.store(0);
       too_many_.store(false);
     }
     {  // the chunks and the level's enabled sets, within the limit
@@ -1041,7 +1038,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
             for (std::uint32_t j = 0; j < st.batched && !no_room; ++j) {
               const std::uint64_t* mk = st.batch_markings.data() + std::size_t{j} * words;
               const Insert in = insert_shared(st, mk, words, st.batch_hashes[j], st.batch_parents[j],
-                                              st.batch_firings[j], stop);
+                                              st.batch_firings[j]);
               if (in == Insert::stashed) {
                 const std::size_t at = ch.hashes.size();
                 if (fit(ch.markings, (at + 1) * words) && fit(ch.hashes, at + 1) && fit(ch.parents, at + 1) &&
