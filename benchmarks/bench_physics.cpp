@@ -5,12 +5,37 @@
 // the database adds: sync (nothing dirty in the steady state), material lookup through the hulls, and the
 // write-back of every pose and velocity through the setters (with the scene's world-frame listeners on).
 // The plain ODE loop reads the poses back into an array, as any application would.
+//
+// MuJoCo 2.2 and DART 6 step the same bodies too when they are found at configure time (see MujocoScene
+// and DartScene for what each step covers); every peer's benchmark fails unless all bodies still rest on
+// the plane after it, and reports its contact count.
 #include <benchmark/benchmark.h>
 #include <ode/ode.h>
 
 #include <cmath>
 #include <memory>
 #include <vector>
+#ifdef VSD_BENCH_HAVE_MUJOCO
+#include "mujoco_peer.hpp"
+
+#include <cstring>
+#include <sstream>
+#include <stdexcept>
+#endif
+#ifdef VSD_BENCH_HAVE_DART
+#include <dart/collision/fcl/FCLCollisionDetector.hpp>
+#include <dart/collision/ode/OdeCollisionDetector.hpp>
+#include <dart/constraint/ConstraintSolver.hpp>
+#include <dart/dynamics/BodyNode.hpp>
+#include <dart/dynamics/BoxShape.hpp>
+#include <dart/dynamics/FreeJoint.hpp>
+#include <dart/dynamics/PlaneShape.hpp>
+#include <dart/dynamics/Skeleton.hpp>
+#include <dart/dynamics/SphereShape.hpp>
+#include <dart/dynamics/WeldJoint.hpp>
+#include <dart/simulation/World.hpp>
+#endif
+#include <string>
 
 #include "vsd/physics.hpp"
 
@@ -215,5 +240,170 @@ void BM_PhysicsStep_PlainOde(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * body_count);
 }
 BENCHMARK(BM_PhysicsStep_PlainOde)->Unit(benchmark::kMicrosecond);
+
+// After the steps: every body still rests on the plane (a peer whose contact buffer is too small lets
+// some fall through, which makes its steps cheaper and its figure meaningless).
+template <class Height>
+bool all_resting(benchmark::State& state, Height&& height) {
+  for (int i = 0; i < body_count; ++i) {
+    const double z = height(i);
+    if (!(z > 0.5 * half && z < 1.5 * half)) {
+      state.SkipWithError(("body " + std::to_string(i) + " no longer rests on the plane").c_str());
+      return false;
+    }
+  }
+  return true;
+}
+
+#ifdef VSD_BENCH_HAVE_MUJOCO
+// ---- MuJoCo 2.2, the same bodies ------------------------------------------------------------------------
+// Free bodies of the same size and density on an infinite plane, friction 0.5 (MuJoCo takes the larger of
+// two geoms' coefficients: 0.5), the same step. mj_step is MuJoCo's whole step: collision, constraint
+// solver (Newton, MuJoCo's default, or PGS: argument 0 or 1), integration. The contact buffers are raised
+// from 2.2.2's defaults, which hold 100 contacts and drop the rest (bodies then sink through the plane).
+// Poses and velocities are copied out of mjData after each step, as the plain ODE loop does.
+struct MujocoScene {
+  mjModel* m = nullptr;
+  mjData* d = nullptr;
+  std::vector<double> poses;
+  explicit MujocoScene(int solver) {
+    std::ostringstream x;
+    x << "<mujoco><option timestep=\"" << step << "\" gravity=\"0 0 -9.81\"/>"
+      << "<size nconmax=\"2000\" njmax=\"8000\"/>"
+      << "<default><geom friction=\"" << mu << " 0.005 0.0001\" density=\"" << density << "\"/></default>"
+      << "<worldbody><geom type=\"plane\" size=\"0 0 1\"/>";
+    for (int i = 0; i < body_count; ++i) {
+      const Eigen::Vector3d p = place(i);
+      x << "<body pos=\"" << p.x() << ' ' << p.y() << ' ' << p.z() << "\"><freejoint/><geom type=\""
+        << (i % 2 == 0 ? "box" : "sphere") << "\" size=\"" << half;
+      if (i % 2 == 0) x << ' ' << half << ' ' << half;
+      x << "\"/></body>";
+    }
+    x << "</worldbody></mujoco>";
+    const std::string xml = x.str();
+    m = vsd_bench::load_mujoco("bodies.xml", xml);
+    m->opt.solver = solver == 0 ? mjSOL_NEWTON : mjSOL_PGS;
+    d = mj_makeData(m);
+    poses.resize(static_cast<std::size_t>(m->nq + m->nv));
+    for (int i = 0; i < settle_steps; ++i) do_step();
+  }
+  MujocoScene(const MujocoScene&) = delete;
+  MujocoScene& operator=(const MujocoScene&) = delete;
+  ~MujocoScene() {
+    mj_deleteData(d);
+    mj_deleteModel(m);
+  }
+  void do_step() {
+    mj_step(m, d);
+    std::memcpy(poses.data(), d->qpos, sizeof(double) * static_cast<std::size_t>(m->nq));
+    std::memcpy(poses.data() + m->nq, d->qvel, sizeof(double) * static_cast<std::size_t>(m->nv));
+  }
+};
+
+void BM_PhysicsStep_Mujoco(benchmark::State& state) {
+  MujocoScene scene(static_cast<int>(state.range(0)));
+  state.SetLabel(state.range(0) == 0 ? "Newton" : "PGS");
+  for (auto _ : state) {
+    scene.do_step();
+    benchmark::DoNotOptimize(scene.poses.back());
+  }
+  if (scene.d->warning[mjWARN_CONTACTFULL].number > 0 || scene.d->warning[mjWARN_CNSTRFULL].number > 0)
+    state.SkipWithError("MuJoCo's contact or constraint buffer overflowed");
+  else if (!all_resting(state, [&](int i) { return scene.d->xpos[3 * (i + 1) + 2]; }))
+    return;
+  state.counters["contacts"] = scene.d->ncon;
+  state.SetItemsProcessed(state.iterations() * body_count);
+}
+BENCHMARK(BM_PhysicsStep_Mujoco)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+#endif
+
+#ifdef VSD_BENCH_HAVE_DART
+// ---- DART 6, the same bodies ----------------------------------------------------------------------------
+// One skeleton per body (a free joint), the ground a welded plane, friction 0.5 on every shape, the same
+// step. World::step is DART's whole step: collision, its boxed-LCP constraint solver (Dantzig, PGS as the
+// fallback), integration. Collision through DART's ODE detector (argument 0: the like-for-like figure,
+// ODE's own box, sphere and plane tests) or its FCL detector (argument 1: FCL with DART's default of meshed
+// primitives, the ground a box). The contact cap is raised from DART's default of 1000, past which bodies
+// sink. Poses and velocities are read back after each step, as the plain ODE loop does.
+struct DartScene {
+  dart::simulation::WorldPtr world = dart::simulation::World::create();
+  std::vector<dart::dynamics::BodyNode*> bodies;
+  std::vector<double> poses;
+  explicit DartScene(int detector) {
+    using namespace dart::dynamics;
+    world->setTimeStep(step);
+    world->setGravity(Eigen::Vector3d(0, 0, -9.81));
+    auto* solver = world->getConstraintSolver();  // the detector first: the shapes go to it as they come
+    if (detector == 0)
+      solver->setCollisionDetector(dart::collision::OdeCollisionDetector::create());
+    else
+      solver->setCollisionDetector(dart::collision::FCLCollisionDetector::create());
+    solver->getCollisionOption().maxNumContacts = 10000;
+    auto ground = Skeleton::create("ground");
+    auto* g = ground->createJointAndBodyNodePair<WeldJoint>().second;
+    // FCL has no plane in DART 6.12 (it substitutes a box of zero thickness, and bodies fall through): a
+    // box 1 m thick whose top face is the plane instead.
+    ShapePtr floor = std::make_shared<PlaneShape>(Eigen::Vector3d::UnitZ(), 0.0);
+    if (detector != 0) {
+      floor = std::make_shared<BoxShape>(Eigen::Vector3d(1000, 1000, 1));
+      Eigen::Isometry3d below = Eigen::Isometry3d::Identity();
+      below.translation().z() = -0.5;
+      g->getParentJoint()->setTransformFromParentBodyNode(below);
+    }
+    g->createShapeNodeWith<CollisionAspect, DynamicsAspect>(floor)->getDynamicsAspect()->setFrictionCoeff(mu);
+    world->addSkeleton(ground);
+    for (int i = 0; i < body_count; ++i) {
+      auto skel = Skeleton::create("body" + std::to_string(i));
+      auto [joint, body] = skel->createJointAndBodyNodePair<FreeJoint>();
+      ShapePtr shape;
+      if (i % 2 == 0)
+        shape = std::make_shared<BoxShape>(Eigen::Vector3d::Constant(2 * half));
+      else
+        shape = std::make_shared<SphereShape>(half);
+      body->createShapeNodeWith<CollisionAspect, DynamicsAspect>(shape)
+          ->getDynamicsAspect()
+          ->setFrictionCoeff(mu);
+      const double mass = density * shape->getVolume();
+      body->setInertia(Inertia(mass, Eigen::Vector3d::Zero(), shape->computeInertia(mass)));
+      Eigen::Isometry3d tf = Eigen::Isometry3d::Identity();
+      tf.translation() = place(i);
+      FreeJoint::setTransformOf(joint, tf);
+      world->addSkeleton(skel);
+      bodies.push_back(body);
+    }
+    poses.resize(bodies.size() * 18);
+    for (int i = 0; i < settle_steps; ++i) do_step();
+  }
+  void do_step() {
+    world->step();
+    double* out = poses.data();
+    for (auto* b : bodies) {
+      const Eigen::Isometry3d& tf = b->getWorldTransform();
+      const Eigen::Vector6d v =
+          b->getSpatialVelocity(dart::dynamics::Frame::World(), dart::dynamics::Frame::World());
+      for (int k = 0; k < 3; ++k) *out++ = tf.translation()[k];
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) *out++ = tf.linear()(r, c);
+      for (int k = 0; k < 6; ++k) *out++ = v[k];
+    }
+  }
+};
+
+void BM_PhysicsStep_Dart(benchmark::State& state) {
+  DartScene scene(static_cast<int>(state.range(0)));
+  state.SetLabel(state.range(0) == 0 ? "ODE collision" : "FCL collision");
+  for (auto _ : state) {
+    scene.do_step();
+    benchmark::DoNotOptimize(scene.poses.back());
+  }
+  if (!all_resting(state, [&](int i) {
+        return scene.bodies[static_cast<std::size_t>(i)]->getWorldTransform().translation().z();
+      }))
+    return;
+  state.counters["contacts"] = static_cast<double>(scene.world->getLastCollisionResult().getNumContacts());
+  state.SetItemsProcessed(state.iterations() * body_count);
+}
+BENCHMARK(BM_PhysicsStep_Dart)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+#endif
 
 }  // namespace

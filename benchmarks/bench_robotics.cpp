@@ -10,6 +10,11 @@
 //                                    vsd's IkSolver (LM-damped least squares, limits respected, 5 ms budget)
 //                                    vs KDL's ChainIkSolverPos_LMA (default settings, no limits)
 //
+//   BM_Robotics_{Fk,Jacobian}_{Mujoco,Dart}, BM_Robotics_Ik_Dart: the same with MuJoCo 2.2 and DART 6, when
+//                                    found at configure time, loading the same URDF (see MujocoArm, DartArm
+//                                    and each benchmark for what its call covers); max_diff_vs_vsd is the
+//                                    largest difference of tip pose and Jacobian from vsd's (checked < 1e-9)
+//
 // Joint vectors cycle through 1024 random configurations within the limits (fixed seed), so nothing is
 // constant-folded and both libraries see the same inputs. The IK benchmarks time every solve on its own
 // and report median_us, p99_us and success (the fraction solved); items/s is solves per second.
@@ -26,6 +31,22 @@
 #include <vector>
 
 #include "kdl_chain.hpp"
+#if defined(VSD_BENCH_HAVE_MUJOCO) || defined(VSD_BENCH_HAVE_DART)
+#include <cstring>
+#include <memory>
+#include <regex>
+#include <stdexcept>
+#endif
+#ifdef VSD_BENCH_HAVE_MUJOCO
+#include "mujoco_peer.hpp"
+#endif
+#ifdef VSD_BENCH_HAVE_DART
+#include <dart/dynamics/BodyNode.hpp>
+#include <dart/dynamics/InverseKinematics.hpp>
+#include <dart/dynamics/SimpleFrame.hpp>
+#include <dart/dynamics/Skeleton.hpp>
+#include <dart/utils/urdf/DartLoader.hpp>
+#endif
 #include "test_util.hpp"
 #include "vsd/robotics.hpp"
 
@@ -119,6 +140,199 @@ void BM_Robotics_Jacobian_Kdl(benchmark::State& state) {
 }
 BENCHMARK(BM_Robotics_Jacobian_Kdl);
 
+// ---- MuJoCo and DART: the same chain, loaded from the same URDF -----------------------------------------
+#if defined(VSD_BENCH_HAVE_MUJOCO) || defined(VSD_BENCH_HAVE_DART)
+// The iiwa14 URDF without its <visual> and <collision> elements: their meshes are not in the test data, and
+// no benchmark here needs them (vsd loads the file with load_meshes = false).
+std::string bare_urdf() {
+  const std::string xml = vsd_test::read_text(std::string(VSD_BENCH_ROBOT_DIR) + "/iiwa14.urdf");
+  static const std::regex element(R"(<(visual|collision)\b[\s\S]*?</\1>)");
+  return std::regex_replace(xml, element, "");
+}
+
+// The largest difference between a peer's tip pose and Jacobian (linear rows first) and vsd's, over the
+// 1024 configurations: the benchmarks below compare like with like only while this is at rounding level.
+template <class Peer>
+double max_difference_from_vsd(Peer&& peer) {
+  Fixture& f = fixture();
+  Model::Data d = f.model.make_data();
+  Eigen::Matrix<double, 6, Eigen::Dynamic> j(6, 7), pj(6, 7);
+  Eigen::Isometry3d pose;
+  double most = 0;
+  for (const auto& q : f.qs) {
+    f.model.forward(q.data(), d);
+    f.model.jacobian(d, f.model.tip(), j);
+    peer(q, pose, pj);
+    const Frame tip = f.model.pose(d, f.model.tip());
+    most = std::max({most, (pose.translation() - tip.translation).cwiseAbs().maxCoeff(),
+                     (pose.linear() - tip.rotation).cwiseAbs().maxCoeff(), (pj - j).cwiseAbs().maxCoeff()});
+  }
+  return most;
+}
+constexpr double kAgree = 1e-9;
+#endif
+
+#ifdef VSD_BENCH_HAVE_MUJOCO
+// MuJoCo 2.2 reads URDF itself; told to keep the links hanging from fixed joints as bodies (fusestatic),
+// iiwa_link_ee among them.
+struct MujocoArm {
+  mjModel* m = nullptr;
+  mjData* d = nullptr;
+  int tip = -1;
+  MujocoArm() {
+    std::string xml = bare_urdf();
+    xml.insert(xml.find('>', xml.find("<robot")) + 1,
+               R"(<mujoco><compiler fusestatic="false" discardvisual="true"/></mujoco>)");
+    m = vsd_bench::load_mujoco("iiwa14.urdf", xml);
+    d = mj_makeData(m);
+    tip = mj_name2id(m, mjOBJ_BODY, "iiwa_link_ee");
+  }
+  MujocoArm(const MujocoArm&) = delete;
+  MujocoArm& operator=(const MujocoArm&) = delete;
+  ~MujocoArm() {
+    mj_deleteData(d);
+    mj_deleteModel(m);
+  }
+  void set(const std::vector<double>& q) const {
+    for (int i = 0; i < 7; ++i) d->qpos[i] = q[static_cast<std::size_t>(i)];
+  }
+  // FK + tip Jacobian: mj_jacBody needs the motion subspaces (cdof) that mj_comPos computes.
+  void jacobian(double* jacp, double* jacr) const {
+    mj_kinematics(m, d);
+    mj_comPos(m, d);
+    mj_jacBody(m, d, jacp, jacr, tip);
+  }
+};
+
+bool mujoco_ok(benchmark::State& state, const MujocoArm& arm) {
+  if (arm.m->nq != 7 || arm.m->nv != 7 || arm.tip < 0) {
+    state.SkipWithError("MuJoCo's model of the iiwa14 is not the 7-joint chain with iiwa_link_ee");
+    return false;
+  }
+  static const double diff =
+      max_difference_from_vsd([&arm](const std::vector<double>& q, Eigen::Isometry3d& pose,
+                                     Eigen::Matrix<double, 6, Eigen::Dynamic>& j) {
+        double jp[21], jr[21];
+        arm.set(q);
+        arm.jacobian(jp, jr);
+        pose.setIdentity();
+        for (int r = 0; r < 3; ++r) {
+          pose.translation()[r] = arm.d->xpos[3 * arm.tip + r];
+          for (int c = 0; c < 3; ++c) pose.linear()(r, c) = arm.d->xmat[9 * arm.tip + 3 * r + c];
+          for (int c = 0; c < 7; ++c) {
+            j(r, c) = jp[7 * r + c];
+            j(3 + r, c) = jr[7 * r + c];
+          }
+        }
+      });
+  state.counters["max_diff_vs_vsd"] = diff;
+  if (diff > kAgree) state.SkipWithError("MuJoCo's tip pose or Jacobian differs from vsd's");
+  return diff <= kAgree;
+}
+
+// Every body of the model (world, the 8 links, iiwa_link_ee and iiwa_link_ee_kuka): frames and inertial
+// frames.
+void BM_Robotics_Fk_Mujoco(benchmark::State& state) {
+  Fixture& f = fixture();
+  MujocoArm arm;
+  if (!mujoco_ok(state, arm)) return;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    arm.set(f.qs[i++ & 1023]);
+    mj_kinematics(arm.m, arm.d);
+    benchmark::DoNotOptimize(arm.d->xpos[3 * arm.tip]);
+    benchmark::ClobberMemory();
+  }
+  state.counters["bodies"] = arm.m->nbody;
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_Robotics_Fk_Mujoco);
+
+void BM_Robotics_Jacobian_Mujoco(benchmark::State& state) {
+  Fixture& f = fixture();
+  MujocoArm arm;
+  if (!mujoco_ok(state, arm)) return;
+  double jp[21], jr[21];
+  std::size_t i = 0;
+  for (auto _ : state) {
+    arm.set(f.qs[i++ & 1023]);
+    arm.jacobian(jp, jr);
+    benchmark::DoNotOptimize(jp);
+    benchmark::DoNotOptimize(jr);
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_Robotics_Jacobian_Mujoco);
+#endif
+
+#ifdef VSD_BENCH_HAVE_DART
+// DART 6 through its URDF loader: the world link and its fixed joint become a welded root, 7 DOF.
+struct DartArm {
+  dart::dynamics::SkeletonPtr skel;
+  dart::dynamics::BodyNode* tip = nullptr;
+  std::vector<Eigen::VectorXd> qs;
+  DartArm() {
+    dart::utils::DartLoader loader;
+    skel = loader.parseSkeletonString(bare_urdf(), dart::common::Uri("file:///iiwa14.urdf"));
+    if (skel == nullptr) throw std::runtime_error("DART could not load the iiwa14");
+    tip = skel->getBodyNode("iiwa_link_ee");
+    for (const auto& q : fixture().qs) qs.push_back(Eigen::Map<const Eigen::VectorXd>(q.data(), 7));
+  }
+};
+
+bool dart_ok(benchmark::State& state, DartArm& arm) {
+  if (arm.skel->getNumDofs() != 7 || arm.tip == nullptr) {
+    state.SkipWithError("DART's model of the iiwa14 is not the 7-joint chain with iiwa_link_ee");
+    return false;
+  }
+  static const double diff =
+      max_difference_from_vsd([&arm](const std::vector<double>& q, Eigen::Isometry3d& pose,
+                                     Eigen::Matrix<double, 6, Eigen::Dynamic>& j) {
+        arm.skel->setPositions(Eigen::Map<const Eigen::VectorXd>(q.data(), 7));
+        pose = arm.tip->getWorldTransform();
+        const dart::math::Jacobian dj = arm.tip->getWorldJacobian();  // angular rows first
+        j.topRows<3>() = dj.bottomRows<3>();
+        j.bottomRows<3>() = dj.topRows<3>();
+      });
+  state.counters["max_diff_vs_vsd"] = diff;
+  if (diff > kAgree) state.SkipWithError("DART's tip pose or Jacobian differs from vsd's");
+  return diff <= kAgree;
+}
+
+// setPositions, then the world transform of every body node (DART computes them lazily, on request).
+void BM_Robotics_Fk_Dart(benchmark::State& state) {
+  DartArm arm;
+  if (!dart_ok(state, arm)) return;
+  const std::size_t bodies = arm.skel->getNumBodyNodes();
+  std::size_t i = 0;
+  for (auto _ : state) {
+    arm.skel->setPositions(arm.qs[i++ & 1023]);
+    for (std::size_t b = 0; b < bodies; ++b)
+      benchmark::DoNotOptimize(arm.skel->getBodyNode(b)->getWorldTransform().translation().data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["bodies"] = static_cast<double>(bodies);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_Robotics_Fk_Dart);
+
+// setPositions, then the tip's world Jacobian (which brings the transforms of the bodies above it up to
+// date).
+void BM_Robotics_Jacobian_Dart(benchmark::State& state) {
+  DartArm arm;
+  if (!dart_ok(state, arm)) return;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    arm.skel->setPositions(arm.qs[i++ & 1023]);
+    benchmark::DoNotOptimize(arm.tip->getWorldJacobian().data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_Robotics_Jacobian_Dart);
+#endif
+
 // Targets (FK of the random configurations) and nearby seeds, the same for both solvers.
 struct IkCase {
   Eigen::Isometry3d target;
@@ -195,6 +409,43 @@ void BM_Robotics_Ik_Kdl(benchmark::State& state) {
   report(state, us, ok);
 }
 BENCHMARK(BM_Robotics_Ik_Kdl);
+
+#ifdef VSD_BENCH_HAVE_DART
+// DART's InverseKinematics on the tip, with its defaults but for the DOF (the skeleton's 7), gradient descent
+// within the joint limits, solved when every component of the 6D error is within 1e-6 (vsd's tolerances are
+// 1e-6 m and 1e-6 rad). Seeded by setting the skeleton's positions; findSolution does not apply the result.
+// (MuJoCo has no IK; DART's ikfast plugin needs solver code generated for the robot, which the iiwa14
+// does not come with.)
+void BM_Robotics_Ik_Dart(benchmark::State& state) {
+  DartArm arm;
+  if (!dart_ok(state, arm)) return;
+  const auto& cases = ik_cases();
+  const auto& ik = arm.tip->getIK(true);
+  auto target = std::make_shared<dart::dynamics::SimpleFrame>(dart::dynamics::Frame::World(), "target");
+  ik->setTarget(target);
+  ik->setDofs(std::vector<std::size_t>{0, 1, 2, 3, 4, 5, 6});  // useChain(), the default, finds none here
+  Eigen::VectorXd out(7);
+  std::vector<double> us;
+  std::size_t ok = 0, i = 0;
+  for (auto _ : state) {
+    const IkCase& c = cases[i++ & 1023];
+    arm.skel->setPositions(Eigen::Map<const Eigen::VectorXd>(c.seed.data(), 7));
+    target->setTransform(c.target);
+    const auto t0 = std::chrono::steady_clock::now();
+    const bool solved = ik->findSolution(out);
+    us.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
+    // Solved means: its answer puts the tip on the target (checked here, not timed).
+    arm.skel->setPositions(out);
+    const Eigen::Isometry3d reached = arm.tip->getWorldTransform();
+    const bool on_target = (reached.translation() - c.target.translation()).norm() < 1e-5 &&
+                           Eigen::AngleAxisd(reached.linear().transpose() * c.target.linear()).angle() < 1e-5;
+    ok += solved && on_target ? 1 : 0;
+    benchmark::DoNotOptimize(out.data());
+  }
+  report(state, us, ok);
+}
+BENCHMARK(BM_Robotics_Ik_Dart);
+#endif
 
 }  // namespace
 

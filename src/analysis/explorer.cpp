@@ -1,7 +1,9 @@
 // Breadth-first exploration of a PtNet's reachable markings. See explorer.hpp for the design; the
 // comments here say why each piece is the way it is.
 //
-// One level of the breadth-first search runs in four phases:
+// A level of a net with structural bounds is either fused (one worker, small hash set) or shared (the
+// workers insert into the hash set themselves: insert_shared). A level of another net, when not fused,
+// runs in four phases:
 //   A (parallel over chunks of the frontier): enabled sets (incrementally from the parent's), counts,
 //     and the successor markings ("candidates") in per-chunk buffers, each with its hash;
 //   B (parallel over hash-set shards): each candidate is looked up in, or inserted into, its shard;
@@ -320,7 +322,20 @@ struct alignas(64) WorkerStats {
   bool overflow = false;
   std::vector<std::uint32_t> unpacked;
   std::vector<std::uint32_t> unpacked2;
+  // Shared levels (see `shared` in attempt()): successors made but not yet inserted, kBatch at most, so
+  // that their slots are prefetched while the next ones are made.
+  std::vector<std::uint64_t> batch_markings;  // kBatch * words
+  std::uint64_t batch_hashes[32];
+  std::uint32_t batch_parents[32], batch_firings[32];
+  std::uint32_t batched = 0;
+  // Shared levels: entries taken in each shard's `used` and not yet filled, and the state indices taken
+  // from next_id_ and not yet given out ([id_next, id_end)): both are taken kCredit at a time, so that
+  // the workers do not write the same cache lines for every new state.
+  std::uint32_t credits[kShards] = {};
+  std::uint64_t id_next = 0, id_end = 0;
 };
+constexpr std::uint32_t kBatch = 32;
+constexpr std::uint32_t kCredit = 64;
 
 // A growable array of a trivial type whose growth does not fill the new elements (std::vector::resize
 // would zero them, only to have them overwritten: a memset per frontier state).
@@ -632,6 +647,157 @@ class Explorer {
     ++s.used;
   }
 
+  // ---- shared levels: all workers insert into the hash set at once --------------------------------
+  // A worker that finds no entry for a marking writes its record at the worker's next state index, then
+  // claims the empty slot with a compare-and-swap to fragment and index (release: the record is there for
+  // whoever finds the slot); if another worker got there first it looks at that entry instead and keeps
+  // the index for its next new state. Shards cannot grow while workers probe them, nor can the list of
+  // arena blocks move: both are sized before the level (reserve_slots, blocks_ capacity), and a successor
+  // that finds its shard three quarters full or the list at its capacity is left in the worker's stash
+  // for drain_stash().
+
+  // Capacity in shard s for `extra` more entries at a load of at most one half; false without room.
+  bool reserve_slots(Shard& s, std::size_t extra) {
+    std::size_t size = s.slots.size();
+    while ((s.used + extra) * 2 > size) size *= 2;
+    if (size == s.slots.size()) return true;
+    const std::size_t old = s.slots.size() * 8;
+    if (!room(size * 8)) return false;
+    while (s.slots.size() < size) grow(s);
+    release(old);
+    return true;
+  }
+  // The record of new state id (its arena block made if need be), or nullptr without room (full_ set) or
+  // when blocks_ is at its capacity: it must not move while workers read it.
+  std::uint64_t* new_record(std::uint32_t id) {
+    const std::size_t b = id >> block_bits_;
+    if (b >= blocks_ready_.load(std::memory_order_acquire)) {
+      std::lock_guard<std::mutex> lock(blocks_mutex_);
+      while (blocks_.size() <= b) {
+        if (blocks_.size() == blocks_.capacity()) return nullptr;
+        if (!room(block_bytes())) return nullptr;
+        blocks_.emplace_back(new std::uint64_t[(std::size_t{1} << block_bits_) * layout_.record]);
+      }
+      blocks_ready_.store(blocks_.size(), std::memory_order_release);
+    }
+    return record(id);
+  }
+  enum class Insert { found, added, stashed, failed };
+  // Looks mk up and adds it if new, concurrently with other workers (see above).
+  Insert insert_shared(WorkerStats& st, const std::uint64_t* mk, std::uint32_t words, std::uint64_t h,
+                       std::uint32_t par, std::uint32_t t) {
+    const std::size_t si = h >> (64 - kShardBits);
+    Shard& sh = shards_[si];
+    const std::uint64_t frag = h & 0x7FFFFFFFull;
+    std::uint64_t* const slots = sh.slots.data();
+    const std::size_t mask = sh.slots.size() - 1;
+    for (std::size_t pos = frag & mask;; pos = (pos + 1) & mask) {
+      std::atomic_ref<std::uint64_t> slot(slots[pos]);
+      std::uint64_t v = slot.load(std::memory_order_acquire);
+      while (true) {
+        if (v == kEmpty) {
+          // Take room for the entry first: the shard must never fill up (the probes would not end).
+          if (st.credits[si] == 0) {  // kCredit entries, or one when the shard is nearly full
+            std::atomic_ref<std::size_t> used(sh.used);
+            const std::size_t most = sh.slots.size() / 4 * 3;
+            std::uint32_t take = kCredit;
+            if (used.fetch_add(take, std::memory_order_relaxed) + take > most) {
+              used.fetch_sub(take, std::memory_order_relaxed);
+              take = 1;
+              if (used.fetch_add(take, std::memory_order_relaxed) + take > most) {
+                used.fetch_sub(take, std::memory_order_relaxed);
+                return Insert::stashed;
+              }
+            }
+            st.credits[si] = take;
+          }
+          // The record first, at the worker's next index, then the slot (release): whoever finds the slot
+          // finds the record. If another worker takes the slot first, the index stays for the next one.
+          if (st.id_next == st.id_end) {
+            st.id_next = next_id_.fetch_add(kCredit, std::memory_order_relaxed);
+            st.id_end = st.id_next + kCredit;
+          }
+          const std::uint64_t id = st.id_next;
+          if (id >= kMaxStates) {
+            too_many_.store(true, std::memory_order_relaxed);
+            return Insert::failed;
+          }
+          std::uint64_t* rec = new_record(static_cast<std::uint32_t>(id));
+          if (rec == nullptr)  // no room (the run stops), or blocks_ is at its capacity: after the level
+            return full_.load(std::memory_order_relaxed) ? Insert::failed : Insert::stashed;
+          std::memcpy(rec, mk, words * 8);
+          rec[words] = (std::uint64_t{par} << 32) | t;
+          if (!slot.compare_exchange_strong(v, frag << 32 | id, std::memory_order_acq_rel,
+                                            std::memory_order_acquire))
+            continue;  // v is what another worker put there: look at it
+          --st.credits[si];
+          ++st.id_next;
+          return Insert::added;
+        }
+        if (((v >> 32) & 0x7FFFFFFFull) != frag) break;
+        if (same(record(static_cast<std::uint32_t>(v & 0xFFFFFFFFull)), mk, words)) return Insert::found;
+        break;
+      }
+    }
+  }
+  // After a shared level: the credits not used go back to the shards, and the indices taken but not given
+  // out (the rest of each worker's last range) are holes below next_id_: the states with the highest
+  // indices move into them (their records copied, their hash entries rewritten; nothing refers to a
+  // state of the newest level yet), so that the level's states are numbered without gaps. Without
+  // `compact` (the run stops) only the count is made right.
+  void close_shared_level(std::vector<WorkerStats>& ws, unsigned workers, const Layout& L, bool compact) {
+    const std::uint64_t end = next_id_.load();
+    std::vector<std::uint64_t> holes;
+    for (unsigned wi = 0; wi < workers; ++wi) {
+      WorkerStats& st = ws[wi];
+      for (std::size_t si = 0; si < kShards; ++si) {
+        shards_[si].used -= st.credits[si];
+        st.credits[si] = 0;
+      }
+      for (std::uint64_t id = st.id_next; id < st.id_end; ++id) holes.push_back(id);
+      st.id_next = st.id_end = 0;
+    }
+    const std::uint64_t count = end - holes.size();
+    states_ = count;
+    if (!compact) return;
+    std::sort(holes.begin(), holes.end());
+    std::size_t next_hole = 0;
+    for (std::uint64_t src = count; src < end; ++src) {
+      if (std::binary_search(holes.begin(), holes.end(), src)) continue;
+      const auto from = static_cast<std::uint32_t>(src);
+      const auto to = static_cast<std::uint32_t>(holes[next_hole++]);  // below count: as many as these
+      std::memcpy(record(to), record(from), std::size_t{L.record} * 8);
+      const std::uint64_t h = hash_words(record(to), L.words);
+      Shard& sh = shards_[h >> (64 - kShardBits)];
+      const std::uint64_t frag = h & 0x7FFFFFFFull;
+      const std::size_t mask = sh.slots.size() - 1;
+      std::size_t pos = frag & mask;
+      while (sh.slots[pos] != (frag << 32 | from)) pos = (pos + 1) & mask;
+      sh.slots[pos] = frag << 32 | to;
+    }
+  }
+  // After a shared level: the successors left in the workers' stashes (chunks_[0..workers)), added one by
+  // one, with the shards growing as they must. False when something found no room.
+  bool drain_stash(unsigned workers, const Layout& L) {
+    for (unsigned wi = 0; wi < workers; ++wi) {
+      Chunk& ch = chunks_[wi];
+      for (std::size_t i = 0; i < ch.hashes.size(); ++i) {
+        const std::uint64_t h = ch.hashes[i];
+        Shard& sh = shards_[h >> (64 - kShardBits)];
+        const std::uint64_t frag = h & 0x7FFFFFFFull;
+        const std::uint64_t* mk = ch.markings.data() + i * L.words;
+        if (contains<0>(sh, frag, mk, L.words)) continue;
+        if (states_ >= kMaxStates)
+          vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
+        std::uint32_t id = 0;
+        if (!ensure_slot(sh) || !add_state(mk, ch.parents[i], ch.firings[i], id)) return false;
+        put_slot(sh, h, frag << 32 | id);
+      }
+      ch.clear();
+    }
+    return true;
+  }
+
   void progress(std::uint32_t level, bool force) {
     if (!show_progress_) return;
     const auto now = Clock::now();
@@ -699,6 +865,12 @@ class Explorer {
   std::vector<std::uint64_t> prev_enabled_, cur_enabled_;
   std::uint64_t states_ = 0;
   std::uint64_t edges_ = 0;
+  // Shared levels (insert_shared): the next state index, 2^32-2 passed; blocks_ entries made (new_record
+  // makes more under blocks_mutex_).
+  std::atomic<std::uint64_t> next_id_{0};
+  std::atomic<bool> too_many_{false};
+  std::atomic<std::size_t> blocks_ready_{0};
+  std::mutex blocks_mutex_;
   WorkerPool pool_;  // last: its helpers stop before anything they could touch goes away
 };
 
@@ -732,10 +904,12 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
   const bool unpack_states = !(use_masks && use_ops);
   // For the whole attempt: the net compiled for the layout, each worker's two unpacked markings, and the
   // result's markings (a dead one, an unbounded pair).
-  attempt_fixed_ = pk.bytes() + std::size_t{threads_} * P * 8 + std::size_t{3} * P * 4;
+  attempt_fixed_ =
+      pk.bytes() + std::size_t{threads_} * (P * 8 + kBatch * L.words * 8) + std::size_t{3} * P * 4;
   if (fixed_ + attempt_fixed_ > limit_) {
-    over_limit(r, "while preparing the exploration (the net compiled for " + std::to_string(bits) +
-                      " bit(s) per place, " + std::to_string(threads_) + " worker(s))",
+    over_limit(r,
+               "while preparing the exploration (the net compiled for " + std::to_string(bits) +
+                   " bit(s) per place, " + std::to_string(threads_) + " worker(s))",
                fixed_ + attempt_fixed_);
     return true;
   }
@@ -743,6 +917,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
   for (auto& w : ws) {
     w.unpacked.assign(P, 0);
     w.unpacked2.assign(P, 0);
+    w.batch_markings.assign(std::size_t{kBatch} * L.words, 0);
   }
 
   begin_phase();
@@ -766,7 +941,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
   end_phase();
 
   std::uint32_t first_dead = kNone;
-  std::uint64_t lo = 0, hi = 1, prev_lo = 0;
+  std::uint64_t lo = 0, hi = 1, prev_lo = 0, prev_n = 0;
   std::uint32_t level = 0;
   for (; lo < hi; ++level) {
     const std::uint64_t n = hi - lo;
@@ -774,8 +949,8 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     // One worker and a small hash set: each successor is looked up (and a new one numbered) as soon as it is
     // made, in the order phases B and C would have used, so the numbering is the same; no successor buffers,
     // and phases B to D fall away. Chunk 0 serves as scratch. Only while the hash set is small enough to stay
-    // in cache: on a larger one the lookups are cache misses, which phase B hides by prefetching a few
-    // candidates ahead (the ring of 490 314 states ran 25 % slower fused).
+    // in cache: on a larger one the lookups are cache misses, which shared levels and phase B hide by
+    // prefetching a few candidates ahead (the ring of 490 314 states ran 25 % slower fused than phased).
     std::size_t table_bytes = 0;
     for (const auto& sh : shards_) table_bytes += sh.slots.size() * 8;
     const bool small_table = table_bytes <= kFusedTableBytes;
@@ -786,10 +961,37 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
                                  ? 1u
                                  : static_cast<unsigned>(std::min<std::size_t>(threads_, nchunks));
     const bool fused = workers == 1 && small_table;
+    // Shared: the workers look their successors up and add the new ones to the hash set and the arena
+    // themselves, all at once (insert_shared), with no phases B to D. New states are numbered in the order
+    // the workers add them, which depends on the timing: the states, edges, levels and token bounds do
+    // not, nor does the length of the firing sequence to a dead marking (a shortest one either way), but
+    // which dead marking and which sequence may. The unboundedness check reads parents on the
+    // breadth-first tree, so nets that need it keep the phases, whose numbering is fixed.
+    const bool shared = !fused && !check_cover;
     const std::uint64_t new_lo = states_;
     begin_phase();
+    if (shared) {  // room for the level's new states: arena block list, hash shards (see insert_shared)
+      // Expected new states: the frontier grew by n / prev_n last level; half as much again for the
+      // variation among shards. More goes to the stashes.
+      const double grow = prev_n == 0 ? 1.0 : static_cast<double>(n) / static_cast<double>(prev_n);
+      const auto per_shard = static_cast<std::size_t>(static_cast<double>(n) * std::max(1.0, grow) * 1.5 /
+                                                      static_cast<double>(kShards)) + 16;
+      // Arena blocks for as many, and the workers' unused index ranges (kCredit each).
+      const std::size_t list = static_cast<std::size_t>(
+          (states_ + per_shard * kShards + std::uint64_t{workers} * kCredit) >> block_bits_) + 2;
+      bool ok = blocks_.capacity() >= list || fit(blocks_, list);
+      for (auto& sh : shards_) ok = ok && reserve_slots(sh, per_shard);
+      if (!ok) {
+        end_phase();
+        check_memory(r);
+        break;
+      }
+      blocks_ready_.store(blocks_.size());
+      next_id_.store(states_);
+      too_many_.store(false);
+    }
     {  // the chunks and the level's enabled sets, within the limit
-      const std::size_t want = fused ? 1 : nchunks;
+      const std::size_t want = fused ? 1 : shared ? workers : nchunks;
       const bool chunks_fit = chunks_.size() >= want || fit(chunks_, want);
       if (!chunks_fit || !fit(cur_enabled_, n * tw_)) {
         end_phase();
@@ -797,6 +999,8 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
         break;
       }
       if (chunks_.size() < want) chunks_.resize(want);
+      if (shared)
+        for (unsigned wi = 0; wi < workers; ++wi) chunks_[wi].clear();
       cur_enabled_.assign(n * tw_, 0);
     }
     std::atomic<std::size_t> next_chunk{0};
@@ -814,12 +1018,12 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
         while (!stop.load(std::memory_order_relaxed)) {
           const std::size_t ci = next_chunk.fetch_add(1);
           if (ci >= nchunks) break;
-          Chunk& ch = chunks_[fused ? 0 : ci];
-          ch.clear();
+          Chunk& ch = chunks_[fused ? 0 : shared ? wi : ci];  // shared: the worker's stash
+          if (!shared) ch.clear();
           const std::uint64_t first = lo + ci * kChunkStates;
           const std::uint64_t last = std::min(hi, first + kChunkStates);
           // Size the buffers from the successors per state so far: few reallocations while filling them.
-          if (!fused) {
+          if (!fused && !shared) {
             const auto expect =
                 static_cast<std::size_t>(static_cast<double>(last - first) * successors_per_state * 1.25) + 16;
             if (!fit(ch.markings, expect * words) || !fit(ch.hashes, expect) || !fit(ch.parents, expect) ||
@@ -828,7 +1032,36 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
               break;
             }
           }
-          bool no_room = false;  // an arena block or a hash shard found no room (fused)
+          bool no_room = false;  // an arena block or a hash shard found no room (fused, shared)
+          // Shared: inserts the batched successors, whose slots were prefetched as they were made.
+          auto flush = [&] {
+            for (std::uint32_t j = 0; j < st.batched && !no_room; ++j) {
+              const std::uint64_t* mk = st.batch_markings.data() + std::size_t{j} * words;
+              const Insert in = insert_shared(st, mk, words, st.batch_hashes[j], st.batch_parents[j],
+                                              st.batch_firings[j]);
+              if (in == Insert::stashed) {
+                const std::size_t at = ch.hashes.size();
+                if (fit(ch.markings, (at + 1) * words) && fit(ch.hashes, at + 1) && fit(ch.parents, at + 1) &&
+                    fit(ch.firings, at + 1)) {
+                  std::memcpy(ch.markings.data() + at * words, mk, words * 8);
+                  ch.markings.set_size((at + 1) * words);
+                  ch.hashes[at] = st.batch_hashes[j];
+                  ch.parents[at] = st.batch_parents[j];
+                  ch.firings[at] = st.batch_firings[j];
+                  ch.hashes.set_size(at + 1);
+                  ch.parents.set_size(at + 1);
+                  ch.firings.set_size(at + 1);
+                  continue;
+                }
+              } else if (in != Insert::failed) {
+                continue;
+              }
+              if (!too_many_.load(std::memory_order_relaxed)) full_.store(true, std::memory_order_relaxed);
+              no_room = true;
+              stop.store(true, std::memory_order_relaxed);
+            }
+            st.batched = 0;
+          };
           for (std::uint64_t s64 = first; s64 < last && !no_room; ++s64) {
             const auto s = static_cast<std::uint32_t>(s64);
             const std::uint64_t* rec = record(s);
@@ -899,14 +1132,15 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
             // Room for the successor of every enabled transition (fused: one at a time), within the limit: no
             // per-successor growth checks in the loop below. (Room for every transition was 5 GB for one
             // state of a net of 200,000 places and transitions.)
-            const std::size_t k0 = ch.hashes.size();
+            const std::size_t k0 = shared ? 0 : ch.hashes.size();
             std::size_t need = 1;
             if (!fused) {
               need = k0;
-              for (std::uint32_t wd = 0; wd < tw_; ++wd) need += static_cast<std::size_t>(std::popcount(en[wd]));
+              for (std::uint32_t wd = 0; wd < tw_; ++wd)
+                need += static_cast<std::size_t>(std::popcount(en[wd]));
             }
-            if (!fit(ch.markings, need * words) || !fit(ch.hashes, need) || !fit(ch.parents, need) ||
-                !fit(ch.firings, need)) {
+            if (!shared && (!fit(ch.markings, need * words) || !fit(ch.hashes, need) ||
+                            !fit(ch.parents, need) || !fit(ch.firings, need))) {
               stop.store(true, std::memory_order_relaxed);
               break;
             }
@@ -920,7 +1154,8 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
               while (bitsw != 0) {
                 const std::uint32_t t = wd * 64 + static_cast<std::uint32_t>(std::countr_zero(bitsw));
                 bitsw &= bitsw - 1;
-                std::uint64_t* out = out_markings + (fused ? k0 : k) * words;
+                std::uint64_t* out = shared ? st.batch_markings.data() + std::size_t{st.batched} * words
+                                            : out_markings + (fused ? k0 : k) * words;
                 if constexpr (W != 0) {
                   if (use_ops) {  // firing adds each word's difference: no carries cross fields here
                     const std::uint64_t* d = pk.diff.data() + std::size_t{t} * W;
@@ -958,6 +1193,13 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
                     }
                     put_slot(sh, h, frag << 32 | id);
                   }
+                } else if (shared) {
+                  const Shard& sh = shards_[h >> (64 - kShardBits)];
+                  __builtin_prefetch(sh.slots.data() + ((h & 0x7FFFFFFFull) & (sh.slots.size() - 1)));
+                  st.batch_hashes[st.batched] = h;
+                  st.batch_parents[st.batched] = s;
+                  st.batch_firings[st.batched] = t;
+                  if (++st.batched == kBatch) flush();
                 } else {
                   out_hashes[k] = h;
                   out_parents[k] = s;
@@ -966,7 +1208,7 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
                 ++k;
               }
             }
-            if (!fused) {
+            if (!fused && !shared) {
               ch.markings.set_size(k * words);
               ch.hashes.set_size(k);
               ch.parents.set_size(k);
@@ -976,7 +1218,8 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
             st.edges += count;
             if (count == 0 && !no_room && s < st.first_dead) st.first_dead = s;
           }
-          if (fused) continue;  // the new states went straight into the arena and the hash set
+          if (shared) flush();
+          if (fused || shared) continue;  // the new states went straight into the arena and the hash set
           if (!fit(ch.fresh, ch.hashes.size()) || !fit(ch.ids, ch.hashes.size())) {
             stop.store(true, std::memory_order_relaxed);
             break;
@@ -996,9 +1239,15 @@ bool Explorer::attempt(unsigned bits, ExploreResult& r) {
     }
     std::swap(prev_enabled_, cur_enabled_);
     prev_lo = lo;
+    prev_n = n;
     r.levels = level + 1;
-    if (stop.load() || (!fused && !phases_b_to_d(nchunks, L))) {  // no room (the only other stop, an
-      end_phase();                                                // overflow, returned above)
+    if (shared) {
+      if (too_many_.load()) vsd::detail::throw_error("explore: more than 2^32-2 states; not supported");
+      close_shared_level(ws, workers, L, !stop.load());
+    }
+    // No room (the only other stop, an overflow, returned above):
+    if (stop.load() || (!fused && !(shared ? drain_stash(workers, L) : phases_b_to_d(nchunks, L)))) {
+      end_phase();
       check_memory(r);
       break;
     }

@@ -15,8 +15,12 @@
  *  - A sharded open-addressing hash set holds state indices (no allocation per marking).
  *  - Enabling is incremental: a successor's enabled set is its parent's, with only the transitions that
  *    read a place the fired transition changed (as input or inhibitor place) tested again.
- *  - Each level is expanded by `threads` threads; new markings are numbered in a fixed order, so every
- *    result (including the firing sequence to a dead marking) is the same for any thread count.
+ *  - Each level is expanded by `threads` threads. On nets with structural bounds the threads add new
+ *    markings to the hash set themselves, at once, so the numbering follows the timing: states, edges,
+ *    levels, token bounds, deadlock and the length of the (shortest) firing sequence to a dead marking
+ *    are the same for any thread count, but which dead marking and sequence may differ with more than one
+ *    thread. Other nets (those needing the unboundedness check) number new markings in a fixed order, so
+ *    every result is the same for any thread count.
  *  - Unboundedness: a new marking M' that strictly covers an ancestor M on its breadth-first path (and
  *    equals it on every inhibitor place) proves the net unbounded: the sequence from M to M' can fire
  *    again forever. The exploration stops and reports the pair. Nets with structural bounds (above)
@@ -69,7 +73,8 @@ struct ExploreResult {
   std::uint64_t states = 0;  ///< Reachable markings (visited ones unless complete).
   std::uint64_t edges = 0;   ///< Firings: one per (marking, enabled transition), over expanded markings.
   bool deadlock = false;     ///< A reachable marking enables no transition.
-  /// @brief A shortest firing sequence (transition indices) from the initial marking to a dead marking.
+  /// @brief A shortest firing sequence (transition indices) from the initial marking to a dead marking
+  /// (its length is the same for any thread count; which one, see the file comment).
   std::vector<std::uint32_t> dead_trace;
   /// @brief The dead marking dead_trace leads to (one entry per place).
   std::vector<std::uint32_t> dead_marking;
