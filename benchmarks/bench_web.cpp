@@ -16,6 +16,9 @@
 #include "vsd/core.hpp"
 #include "vsd/scene.hpp"
 #include "vsd/web.hpp"
+#ifdef VSD_BENCH_WEB_PHYSICS
+#include "physics_scene.hpp"
+#endif
 
 namespace {
 
@@ -117,6 +120,33 @@ void BM_WebStep(benchmark::State& st) {
   }
 }
 BENCHMARK(BM_WebStep)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
+
+#ifdef VSD_BENCH_WEB_PHYSICS
+// The same three cases on a step that does real work: the physics benchmark's 200 bodies resting on a
+// plane (bench_physics.cpp, about 500 contacts; every pose and velocity written back through the setters).
+void BM_WebPhysicsStep(benchmark::State& st) {
+  vsd_bench_physics::VsdScene scene;
+  auto& s = scene.env.main_state();
+  std::unique_ptr<vsd::web::Server> server;
+  std::unique_ptr<StreamReader> page;
+  if (st.range(0) >= 1) {
+    vsd::web::Options o;
+    o.port = 0;
+    if (st.range(0) == 2) o.timeline_bytes = 0;
+    server = std::make_unique<vsd::web::Server>(scene.env, s, o);
+    server->start();
+    page = std::make_unique<StreamReader>(*server, [](std::string_view) {});
+    while (server->stats().clients == 0) server->serve_for(std::chrono::milliseconds(1));
+  }
+  for (auto _ : st) {
+    scene.env.step();
+    benchmark::DoNotOptimize(scene.hulls.back()->frame());
+  }
+  if (scene.sim->stats().bodies != vsd_bench_physics::body_count) st.SkipWithError("not all bodies simulated");
+  if (server) st.counters["batches"] = static_cast<double>(server->stats().batches);
+}
+BENCHMARK(BM_WebPhysicsStep)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
+#endif
 
 // Edit -> database -> page: a POST /api/set from one thread until the page's event stream shows the new
 // value, while the simulation steps at 1 kHz in real time on its own thread. Manual time; p50 and p95 of
