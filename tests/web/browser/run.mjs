@@ -300,6 +300,18 @@ async function runChecks(browser) {
     await shot(page, '03-edited');
   });
 
+  await check('a click on a hull in the 3D view selects its node', async () => {
+    assert(target, 'no hull (see above)');
+    await page.click('nav.tabs button[data-tab="scene"]');
+    // Select the hull itself first, so that the pick's selection of its node is a change.
+    await page.evaluate((id) => window.vsdTest.select(id), target.hull);
+    await until('the hull to be selected', () => page.evaluate((id) => window.vsdTest.selected() === id, target.hull));
+    const at = await until('the hull to be drawn', () => page.evaluate((id) => window.vsdTest.screenPosition(id), target.hull));
+    await page.mouse.click(at[0], at[1]);
+    await until(`#${target.id} to be selected`, () => page.evaluate((id) => window.vsdTest.selected() === id, target.id));
+    await page.locator(`#inspector[data-id="${target.id}"]`).waitFor({ timeout: 5000 });
+  });
+
   await check('a bad value is refused with a message and nothing changes', async () => {
     assert(target, 'no editable Node3D (see above)');
     const before = await frameOf(target.id);

@@ -7,10 +7,17 @@ import { connect } from './events.js';
 import * as tree from './tree.js';
 import * as table from './table.js';
 import * as inspector from './inspector.js';
-import * as scene3d from './scene3d.js';
-import * as nets from './nets.js';
 import * as timeline from './timeline.js';
-import * as plots from './plots.js';
+
+// The views over the big libraries (three.js 2 MB, uPlot) load in parallel with the first answers, so
+// the tree and the inspector do not wait for them.
+const scene3dModule = import('./scene3d.js');
+const netsModule = import('./nets.js');
+const plotsModule = import('./plots.js');
+let scene3d = null;
+let plots = null;
+scene3dModule.then((m) => (scene3d = m));
+plotsModule.then((m) => (plots = m));
 
 const stateInfo = document.getElementById('state-info');
 const statsLine = document.getElementById('stats');
@@ -48,8 +55,8 @@ async function reloadAll(reason) {
       table.fillClasses(classes);
     }),
     tree.reload(),
-    scene3d.reload(),
-    nets.reload(),
+    scene3dModule.then((m) => m.reload()),
+    netsModule.then((m) => m.reload()),
     timeline.reload(),
     state.selected !== null ? inspector.show(state.selected) : null,
   ]);
@@ -93,14 +100,15 @@ on('connected', (up) => document.body.classList.toggle('disconnected', !up));
 // The browser tests' hook (tests/web/browser): the view's state, read without pixels.
 window.vsdTest = {
   ready: () => ready,
-  positions: () => scene3d.positions(),
-  objects: () => scene3d.objectIds(),
+  positions: () => scene3d?.positions() ?? {},
+  objects: () => scene3d?.objectIds() ?? [],
   selected: () => state.selected,
   writable: () => state.writable,
   select: (id) => select(id),
-  pick: (hullId) => scene3d.pick(hullId),
+  pick: (hullId) => scene3d?.pick(hullId),
+  screenPosition: (id) => scene3d?.screenPosition(id) ?? null,
   timeline: () => timeline.current(),
-  plots: () => plots.plotted(),
+  plots: () => plots?.plotted() ?? [],
 };
 
 connect();

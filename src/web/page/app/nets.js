@@ -35,9 +35,26 @@ function structure(answer) {
     n.transitions.map((t) => t.id), n.arrows.map((a) => [a.id, a.from, a.to])]));
 }
 
+// elkjs ships no ES module: its bundled UMD build is a classic script that defines window.ELK. It is
+// 1.6 MB, so it is loaded when the first net is drawn, not with the page.
+let elkLoading = null;
+function loadElk() {
+  elkLoading ??= new Promise((resolve, reject) => {
+    const script = document.createElement('script');
+    script.src = '/lib/elkjs/lib/elk.bundled.js';
+    script.onload = () => (window.ELK ? resolve() : reject(new Error('elk.bundled.js defined no ELK')));
+    script.onerror = () => {
+      elkLoading = null;
+      reject(new Error('elkjs did not load (/lib/elkjs/lib/elk.bundled.js)'));
+    };
+    document.head.append(script);
+  });
+  return elkLoading;
+}
+
 async function layout(net) {
   if (!elk) {
-    if (!window.ELK) throw new Error('elkjs did not load (/lib/elkjs/lib/elk.bundled.js)');
+    await loadElk();
     elk = new window.ELK();
   }
   const width = (name) => Math.max(48, 8 * String(name).length + 16);

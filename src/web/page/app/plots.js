@@ -7,6 +7,7 @@ import { get } from './api.js';
 import { on } from './bus.js';
 
 const MAX_POINTS = 3000;
+const stepped = uPlot.paths.stepped({ align: 1 });
 const pane = document.getElementById('plots');
 const hint = document.getElementById('plots-hint');
 
@@ -49,7 +50,9 @@ function rebuild() {
   chart = new uPlot({
     width: Math.max(pane.clientWidth - 20, 300),
     height: Math.max(pane.clientHeight - 80, 200),
-    series: [{}, ...series.map((s, i) => ({ label: s.label, stroke: colors[i % colors.length], spanGaps: true }))],
+    // Stepped: a property keeps its value until the next change.
+    series: [{}, ...series.map((s, i) => ({ label: s.label, stroke: colors[i % colors.length], spanGaps: true,
+                                             paths: stepped }))],
     scales: { x: { time: true } },
   }, [xs, ...ys], pane);
 }

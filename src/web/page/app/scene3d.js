@@ -256,6 +256,17 @@ export function positions() {
   return out;
 }
 
+// Where an object's origin is drawn, in page pixels (null when the view is not drawn): the tests click
+// there to pick it.
+export function screenPosition(id) {
+  const object = objects.get(id);
+  if (!object || !renderer) return null;
+  const p = new THREE.Vector3().setFromMatrixPosition(object.matrix).project(camera);
+  const rect = renderer.domElement.getBoundingClientRect();
+  if (rect.width === 0) return null;
+  return [rect.left + ((p.x + 1) / 2) * rect.width, rect.top + ((1 - p.y) / 2) * rect.height];
+}
+
 export function objectIds() {
   return [...objects.keys()];
 }

@@ -17,6 +17,9 @@ const errorLabel = document.getElementById('table-error');
 const scroller = document.getElementById('table-scroll');
 const sizer = document.getElementById('table-sizer');
 const table = document.getElementById('table-rows');
+const headBox = document.getElementById('table-head');
+const header = document.getElementById('table-header');
+let columns = [];
 
 let total = 0;
 let shown = { offset: -1, count: 0 }; // the window of rows in the DOM
@@ -72,7 +75,7 @@ async function fetchWindow(force = false) {
     filter.classList.remove('error');
     total = reply.total;
     totalLabel.textContent = `${total} rows`;
-    sizer.style.height = `${(total + 1) * ROW * scale()}px`; // + the header row
+    sizer.style.height = `${total * ROW * scale()}px`;
     draw(reply);
   } catch (e) {
     if (mine !== request) return;
@@ -86,13 +89,31 @@ function draw(reply) {
   const s = scale();
   shown = { offset: reply.offset, count: reply.rows.length };
   table.style.transform = `translateY(${reply.offset * ROW * s}px)`;
+  // The header is a table of its own above the scroller (so it stays in view); both tables have fixed
+  // column widths, so their columns line up.
+  columns = ['id', 'name', ...reply.columns];
+  const widths = columns.map((c, i) => (i === 0 ? 70 : i === 1 ? 140 : 110));
+  const colgroup = () => {
+    const g = document.createElement('colgroup');
+    for (const w of widths) {
+      const col = document.createElement('col');
+      col.style.width = `${w}px`;
+      g.append(col);
+    }
+    return g;
+  };
+  const width = `${widths.reduce((a, b) => a + b, 0)}px`;
   const head = document.createElement('tr');
-  for (const name of ['id', 'name', ...reply.columns]) {
+  for (const name of columns) {
     const th = document.createElement('th');
     th.textContent = name;
+    th.title = name;
     head.append(th);
   }
-  const rows = [head];
+  header.replaceChildren(colgroup(), head);
+  header.style.width = width;
+  table.style.width = width;
+  const rows = [colgroup()];
   for (const r of reply.rows) {
     const tr = document.createElement('tr');
     tr.dataset.id = r.id;
@@ -101,6 +122,7 @@ function draw(reply) {
     for (const text of cells) {
       const td = document.createElement('td');
       td.textContent = text === undefined ? '' : String(text).slice(0, 80);
+      td.title = td.textContent;
       tr.append(td);
     }
     tr.addEventListener('click', () => select(r.id));
@@ -110,15 +132,14 @@ function draw(reply) {
 }
 
 scroller.addEventListener('scroll', () => {
+  headBox.scrollLeft = scroller.scrollLeft;
   // Fetch when the scrolling pauses, not on every scroll event: a fling across 100,000 rows then
   // costs one request.
   clearTimeout(timer);
   timer = setTimeout(() => fetchWindow(), 60);
 });
 classSelect.addEventListener('change', restart);
-filter.addEventListener('keydown', (e) => {
-  if (e.key === 'Enter') restart();
-});
+// 'change' fires on Enter and when the box loses the focus with a new text.
 filter.addEventListener('change', restart);
 
 on('select', (id) => {
@@ -135,8 +156,7 @@ on('changes', (batch) => {
   for (const s of batch.set || []) {
     const tr = table.querySelector(`tr[data-id="${s.id}"]`);
     if (!tr) continue;
-    const names = [...table.querySelectorAll('th')].map((th) => th.textContent);
-    const i = names.indexOf(s.property);
+    const i = columns.indexOf(s.property);
     if (i >= 0) tr.children[i].textContent = String(formatValue(s.value)).slice(0, 80);
   }
 });
