@@ -147,6 +147,8 @@ async function until(what, fn, timeout = 10000) {
 }
 
 const near = (a, b, eps = 1e-6) => Math.abs(a - b) <= eps;
+// One past the newest timeline entry (the server may have dropped the oldest ones).
+const timelineEnd = (t) => t.end ?? (t.first ?? 0) + t.entries.length;
 
 async function shot(page, name) {
   try {
@@ -180,6 +182,7 @@ async function openPage(browser, { withToken }) {
 // ---- the checks -------------------------------------------------------------------------------------
 
 const results = [];
+let mainPage = null; // a failing check leaves a screenshot of it
 async function check(name, fn) {
   const started = Date.now();
   try {
@@ -189,6 +192,7 @@ async function check(name, fn) {
   } catch (e) {
     results.push({ name, ok: false, message: e.message });
     console.log(`FAIL ${name}: ${e.message}`);
+    if (mainPage) await shot(mainPage, `FAIL-${results.length}`);
   }
 }
 
@@ -235,6 +239,7 @@ async function runChecks(browser) {
   });
 
   const { page, problems } = await openPage(browser, { withToken: true });
+  mainPage = page;
   await shot(page, '01-loaded');
 
   await check('the page loads without errors', async () => {
@@ -245,6 +250,14 @@ async function runChecks(browser) {
     assert(!problems.length, problems.join('; '));
   });
 
+  // The Node3D to move: the node of the first hull, with an Editable frame.
+  const scene = await apiOk('/api/scene');
+  let target = null;
+  for (const hull of scene.hulls || []) {
+    const node = await apiOk(`/api/instance?id=${hull.node}`);
+    const frame = node.properties.find((p) => p.name === 'frame');
+    if (frame?.editable) { target = { id: node.id, hull: hull.id, frame: frame.value }; break; }
+  }
   await check('the tree shows the model', async () => {
     const top = await apiOk('/api/children');
     assert(top.children.length > 0, '/api/children lists no top-level node');
@@ -262,17 +275,14 @@ async function runChecks(browser) {
       const kids = await apiOk(`/api/children?id=${parent.id}&offset=0&limit=5`);
       await page.locator(`#tree li[data-id="${kids.children[0].id}"]`).waitFor({ timeout: 5000 });
     }
+    // Selecting an instance elsewhere opens the tree down to it.
+    if (target) {
+      await page.evaluate((id) => window.vsdTest.select(id), target.id);
+      await page.locator(`#tree li[data-id="${target.id}"] > .tree-row.selected`).waitFor({ timeout: 5000 });
+    }
     await shot(page, '02-tree');
   });
 
-  // The Node3D to move: the node of the first hull, with an Editable frame.
-  const scene = await apiOk('/api/scene');
-  let target = null;
-  for (const hull of scene.hulls || []) {
-    const node = await apiOk(`/api/instance?id=${hull.node}`);
-    const frame = node.properties.find((p) => p.name === 'frame');
-    if (frame?.editable) { target = { id: node.id, hull: hull.id, frame: frame.value }; break; }
-  }
   const frameOf = async (id) => (await apiOk(`/api/instance?id=${id}`)).properties.find((p) => p.name === 'frame').value;
   const frameRow = 'tr[data-property="frame"]';
   let timelineBefore = null;
@@ -282,7 +292,7 @@ async function runChecks(browser) {
     assert(target, 'the model has no hull whose node has an Editable frame (see /api/scene)');
     await until('the 3D view to hold the hull', () => page.evaluate((id) => id in window.vsdTest.positions(), target.hull));
     const before = await page.evaluate(() => window.vsdTest.positions());
-    timelineBefore = (await apiOk('/api/timeline')).entries.length;
+    timelineBefore = timelineEnd(await apiOk('/api/timeline'));
     await page.evaluate((id) => window.vsdTest.select(id), target.id);
     await page.locator(`#inspector ${frameRow} input.tx`).waitFor({ timeout: 5000 });
     const x0 = target.frame.translation[0];
@@ -305,7 +315,7 @@ async function runChecks(browser) {
     await page.click('nav.tabs button[data-tab="scene"]');
     // Select the hull itself first, so that the pick's selection of its node is a change.
     await page.evaluate((id) => window.vsdTest.select(id), target.hull);
-    await until('the hull to be selected', () => page.evaluate((id) => window.vsdTest.selected() === id, target.hull));
+    await page.locator(`#inspector[data-id="${target.hull}"]`).waitFor({ timeout: 5000 });
     const at = await until('the hull to be drawn', () => page.evaluate((id) => window.vsdTest.screenPosition(id), target.hull));
     await page.mouse.click(at[0], at[1]);
     await until(`#${target.id} to be selected`, () => page.evaluate((id) => window.vsdTest.selected() === id, target.id));
@@ -338,30 +348,8 @@ async function runChecks(browser) {
     await shot(page, '04-refused');
   });
 
-  await check('scrubbing the timeline back restores the earlier value, Live brings the edit back', async () => {
-    assert(edited, 'the edit check did not pass');
-    const timeline = await apiOk('/api/timeline');
-    assert(timeline.entries.length > timelineBefore, `the edit made no timeline entry (${timeline.entries.length} entries)`);
-    await page.locator('#timeline-slider').waitFor();
-    await until('the slider to know the entries', async () =>
-      Number(await page.getAttribute('#timeline-slider', 'max')) >= timeline.entries.length);
-    // Drag the thumb back to before the edit: what the slider's input and change events do.
-    await page.evaluate((k) => {
-      const s = document.getElementById('timeline-slider');
-      s.value = String(k);
-      s.dispatchEvent(new Event('input', { bubbles: true }));
-      s.dispatchEvent(new Event('change', { bubbles: true }));
-    }, timelineBefore);
-    await until('the frame to be back at its earlier translation', async () => near((await frameOf(target.id)).translation[0], edited.x0));
-    await until('the hull to be back in the 3D view', () => page.evaluate(({ hull, x }) =>
-      Math.abs(window.vsdTest.positions()[hull][0] - x) < 1e-6, { hull: target.hull, x: scene.hulls.find((h) => h.id === target.hull).world[12] }));
-    await shot(page, '05-scrubbed');
-    await page.click('#timeline-live');
-    await until('the edit to be applied again after Live', async () => near((await frameOf(target.id)).translation[0], edited.x1));
-    await until('the timeline to be live', async () => (await apiOk('/api/timeline')).live);
-  });
-
-  // Nets: the DOM's counts must match the server's marking.
+  // Nets: the DOM's counts must match the server's marking. These run before the timeline's Live
+  // (which unpauses the simulation): vsd-web starts paused, so only the checks fire transitions.
   const marking = async () => {
     const nets = (await apiOk('/api/nets')).nets;
     return Object.fromEntries(nets.flatMap((n) => n.places.map((p) => [p.id, p.tokens])));
@@ -407,6 +395,29 @@ async function runChecks(browser) {
       await until('the place\'s tokens to be listed', async () =>
         (await page.textContent('#place-tokens')).includes(`${after[placeId]} token`));
     }
+  });
+
+  await check('scrubbing the timeline back restores the earlier value, Live brings the edit back', async () => {
+    assert(edited, 'the edit check did not pass');
+    const timeline = await apiOk('/api/timeline');
+    assert(timelineEnd(timeline) > timelineBefore, `the edit made no timeline entry (${JSON.stringify(timeline).slice(0, 200)})`);
+    await page.locator('#timeline-slider').waitFor();
+    await until('the slider to know the entries', () =>
+      page.evaluate((end) => Number(document.getElementById('timeline-slider').max) >= end, timelineEnd(timeline)));
+    // Drag the thumb back to before the edit: what the slider's input and change events do.
+    await page.evaluate((k) => {
+      const s = document.getElementById('timeline-slider');
+      s.value = String(k);
+      s.dispatchEvent(new Event('input', { bubbles: true }));
+      s.dispatchEvent(new Event('change', { bubbles: true }));
+    }, timelineBefore);
+    await until('the frame to be back at its earlier translation', async () => near((await frameOf(target.id)).translation[0], edited.x0));
+    await until('the hull to be back in the 3D view', () => page.evaluate(({ hull, x }) =>
+      Math.abs(window.vsdTest.positions()[hull][0] - x) < 1e-6, { hull: target.hull, x: scene.hulls.find((h) => h.id === target.hull).world[12] }));
+    await shot(page, '05-scrubbed');
+    await page.click('#timeline-live');
+    await until('the edit to be applied again after Live', async () => near((await frameOf(target.id)).translation[0], edited.x1));
+    await until('the timeline to be live', async () => (await apiOk('/api/timeline')).live);
   });
 
   await check('without the token the page is read-only', async () => {

@@ -35,6 +35,7 @@ export function select(id) {
 }
 
 export function setWritable(writable) {
+  if (state.writable === !!writable) return; // the views re-render their controls only on a change
   state.writable = !!writable;
   document.body.classList.toggle('writable', state.writable);
   emit('writable', state.writable);

@@ -53,6 +53,14 @@ function editor(p, commit) {
     box.addEventListener('change', commit);
     return { node: box, read: () => box.checked, show: (v) => (box.checked = !!v), inputs: [box] };
   }
+  if (Array.isArray(p.enum) && p.enum.length && typeof p.value === 'string') {
+    // An enum whose names the server listed: a choice among them.
+    const choice = el('select', { class: 'value-input', disabled: !enabled });
+    for (const name of p.enum) choice.append(el('option', { value: name }, name));
+    choice.value = p.value;
+    choice.addEventListener('change', commit);
+    return { node: choice, read: () => choice.value, show: (v) => (choice.value = v), inputs: [choice] };
+  }
   if (p.type === 'Isometry3d' && p.value && Array.isArray(p.value.translation)) {
     const axes = ['x', 'y', 'z'].map((a) =>
       el('input', { class: `value-input t${a}`, size: 7, disabled: !enabled, title: `translation ${a}` }));
@@ -123,7 +131,7 @@ function propertyRow(p) {
   if (ed) {
     const set = el('button', { class: 'set', disabled: !state.writable, title: 'POST /api/set' }, 'set');
     set.addEventListener('click', commit);
-    if (p.type !== 'bool') cell.append(set);
+    if (p.type !== 'bool' && !(ed.node.tagName === 'SELECT')) cell.append(set);
     ed.inputs.push(set);
   }
   if (isNumericType(p.type) && p.kind === 'value') {

@@ -127,13 +127,14 @@ async function reveal(id) {
   if (!nodes.has(id)) {
     const path = [];
     let at = id;
-    for (let guard = 0; guard < 64 && at !== null && at !== undefined && !nodes.has(at); ++guard) {
+    // No parent is null (or 0, which no instance has).
+    for (let guard = 0; guard < 64 && at && !nodes.has(at); ++guard) {
       if (at === rootId) break;
       path.push(at);
       const info = await get('/api/instance', { id: at }).catch(() => null);
       at = info ? info.parent : null;
     }
-    if (at === null || at === undefined || !nodes.has(at)) return; // not in the tree (an extension)
+    if (!at || !nodes.has(at)) return; // not in the tree (an extension, a floating instance)
     for (let i = path.length - 1; i >= 0; --i) {
       const parent = nodes.get(at);
       await expand(parent);
