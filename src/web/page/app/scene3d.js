@@ -40,6 +40,21 @@ try {
   container.append(note);
 }
 
+// Two switches over the view: collision hulls (drawn as wireframes; off by default when there are
+// visual hulls, which they mostly double) and the axes of the Node3D frames.
+const toolbar = document.createElement('div');
+toolbar.className = 'scene-toolbar';
+toolbar.innerHTML = '<label><input type="checkbox" data-show="collision"> collision hulls</label> ' +
+  '<label><input type="checkbox" data-show="axes" checked> frames</label>';
+container.append(toolbar);
+const show = { collision: null, axes: true }; // collision: null = not chosen by the user yet
+for (const box of toolbar.querySelectorAll('input')) {
+  box.addEventListener('change', () => {
+    show[box.dataset.show] = box.checked;
+    applyVisibility();
+  });
+}
+
 const objects = new Map();   // id -> Object3D (nodes: axes; hulls: meshes)
 const hullNode = new Map();  // hull id -> its node's id (what a pick selects)
 const meshCache = new Map(); // Geometry id -> Promise<BufferGeometry>
@@ -77,9 +92,12 @@ function place(object, world) {
 async function meshGeometry(id) {
   if (!meshCache.has(id)) {
     meshCache.set(id, get('/api/mesh', { id }).then((m) => {
-      const g = new THREE.BufferGeometry();
+      let g = new THREE.BufferGeometry();
       g.setAttribute('position', new THREE.Float32BufferAttribute(m.positions, 3));
       if (m.indices?.length) g.setIndex(m.indices);
+      // Flat normals: the database holds no normals here, and averaging them over shared vertices
+      // smears the edges of CAD parts.
+      g = g.toNonIndexed();
       g.computeVertexNormals();
       return g;
     }));
@@ -153,7 +171,7 @@ export async function reload() {
     }
     // A hull without drawable geometry still gets an object: its position is part of the view's state.
     const mesh = geometry ? new THREE.Mesh(geometry, material(hull)) : new THREE.Object3D();
-    mesh.userData = { id: hull.id, node: hull.node, kind: 'hull' };
+    mesh.userData = { id: hull.id, node: hull.node, kind: 'hull', role: hull.role };
     place(mesh, hull.world);
     // A hull that is also a node of the answer (hulls are Node3Ds) replaces the node's axes.
     const old = objects.get(hull.id);
@@ -162,8 +180,24 @@ export async function reload() {
     hullNode.set(hull.id, hull.node);
     root.add(mesh);
   }));
+  applyVisibility();
   highlight();
   if (!fitted) fit();
+  requestRender();
+}
+
+function applyVisibility() {
+  const hulls = [...objects.values()].filter((o) => o.userData.kind === 'hull');
+  if (show.collision === null) {
+    // Until the user chooses: collision hulls only where there is nothing else to see.
+    const visual = hulls.some((o) => o.userData.role !== 'Collision');
+    toolbar.querySelector('[data-show="collision"]').checked = !visual;
+  }
+  const collision = toolbar.querySelector('[data-show="collision"]').checked;
+  for (const o of objects.values()) {
+    if (o.userData.kind === 'node') o.visible = show.axes;
+    else if (o.userData.role === 'Collision') o.visible = collision;
+  }
   requestRender();
 }
 
