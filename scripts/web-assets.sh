@@ -64,7 +64,7 @@ if [[ ! -f "$stamp" || "$(cat "$stamp")" != "$stamp_value" || ! -d "$out/lib" ]]
   # elkjs: the bundled build runs the layout in the page (no worker file to serve).
   copy elkjs LICENSE.md package.json lib/elk.bundled.js
   copy uplot LICENSE package.json dist/uPlot.esm.js dist/uPlot.min.css
-  rm -rf "$out/lib"
+  rm -rf "${out:?}/lib"
   mv "$out/lib.new" "$out/lib"
   echo "$stamp_value" >"$stamp"
 fi
