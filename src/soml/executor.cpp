@@ -481,6 +481,25 @@ std::uint64_t ProgramImpl::step(std::uint64_t n) {
   return fired;
 }
 
+bool ProgramImpl::fire_chosen(const Transition& node) {
+  bool fired = false;
+  try {
+    refresh();
+    for (const std::uint32_t i : enabled_) {
+      const TI& ti = tis_[i];
+      if (ti.net->dead || ti.net->transitions[static_cast<std::size_t>(ti.t)] != &node) continue;
+      fire(i);
+      fired = true;
+      break;
+    }
+  } catch (...) {
+    sync_state();
+    throw;
+  }
+  sync_state();
+  return fired;
+}
+
 std::uint64_t ProgramImpl::step_loop(std::uint64_t n) {
   std::uint64_t fired = 0;
   while (fired < n) {

@@ -1277,6 +1277,7 @@ bool Program::enabled_any() {
   impl_->sync_state();
   return any;
 }
+bool Program::fire(const Transition& transition) { return impl_->fire_chosen(transition); }
 std::uint64_t Program::firings() const noexcept { return impl_->firings_; }
 void Program::on_firing(std::function<void(const Firing&)> fn) { impl_->trace_ = std::move(fn); }
 std::size_t Program::watched_properties() const noexcept { return impl_->deps_map_.size(); }

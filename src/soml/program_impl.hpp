@@ -589,6 +589,7 @@ class ProgramImpl {
     return a.holder < 0 ? net.owner : net.transitions[static_cast<std::size_t>(a.holder)]->id();
   }
   void fire(std::uint32_t ti);
+  bool fire_chosen(const Transition& node);  // Program::fire
   void fire_body(std::uint32_t ti);  // fire() without the savepoint
   // Undoes a failed firing: the SimState back to @p sp, nets killed since killed_[killed] revived.
   void roll_back(const SimState::Savepoint& sp, std::size_t killed, const std::string& why);

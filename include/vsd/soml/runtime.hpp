@@ -157,6 +157,11 @@ class Program {
   std::uint64_t run_until_quiet(std::uint64_t limit = 10'000'000);
   /// @brief True when some transition is enabled.
   [[nodiscard]] bool enabled_any();
+  /// @brief Fires @p transition (a Transition node of one of this program's nets) if it is enabled, as
+  /// step() would have fired it had its choice fallen on it (an interactive fire button, a test).
+  /// @return false, changing nothing, when it is not enabled or not one of this program's live nets.
+  /// @throws vsd::Error as step() does when its action fails (the firing is undone whole).
+  bool fire(const Transition& transition);
   /// @brief Firings so far.
   [[nodiscard]] std::uint64_t firings() const noexcept;
   /// @brief Calls @p fn after every firing (empty: no trace).
