@@ -174,7 +174,8 @@ async function openPage(browser, { withToken }) {
     await page.press('#token', 'Enter');
     await page.locator('#token').blur();
   }
-  await until('the page to finish loading (window.vsdTest.ready())', () => page.evaluate(() => window.vsdTest?.ready()));
+  // Generous: a loaded CI machine, and 4 MB of libraries (three.js, elkjs, uPlot) on the first load.
+  await until('the page to finish loading (window.vsdTest.ready())', () => page.evaluate(() => window.vsdTest?.ready()), 30000);
   if (withToken) await until('the page to be writable', () => page.evaluate(() => window.vsdTest.writable()));
   return { page, context, problems };
 }

@@ -22,6 +22,11 @@ function el(tag, attrs = {}, ...children) {
   return e;
 }
 
+// A read-only value of up to 64 KiB of text would fill the panel: the first 2,000 characters show.
+function shorten(text) {
+  return text.length > 2000 ? `${text.slice(0, 2000)} … (${text.length} characters)` : text;
+}
+
 function refLink(ref) {
   if (ref === null || ref === undefined) return el('span', { class: 'null' }, 'null');
   const id = Number(String(ref).replace(/^@/, ''));
@@ -116,7 +121,10 @@ function propertyRow(p) {
     }
   }
 
-  if (p.kind === 'ref' || p.kind === 'list') {
+  if (p.truncated) {
+    // Over 64 KiB of text (a mesh's vertices): the server sends null, and an edit would overwrite it.
+    cell.append(el('span', { class: 'null' }, 'too long to show (over 64 KiB)'));
+  } else if (p.kind === 'ref' || p.kind === 'list') {
     cell.append(refLinks(p.value));
     if (p.editable && p.kind === 'ref') {
       ed = editor({ ...p, value: p.value === null ? 'null' : p.value }, commit);
@@ -126,7 +134,7 @@ function propertyRow(p) {
     ed = editor(p, commit);
     cell.append(ed.node);
   } else {
-    cell.append(el('span', { class: 'readonly-value' }, formatValue(p.value, p.type)));
+    cell.append(el('span', { class: 'readonly-value' }, shorten(formatValue(p.value, p.type))));
   }
   if (ed) {
     const set = el('button', { class: 'set', disabled: !state.writable, title: 'POST /api/set' }, 'set');
@@ -209,6 +217,7 @@ on('changes', (batch) => {
     const tr = root.querySelector(`tr[data-property="${CSS.escape(s.property)}"]`);
     if (!tr || !tr.vsd) continue;
     const { p, ed, cell, msg } = tr.vsd;
+    if (p.truncated || s.truncated) continue; // shown as too long; nothing to update
     p.value = s.value;
     // The field now shows what the database holds: an earlier refusal no longer applies to it.
     if (ed && !ed.inputs.includes(document.activeElement)) {
@@ -221,7 +230,7 @@ on('changes', (batch) => {
     } else if (ed) {
       if (!ed.inputs.includes(document.activeElement)) ed.show(s.value);
     } else {
-      cell.firstChild.textContent = formatValue(s.value, p.type);
+      cell.firstChild.textContent = shorten(formatValue(s.value, p.type));
     }
   }
 });

@@ -91,6 +91,12 @@ on('changes', (batch) => {
   paintInfo();
 });
 on('stats', (s) => {
+  if (info && typeof s.step === 'number') {
+    // Stats come while the simulation steps even when nothing changed: the header follows them too.
+    info.step = s.step;
+    info.time = s.time ?? info.time;
+    paintInfo();
+  }
   const f = (x) => (typeof x === 'number' ? (x >= 100 ? x.toFixed(0) : x.toFixed(1)) : '?');
   statsLine.textContent = `${f(s.steps_per_s)} steps/s · ${f(s.changes_per_s)} changes/s · ` +
     `${f(s.firings_per_s)} firings/s · ${s.clients} client${s.clients === 1 ? '' : 's'}`;
