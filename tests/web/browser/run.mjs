@@ -349,6 +349,42 @@ async function runChecks(browser) {
     await shot(page, '04-refused');
   });
 
+  await check('the per-class table lists the instances and filters them', async () => {
+    assert(target, 'no editable Node3D (see above)');
+    const info = await apiOk(`/api/instance?id=${target.id}`);
+    const all = await apiOk(`/api/table?class=${encodeURIComponent(info.class)}&offset=0&limit=1`);
+    await page.click('nav.tabs button[data-tab="table"]');
+    await page.selectOption('#table-class', info.class);
+    await until(`the table to count ${all.total} rows`, async () => (await page.textContent('#table-total')) === `${all.total} rows`);
+    await page.locator(`#table-rows tr[data-id="${target.id}"]`).waitFor({ timeout: 5000 });
+    const where = `name ~ ${info.name}`;
+    const some = await apiOk(`/api/table?class=${encodeURIComponent(info.class)}&offset=0&limit=1&where=${encodeURIComponent(where)}`);
+    await page.fill('#table-filter', where);
+    await page.press('#table-filter', 'Enter');
+    await until(`the filter to leave ${some.total} rows`, async () => (await page.textContent('#table-total')) === `${some.total} rows`);
+    await page.fill('#table-filter', 'no_such_property > 1');
+    await page.press('#table-filter', 'Enter');
+    await until('the server\'s message about the bad filter', async () => (await page.textContent('#table-error')).trim());
+    await shot(page, '05-table');
+    await page.fill('#table-filter', '');
+    await page.press('#table-filter', 'Enter');
+    await page.click('nav.tabs button[data-tab="tree"]');
+  });
+
+  await check('a numeric property picked in the inspector is plotted live', async () => {
+    assert(target, 'no editable Node3D (see above)');
+    const info = await apiOk(`/api/instance?id=${target.id}`);
+    const numeric = info.properties.find((p) => p.editable && p.kind === 'value' && /^(double|float|u?int\d+)$/.test(p.type));
+    assert(numeric, `#${target.id} has no editable numeric property`);
+    const row = `#inspector tr[data-property="${numeric.name}"]`;
+    await page.click(`${row} button.plot`);
+    await until('the plot to start', () => page.evaluate(() => window.vsdTest.plots().length === 1));
+    await page.fill(`${row} input.value-input`, String(Number(numeric.value) + 1));
+    await page.click(`${row} button.set`);
+    await until('the change to reach the plot', () => page.evaluate(() => window.vsdTest.plots()[0].points >= 2));
+    await shot(page, '06-plot');
+  });
+
   // Nets: the DOM's counts must match the server's marking. These run before the timeline's Live
   // (which unpauses the simulation): vsd-web starts paused, so only the checks fire transitions.
   const marking = async () => {
@@ -372,14 +408,14 @@ async function runChecks(browser) {
     const button = page.locator(`#nets table.transitions tr[data-id="${t.id}"] button.fire`);
     await until('the Fire button to be enabled', () => button.isEnabled());
     await page.locator(`#nets .transition[data-id="${t.id}"].enabled`).waitFor({ timeout: 5000 });
-    await shot(page, '06-nets-before');
+    await shot(page, '07-nets-before');
     await button.click();
     await until('the transition to have fired', async () =>
       (await apiOk('/api/nets')).nets.flatMap((n) => n.transitions).find((x) => x.id === t.id).firings === t.firings + 1);
     const after = await marking();
     assert(JSON.stringify(after) !== JSON.stringify(before), 'the marking did not change');
     await until('the nets view to show the new marking', sameMarking);
-    await shot(page, '07-nets-fired');
+    await shot(page, '08-nets-fired');
   });
 
   await check('the marking updates when a transition fires (fired by another client)', async () => {
@@ -415,7 +451,7 @@ async function runChecks(browser) {
     await until('the frame to be back at its earlier translation', async () => near((await frameOf(target.id)).translation[0], edited.x0));
     await until('the hull to be back in the 3D view', () => page.evaluate(({ hull, x }) =>
       Math.abs(window.vsdTest.positions()[hull][0] - x) < 1e-6, { hull: target.hull, x: scene.hulls.find((h) => h.id === target.hull).world[12] }));
-    await shot(page, '05-scrubbed');
+    await shot(page, '09-scrubbed');
     await page.click('#timeline-live');
     await until('the edit to be applied again after Live', async () => near((await frameOf(target.id)).translation[0], edited.x1));
     await until('the timeline to be live', async () => (await apiOk('/api/timeline')).live);
@@ -442,7 +478,7 @@ async function runChecks(browser) {
         method: 'POST', headers: { 'Content-Type': 'application/json' },
         body: JSON.stringify({ id, property: 'name', value: 'x' }) })).status, target?.id ?? 1);
       assert(status === 403, `a POST /api/set without the token answered ${status}`);
-      await shot(ro, '08-read-only');
+      await shot(ro, '10-read-only');
       assert(!roProblems.length, roProblems.join('; '));
     } finally {
       await context.close();
@@ -452,7 +488,7 @@ async function runChecks(browser) {
   await check('no errors in the page', async () => {
     assert(!problems.length, problems.join('; '));
   });
-  await shot(page, '09-end');
+  await shot(page, '11-end');
 }
 
 main().catch((e) => {

@@ -91,7 +91,10 @@ function draw(reply) {
   table.style.transform = `translateY(${reply.offset * ROW * s}px)`;
   // The header is a table of its own above the scroller (so it stays in view); both tables have fixed
   // column widths, so their columns line up.
-  columns = ['id', 'name', ...reply.columns];
+  // id, name and class come with every row; the property columns follow (without name, shown already).
+  const values = reply.columns.filter((c) => c !== 'name');
+  const withClass = reply.rows.some((r) => r.class !== undefined);
+  columns = ['id', 'name', ...(withClass ? ['class'] : []), ...values];
   const widths = columns.map((c, i) => (i === 0 ? 70 : i === 1 ? 140 : 110));
   const colgroup = () => {
     const g = document.createElement('colgroup');
@@ -118,7 +121,7 @@ function draw(reply) {
     const tr = document.createElement('tr');
     tr.dataset.id = r.id;
     if (state.selected === r.id) tr.classList.add('selected');
-    const cells = [`#${r.id}`, r.name, ...reply.columns.map((c) => formatValue(r.values?.[c]))];
+    const cells = [`#${r.id}`, r.name, ...(withClass ? [r.class] : []), ...values.map((c) => formatValue(r.values?.[c]))];
     for (const text of cells) {
       const td = document.createElement('td');
       td.textContent = text === undefined ? '' : String(text).slice(0, 80);
