@@ -41,6 +41,16 @@ export function setWritable(writable) {
   emit('writable', state.writable);
 }
 
+// Whether class `name` is `base` or derives from it, by the bases of /api/classes (a script class that
+// derives from scene::Node3D is drawn like a Node3D).
+export function isA(name, base) {
+  for (let c = name, guard = 0; c && guard < 64; ++guard) {
+    if (c === base) return true;
+    c = state.classes.get(c)?.base;
+  }
+  return false;
+}
+
 // Parse what the user typed into a value field: JSON where it is JSON (numbers, vectors, frames,
 // booleans, null), else the text itself as a string (enum names, "@42" references, free text). The
 // server checks the type and answers with a message that names the property and the expected type, so

@@ -6,7 +6,7 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { get } from './api.js';
-import { on, select, state } from './bus.js';
+import { isA, on, select, state } from './bus.js';
 
 const container = document.getElementById('scene');
 const scene = new THREE.Scene();
@@ -272,7 +272,8 @@ on('changes', (batch) => {
     moved = true;
   }
   if (moved) requestRender();
-  const created = (batch.created || []).some((c) => /Node3D|Hull|Link|Geometry|Material/.test(c.class));
+  const created = (batch.created || []).some((c) =>
+    ['scene::Node3D', 'scene::Geometry', 'scene::Material'].some((base) => isA(c.class, base)));
   const deleted = (batch.deleted || []).some((id) => objects.has(id));
   const reshaped = (batch.set || []).some((s) => RESHAPE.has(s.property));
   if (created || deleted || reshaped || (batch.moved || []).some((m) => objects.has(m.id))) reloadSoon();
