@@ -95,6 +95,16 @@ void write_value(JsonWriter& out, const SimStateInstance& i, const MetaProperty&
   out.raw(text);
 }
 
+/// `"parent": id` of a node's parent, `null` for a node without one and for what is not a node.
+void write_parent(JsonWriter& out, const SimStateInstance& i) {
+  out.key("parent");
+  const Node* parent = i.as<Node>() != nullptr ? static_cast<const Node&>(i).parent() : nullptr;
+  if (parent != nullptr)
+    out.number(parent->id());
+  else
+    out.null();
+}
+
 void write_method(JsonWriter& out, const MetaMethod& m) {
   out.begin_object().member("name", m.name()).key("params").begin_array();
   for (std::size_t k = 0; k < m.arguments().size(); ++k)
@@ -448,8 +458,7 @@ void Inspector::instance(JsonWriter& out, const Request& r) const {
   out.begin_object().member("id", i.id()).member("class", i.meta().name());
   const auto* named = i.as<NamedModelInstance>();
   out.member("name", named != nullptr ? named->name() : std::string());
-  const Node* parent = i.as<Node>() != nullptr ? static_cast<const Node&>(i).parent() : nullptr;
-  out.member("parent", parent != nullptr ? parent->id() : Id{0});
+  write_parent(out, i);
   out.key("properties").begin_array();
   for (const MetaProperty* p : i.meta().properties()) {
     out.begin_object().member("name", p->name()).member("type", p->type().name()).member("kind", kind_of(p->type()));
@@ -596,10 +605,10 @@ void Inspector::write_batch(JsonWriter& out, std::vector<Watch::Report>& reports
     const SimStateInstance* i = state_.find(r.id);
     if (i == nullptr) continue;
     const auto* named = i->as<NamedModelInstance>();
-    const Node* parent = i->as<Node>() != nullptr ? static_cast<const Node*>(i)->parent() : nullptr;
     out.begin_object().member("id", r.id).member("class", i->meta().name());
     out.member("name", named != nullptr ? named->name() : std::string());
-    out.member("parent", parent != nullptr ? parent->id() : Id{0}).end_object();
+    write_parent(out, *i);
+    out.end_object();
   }
   out.end_array().key("deleted").begin_array();
   for (const Watch::Report& r : reports)
@@ -609,8 +618,9 @@ void Inspector::write_batch(JsonWriter& out, std::vector<Watch::Report>& reports
     if (!r.changes.has(Changes::parent)) continue;
     const SimStateInstance* i = state_.find(r.id);
     if (i == nullptr || i->as<Node>() == nullptr) continue;
-    const Node* parent = static_cast<const Node*>(i)->parent();
-    out.begin_object().member("id", r.id).member("parent", parent != nullptr ? parent->id() : Id{0}).end_object();
+    out.begin_object().member("id", r.id);
+    write_parent(out, *i);
+    out.end_object();
   }
   out.end_array();
   write_frames(out, state_, reports);

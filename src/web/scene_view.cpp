@@ -31,9 +31,12 @@ void write_vector(JsonWriter& out, const double* v, int n) {
   out.end_array();
 }
 
-Id frame_parent_id(const Node3D& n) {
-  const Node3D* p = n.frame_parent();
-  return p != nullptr ? p->id() : 0;
+/// The id of @p n's nearest Node3D ancestor, or null.
+void write_frame_parent(JsonWriter& out, const Node3D& n) {
+  if (const Node3D* p = n.frame_parent())
+    out.number(p->id());
+  else
+    out.null();
 }
 
 void write_shape(JsonWriter& out, const Geometry* g) {
@@ -82,7 +85,9 @@ void write_scene(JsonWriter& out, const SimState& state) {
     if (i.as<Hull>() != nullptr) return;
     const auto& n = static_cast<const Node3D&>(i);
     out.begin_object().member("id", n.id()).member("name", n.name()).member("class", n.meta().name());
-    out.member("parent", frame_parent_id(n)).key("world");
+    out.key("parent");
+    write_frame_parent(out, n);
+    out.key("world");
     write_matrix(out, n.world_frame());
     out.end_object();
   });
@@ -90,7 +95,8 @@ void write_scene(JsonWriter& out, const SimState& state) {
   out.key("hulls").begin_array();
   state.index().for_each(Hull::static_meta(), true, [&](SimStateInstance& i) {
     const auto& h = static_cast<const Hull&>(i);
-    out.begin_object().member("id", h.id()).member("name", h.name()).member("node", frame_parent_id(h));
+    out.begin_object().member("id", h.id()).member("name", h.name()).key("node");
+    write_frame_parent(out, h);
     out.member("role", std::string(h.role() == scene::HullRole::Visual ? "Visual" : "Collision"));
     out.key("world");
     write_matrix(out, h.world_frame());

@@ -249,7 +249,9 @@ struct Server::Impl {
       return;
     }
     ++requests;
-    res.set_header("Cache-Control", "no-cache");
+    // The libraries under /lib are pinned by the lockfile: a day in the browser's cache. The page's own
+    // files are asked again each time (edits show up at once).
+    res.set_header("Cache-Control", path.rfind("/lib/", 0) == 0 ? "max-age=86400" : "no-cache");
     res.set_content(data.str(), content_type(it->second));
   }
 
@@ -320,6 +322,11 @@ void Server::start() {
   d.http.set_read_timeout(10, 0);
   d.http.set_write_timeout(10, 0);
   d.http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    // No compression: Debian's httplib is built with brotli, which takes seconds for the page's 1.5 MB
+    // layout library on every load, where sending it plain over the loopback takes milliseconds. The
+    // request object is httplib's own (not const), handed to us as const: dropping the header here is
+    // the one way 0.11 offers.
+    const_cast<httplib::Request&>(req).headers.erase("Accept-Encoding");
     if (impl_->host_allowed(req)) return httplib::Server::HandlerResponse::Unhandled;
     impl_->answer(res, Reply::error(403, "Host '" + req.get_header_value("Host").substr(0, 100) +
                                              "' is not this server's address or localhost"));

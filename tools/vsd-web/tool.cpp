@@ -4,6 +4,7 @@
 #include <signal.h>
 
 #include <atomic>
+#include <cstdint>
 #include <chrono>
 #include <ostream>
 #include <string>
@@ -37,7 +38,9 @@ Usage:
       picks a free port — and prints "vsd-web: serving URL" and "vsd-web: write token: T". Editing needs
       the token (a random one unless --token is given); an address other than a loopback one needs
       --token. The simulation is paused until the page starts it (or --run is given); it then steps in
-      real time, SECONDS per step (default 0.01, from 0.0001 to 1). Stops on Ctrl-C or SIGTERM, or after
+      real time, SECONDS per step (default 0.01, from 0.0001 to 1), each step firing at most 100
+      transitions of a script (a net that never becomes quiet goes on in the next step). Stops on
+      Ctrl-C or SIGTERM, or after
       S seconds of wall time (--seconds, for scripts and tests).
   vsd-web --help
 
@@ -45,6 +48,8 @@ Exit status: 0 stopped, 1 the file could not be loaded or the address not bound,
 )";
 
 const Tool tool{"vsd-web", usage};
+
+constexpr std::uint64_t firings_per_step = 100;
 
 bool ends_with(std::string_view s, std::string_view suffix) {
   return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
@@ -104,6 +109,9 @@ int body(std::span<const std::string_view> args, std::ostream& out, std::ostream
   env.use<scene::Module>();
   env.use<robotics::Module>();
   auto& soml = env.use<vsd::soml::Module>();
+  // A net that never becomes quiet (the dining philosophers) fires this often per step, so that steps
+  // end, the page sees the tokens move, and requests and signals are served.
+  soml.step_limit = firings_per_step;
   SimState& state = ws.state();
   if (ends_with(path, ".soml")) {
     const std::string file(path);

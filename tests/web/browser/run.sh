@@ -27,9 +27,9 @@ if [[ -z "$server" ]]; then
   exit 2
 fi
 
-command -v node >/dev/null 2>&1 || skip "node (Node.js >= 20) is not installed; the browser tests need it"
+command -v node >/dev/null 2>&1 || skip "node (Node.js >= 18) is not installed; the browser tests need it"
 node_major="$(node -p 'process.versions.node.split(".")[0]')"
-((node_major >= 20)) || skip "node $(node --version) is too old; playwright-core needs Node.js >= 20"
+((node_major >= 18)) || skip "node $(node --version) is too old; playwright-core needs Node.js >= 18"
 
 chromium="${VSD_CHROMIUM:-}"
 if [[ -z "$chromium" ]]; then
