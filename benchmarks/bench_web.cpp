@@ -62,6 +62,24 @@ class StreamReader {
   std::thread thread_;
 };
 
+/// The three cases of the step benchmarks: @p mode 0 no server, 1 a server with one page connected to its
+/// event stream, 2 the same with the timeline off.
+struct Inspected {
+  std::unique_ptr<vsd::web::Server> server;
+  std::unique_ptr<StreamReader> page;
+  Inspected(vsd::Environment& env, vsd::SimState& s, std::int64_t mode) {
+    if (mode == 0) return;
+    vsd::web::Options o;
+    o.port = 0;
+    if (mode == 2) o.timeline_bytes = 0;
+    server = std::make_unique<vsd::web::Server>(env, s, o);
+    server->start();
+    page = std::make_unique<StreamReader>(*server, [](std::string_view) {});
+    while (server->stats().clients == 0) server->serve_for(std::chrono::milliseconds(1));
+  }
+  ~Inspected() { page.reset(); }  // the page goes before its server
+};
+
 /// A cell-sized scene: @p n boxes (a Node3D with a box hull each) that move every step.
 std::vector<vsd::scene::Node3D*> boxes(vsd::SimState& s, int n) {
   std::vector<vsd::scene::Node3D*> out;
@@ -95,17 +113,9 @@ void BM_WebStep(benchmark::State& st) {
   env.use<vsd::scene::Module>();
   auto& s = env.main_state();
   const auto nodes = boxes(s, 200);
-  std::unique_ptr<vsd::web::Server> server;
-  std::unique_ptr<StreamReader> page;
-  if (st.range(0) >= 1) {
-    vsd::web::Options o;
-    o.port = 0;
-    if (st.range(0) == 2) o.timeline_bytes = 0;
-    server = std::make_unique<vsd::web::Server>(env, s, o);
-    server->start();
-    page = std::make_unique<StreamReader>(*server, [](std::string_view) {});
-    while (server->stats().clients == 0) server->serve_for(std::chrono::milliseconds(1));
-  }
+  Inspected inspected(env, s, st.range(0));
+  auto& server = inspected.server;
+  auto& page = inspected.page;
   double z = 0;
   for (auto _ : st) {
     z += 0.001;
@@ -127,17 +137,8 @@ BENCHMARK(BM_WebStep)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
 void BM_WebPhysicsStep(benchmark::State& st) {
   vsd_bench_physics::VsdScene scene;
   auto& s = scene.env.main_state();
-  std::unique_ptr<vsd::web::Server> server;
-  std::unique_ptr<StreamReader> page;
-  if (st.range(0) >= 1) {
-    vsd::web::Options o;
-    o.port = 0;
-    if (st.range(0) == 2) o.timeline_bytes = 0;
-    server = std::make_unique<vsd::web::Server>(scene.env, s, o);
-    server->start();
-    page = std::make_unique<StreamReader>(*server, [](std::string_view) {});
-    while (server->stats().clients == 0) server->serve_for(std::chrono::milliseconds(1));
-  }
+  Inspected inspected(scene.env, s, st.range(0));
+  auto& server = inspected.server;
   for (auto _ : st) {
     scene.env.step();
     benchmark::DoNotOptimize(scene.hulls.back()->frame());
