@@ -1,6 +1,8 @@
 // vsd::web::Server over real sockets: reads generated from the meta-information, edits through the
 // setters (and refused ones that change nothing), the security rules, the timeline, the nets' fire
 // button and the event stream.
+#include <filesystem>
+#include <fstream>
 #include <thread>
 
 #include "web_fixture.hpp"
@@ -387,6 +389,35 @@ TEST_F(Server, ChangesArePushedToTheEventStreamWithWorldFrames) {
   EXPECT_NE(all.find("\"property\":\"frame\""), std::string::npos);
   // The hull below the box moved too: its world frame travels although its own frame did not change.
   EXPECT_NE(all.find("{\"id\":" + std::to_string(hull->id()) + ",\"world\":"), std::string::npos) << all;
+}
+
+TEST_F(Server, OnlyThePagesOwnFilesAreServed) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("vsd_web_assets_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "app");
+  std::ofstream(dir / "index.html") << "<!doctype html><title>vsd</title>";
+  std::ofstream(dir / "app" / "main.js") << "export {};";
+  std::ofstream(dir / ".hidden") << "secret";
+  fs::create_symlink("/etc/passwd", dir / "app" / "passwd.js");  // a link that leads out of the folder
+  vsd::web::Options o;
+  o.port = 0;
+  o.assets = dir.string();
+  server = std::make_unique<vsd::web::Server>(env, state, o);
+  server->start();
+  const HttpReply index = get("/");
+  EXPECT_EQ(index.status, 200);
+  EXPECT_NE(index.body.find("<title>vsd</title>"), std::string::npos);
+  EXPECT_NE(index.head.find("text/html"), std::string::npos);
+  EXPECT_EQ(get("/app/main.js").status, 200);
+  for (const char* path : {"/app/passwd.js", "/.hidden", "/../../../../etc/passwd", "/app/../../etc/passwd",
+                           "/%2e%2e/%2e%2e/etc/passwd", "/app", "/nothing.html"}) {
+    const HttpReply r = get(path);
+    EXPECT_NE(r.status, 200) << path;
+    EXPECT_EQ(r.body.find("root:"), std::string::npos) << path;
+  }
+  server.reset();
+  fs::remove_all(dir);
 }
 
 TEST_F(Server, StopEndsRunFromAnotherThread) {
