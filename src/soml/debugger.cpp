@@ -103,7 +103,12 @@ class Debugger::Impl final : public DebugHooks {
       if (trace_) trace_(f);
     };
   }
-  ~Impl() override {
+  ~Impl() override { detach(); }
+  void on_program_gone() noexcept override { detach(); }
+  // Restores the program's code and trace, once; afterwards P_ and program_ are never used again.
+  void detach() noexcept {
+    if (gone_) return;
+    gone_ = true;
     for (auto& f : P_.functions_) {
       if (f->original.empty()) continue;
       f->code = f->original;
@@ -111,6 +116,11 @@ class Debugger::Impl final : public DebugHooks {
     }
     P_.trace_ = previous_trace_;
     P_.debug_ = nullptr;
+  }
+  // Every call that reads or changes the program goes through here.
+  ProgramImpl& live() const {
+    if (gone_) throw Error("SOML++ debugger: the program it was attached to is gone");
+    return P_;
   }
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
@@ -133,6 +143,7 @@ class Debugger::Impl final : public DebugHooks {
   vsd::Id stop_mark_ = 0;        // at a transition breakpoint: its mark
   vsd::Id stop_transition_ = 0;  // and the transition
   bool stepping_patched_ = false;
+  bool gone_ = false;  // the program was destroyed: detached for good
   // Per function: 1 where a line's run of instructions starts, 2 where a jump lands inside a line.
   std::vector<std::vector<std::uint8_t>> starts_;
 
@@ -437,7 +448,7 @@ Debugger::Debugger(Program& program) : impl_(std::make_unique<Impl>(*this, progr
 Debugger::~Debugger() = default;
 
 int Debugger::break_at_line(std::uint32_t line) {
-  ProgramImpl& P = impl_->P_;
+  ProgramImpl& P = impl_->live();
   bool found = false;
   std::uint32_t before = 0, after = 0;
   for (std::size_t fi = 0; fi < P.functions_.size(); ++fi) {
@@ -479,7 +490,7 @@ int Debugger::break_at(std::string_view location) {
   if (num.empty() || r.ec != std::errc() || r.ptr != num.data() + num.size() || line == 0)
     throw Error("SOML++ debugger: '" + std::string(location) + "' is not FILE:LINE or LINE");
   if (!file.empty()) {
-    const std::string& name = impl_->P_.checked_->source->name();
+    const std::string& name = impl_->live().checked_->source->name();
     const auto slash = name.find_last_of('/');
     const std::string base = slash == std::string::npos ? name : name.substr(slash + 1);
     if (file != name && file != base)
@@ -491,7 +502,7 @@ int Debugger::break_at(std::string_view location) {
 int Debugger::break_on_transition(std::string_view name) {
   name = trim(name);
   bool found = false;
-  for (const auto& [owner, net] : impl_->P_.nets_) {
+  for (const auto& [owner, net] : impl_->live().nets_) {
     (void)owner;
     for (const Transition* t : net->transitions)
       if (net_node_label(t) == name || t->name() == name) found = true;
@@ -505,6 +516,7 @@ int Debugger::break_on_transition(std::string_view name) {
 }
 
 bool Debugger::remove(int id) {
+  (void)impl_->live();
   auto& v = impl_->bps_;
   auto it = std::find_if(v.begin(), v.end(), [&](const Breakpoint& b) { return b.id == id; });
   if (it == v.end()) return false;
@@ -518,6 +530,7 @@ const std::vector<Breakpoint>& Debugger::breakpoints() const noexcept { return i
 void Debugger::on_stop(std::function<Resume(Debugger&, const Stop&)> fn) { impl_->handler_ = std::move(fn); }
 
 void Debugger::step_into_next(bool on) {
+  (void)impl_->live();
   impl_->stop_fn_ = nullptr;
   impl_->stop_depth_ = 0;
   impl_->stop_line_ = 0;
@@ -530,7 +543,7 @@ bool Debugger::stopped() const noexcept { return impl_->in_stop_; }
 
 std::vector<StackFrame> Debugger::call_stack() const {
   std::vector<StackFrame> out;
-  if (!impl_->in_stop_) return out;
+  if (!impl_->in_stop_ || impl_->gone_) return out;
   const ProgramImpl& P = impl_->P_;
   for (std::size_t k = 0; k < P.frames_.size(); ++k) {
     const Frame& f = impl_->frame(k);
@@ -547,6 +560,7 @@ std::vector<StackFrame> Debugger::call_stack() const {
 }
 
 std::vector<Variable> Debugger::locals(std::size_t k) const {
+  (void)impl_->live();
   const Frame& f = impl_->frame(k);
   const ProgramImpl& P = impl_->P_;
   const std::size_t at = Impl::pc_of(f);
@@ -569,7 +583,7 @@ std::vector<Variable> Debugger::locals(std::size_t k) const {
 }
 
 std::string Debugger::print(std::string_view path, std::size_t k) const {
-  const ProgramImpl& P = impl_->P_;
+  const ProgramImpl& P = impl_->live();
   const std::string text(trim(path));
   std::vector<std::string> parts;
   for (std::size_t from = 0;;) {
@@ -684,12 +698,35 @@ std::string Debugger::print(std::string_view path, std::size_t k) const {
 }
 
 std::string Debugger::marking() const {
+  (void)impl_->live();
   std::string s;
   for (const Place* p : impl_->program_.places())
     s += net_node_label(p) + " = " + Impl::place_text(*p) + "\n";
   return s;
 }
 
-Program& Debugger::program() const noexcept { return impl_->program_; }
+Program& Debugger::program() const {
+  (void)impl_->live();
+  return impl_->program_;
+}
+
+bool Debugger::attached() const noexcept { return !impl_->gone_; }
+
+const std::string& Debugger::source() const { return impl_->live().checked_->source->text(); }
+
+const std::string& Debugger::file() const { return impl_->live().checked_->source->name(); }
+
+std::vector<std::uint32_t> Debugger::lines() const {
+  const ProgramImpl& P = impl_->live();
+  std::vector<std::uint32_t> out;
+  for (std::size_t fi = 0; fi < P.functions_.size(); ++fi) {
+    const auto& s = impl_->starts(fi);
+    for (std::size_t i = 0; i < s.size(); ++i)
+      if (s[i] == 1) out.push_back(P.functions_[fi]->lines[i]);
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
 
 }  // namespace vsd::soml

@@ -1212,7 +1212,11 @@ Value ProgramImpl::call_from_cpp(int fi, SimStateInstance& self, std::span<const
 // ---- Program ----
 
 Program::Program(std::shared_ptr<ProgramImpl> impl) : impl_(std::move(impl)) {}
-Program::~Program() = default;
+Program::~Program() {
+  // A debugger may outlive the program (a server's, attached to every program it saw): it is told, and
+  // from then on refuses its calls instead of reading freed memory.
+  if (impl_ && impl_->debug_ != nullptr) impl_->debug_->on_program_gone();
+}
 
 std::unique_ptr<Program> Program::load(SimState& state, std::string name, std::string text,
                                        RunOptions options) {

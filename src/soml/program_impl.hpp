@@ -196,6 +196,8 @@ class DebugHooks {
   virtual void on_break(const Function& f, std::size_t at) = 0;
   // Transition @p t of @p net is about to fire with mark @p mark.
   virtual void on_fire(const Transition& t, std::uint64_t mark) = 0;
+  // The Program is being destroyed: restore the code and never touch the program again.
+  virtual void on_program_gone() noexcept = 0;
 };
 
 // How to reach the instance `outer` levels out of a function's scope: a fixed object, or parents.

@@ -4,6 +4,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -251,6 +252,43 @@ TEST_F(Dbg, AnErrorInTheStopHandlerUnwindsTheProgramCleanly) {
   EXPECT_EQ(p->place("free", p->object("cell"))->tokens(), 2);  // the firing was undone
   d.on_stop({});
   EXPECT_EQ(p->run_until_quiet(), 2u);
+}
+
+
+TEST_F(Dbg, ShowsTheSourceAndTheLinesThatTakeABreakpoint) {
+  Debugger d(*p);
+  EXPECT_EQ(d.file(), "dbg.soml");
+  EXPECT_EQ(d.source(), kScript);
+  const std::vector<std::uint32_t> lines = d.lines();
+  ASSERT_FALSE(lines.empty());
+  EXPECT_TRUE(std::is_sorted(lines.begin(), lines.end()));
+  for (std::uint32_t l : lines) EXPECT_NO_THROW(d.remove(d.break_at_line(l))) << "line " << l;
+  EXPECT_THAT(lines, ::testing::Contains(2u));               // in a function
+  EXPECT_THAT(lines, ::testing::Not(::testing::Contains(7u)));  // a blank line
+  EXPECT_THAT([&] { d.break_at_line(7); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("no code")));
+}
+
+TEST(DebuggerLifetime, OutlivingItsProgramDetachesIt) {
+  vsd::Registry reg;
+  vsd::Environment env{0, reg};
+  auto& soml = env.use<vsd::soml::Module>();
+  std::ostringstream out;
+  vsd::soml::RunOptions o;
+  o.out = &out;
+  vsd::SimState& copy = env.create_state("other");
+  Program& p = soml.load(copy, "dbg.soml", kScript, o);
+  Debugger d(p);
+  d.break_at_line(3);
+  d.break_on_transition("cell.go");
+  EXPECT_TRUE(d.attached());
+  env.remove_state(copy);  // the program goes with its state
+  EXPECT_FALSE(d.attached());
+  EXPECT_EQ(d.breakpoints().size(), 2u);  // still readable
+  EXPECT_TRUE(d.call_stack().empty());
+  EXPECT_THAT([&] { d.break_at_line(3); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("is gone")));
+  EXPECT_THAT([&] { (void)d.print("cell"); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("is gone")));
+  EXPECT_THAT([&] { (void)d.program(); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("is gone")));
+  EXPECT_THAT([&] { (void)d.remove(1); }, ::testing::ThrowsMessage<vsd::Error>(HasSubstr("is gone")));
 }
 
 }  // namespace

@@ -82,7 +82,8 @@ struct Variable {
   std::string value;  ///< as print() writes it; strings quoted
 };
 
-/// @brief A debugger attached to one Program (at most one at a time).
+/// @brief A debugger attached to one Program (at most one at a time). It may outlive the Program: it
+/// is detached then (attached() is false) and its calls that need the program throw.
 class Debugger {
  public:
   /// @brief Attaches to @p program.
@@ -135,8 +136,16 @@ class Debugger {
   /// @brief The marking of every place, one "owner.place = 3" or "owner.place = [a, b]" per line.
   [[nodiscard]] std::string marking() const;
 
-  /// @brief The program debugged.
-  [[nodiscard]] Program& program() const noexcept;
+  /// @brief The program debugged. @throws vsd::Error when it is gone (see attached()).
+  [[nodiscard]] Program& program() const;
+  /// @brief False once the program was destroyed (its state went, or the Module stopped serving it): the
+  /// debugger may outlive its program, and every call that needs the program then throws vsd::Error.
+  [[nodiscard]] bool attached() const noexcept;
+  /// @brief The script's name as loaded and its source text (for a front end that shows the lines).
+  [[nodiscard]] const std::string& file() const;
+  [[nodiscard]] const std::string& source() const;
+  /// @brief The source lines where code starts, ascending: the lines break_at_line() accepts.
+  [[nodiscard]] std::vector<std::uint32_t> lines() const;
 
  private:
   class Impl;
