@@ -29,6 +29,7 @@ constexpr std::size_t max_value_text = 64 * 1024;
 /// Rows of one /api/table or /api/children page; entries of /api/timeline.
 constexpr std::size_t max_rows = 1000;
 constexpr std::size_t max_timeline = 10000;
+constexpr std::size_t max_trace = 1000;  // token-trace entries per answer or event
 
 class StateResolver final : public RefResolver {
  public:
@@ -239,6 +240,13 @@ Inspector::Inspector(Environment& env, SimState& state, const Options& options, 
   // The nets view reads the enabled transitions from the state: make them current for a program that
   // was loaded but not stepped yet.
   refresh_programs(env, state);
+  if (options.debug) {
+    debug_ = std::make_unique<Debugging>(env, state, options.trace_entries);
+    debug_->announce = [this](const std::string& json) {
+      publish(true);  // the changes up to the stop first: the page shows the state the program stopped in
+      (void)feed_.broadcast(make_event("debug", json));
+    };
+  }
   last_stats_ = std::chrono::steady_clock::now();
   stats_steps_ = env.scheduler().steps();
   stats_firings_ = firings(env, state);
@@ -268,6 +276,9 @@ Reply Inspector::handle(const Request& r) {
     if (r.method == "GET") return get(r);
     if (r.method == "POST") {
       if (!r.writable) return Reply::error(403, "writing needs the token (header X-VSD-Token)");
+      // Stopped in the middle of a firing: nothing may run or change the state but the debugger.
+      if (debug_ && debug_->stopped() && r.path.rfind("/api/debug/", 0) != 0 && r.path != "/api/pause")
+        return Reply::error(409, "a SOML++ program is stopped at a breakpoint: resume it first (POST /api/debug/resume)");
       return post(r);
     }
     return Reply::error(405, "method " + r.method + " is not allowed");
@@ -302,6 +313,29 @@ Reply Inspector::get(const Request& r) {
     write_nets(out, state_);
   } else if (r.path == "/api/timeline") {
     timeline_.write(out, max_timeline);
+  } else if (r.path == "/api/trace" || r.path.rfind("/api/debug", 0) == 0) {
+    if (!debug_) return Reply::error(404, "debugging is off in this server (Options::debug)");
+    const auto count = [&](std::string_view name, std::size_t dflt, std::size_t max) {
+      const std::string* v = r.param(name);
+      return v != nullptr ? parse_count(*v, name, max) : dflt;
+    };
+    if (r.path == "/api/debug") {
+      debug_->write(out);
+    } else if (r.path == "/api/debug/source") {
+      const std::string* p = r.param("program");
+      if (p == nullptr) throw Error("request: parameter 'program' is missing");
+      debug_->write_source(out, parse_id(*p, "program"));
+    } else if (r.path == "/api/debug/locals") {
+      debug_->write_locals(out, count("frame", 0, SIZE_MAX));
+    } else if (r.path == "/api/debug/print") {
+      const std::string* path = r.param("path");
+      if (path == nullptr) throw Error("request: parameter 'path' is missing");
+      debug_->write_print(out, *path, count("frame", 0, SIZE_MAX));
+    } else if (r.path == "/api/trace") {
+      debug_->write_trace(out, count("after", 0, SIZE_MAX), count("limit", 500, max_trace));
+    } else {
+      return Reply::error(404, "no such path: " + r.path);
+    }
   } else {
     return Reply::error(404, "no such path: " + r.path);
   }
@@ -322,6 +356,12 @@ Reply Inspector::post(const Request& r) {
     out.begin_object().member("ok", true).member("paused", paused_).end_object();
   } else if (r.path == "/api/timeline/seek") {
     seek(out, r);
+  } else if (r.path.rfind("/api/debug/", 0) == 0) {
+    if (!debug_) return Reply::error(404, "debugging is off in this server (Options::debug)");
+    if (r.path != "/api/debug/resume" && r.path != "/api/debug/break" && r.path != "/api/debug/remove" &&
+        r.path != "/api/debug/pause")
+      return Reply::error(404, "no such path: " + r.path);
+    debug_->post(out, r.path, JsonObject::parse(r.body));
   } else if (r.path == "/api/timeline/live") {
     (void)JsonObject::parse(r.body.empty() ? std::string_view("{}") : std::string_view(r.body));
     timeline_.seek(timeline_.end(), env_.scheduler().steps(), env_.time());
@@ -567,10 +607,18 @@ void Inspector::seek(JsonWriter& out, const Request& r) {
 }
 
 void Inspector::publish(bool force) {
-  timeline_.cut(env_.scheduler().steps(), env_.time());
+  const bool stopped = debug_ && debug_->stopped();
+  // At a stop the program is in the middle of a firing: no timeline entry ends there.
+  if (!stopped) timeline_.cut(env_.scheduler().steps(), env_.time());
+  if (debug_ && !stopped) debug_->sync();
   const auto now = std::chrono::steady_clock::now();
   const auto interval = std::chrono::duration<double>(options_.push_rate > 0 ? 1.0 / options_.push_rate : 0.0);
-  if (!watch_.empty() && (force || now - last_push_ >= interval)) {
+  const bool due = force || now - last_push_ >= interval;
+  if (due && debug_) {
+    const std::string trace = debug_->take_trace_event(max_trace);
+    if (!trace.empty()) dropped_ += feed_.broadcast(make_event("trace", trace));
+  }
+  if (!watch_.empty() && due) {
     std::vector<Watch::Report> reports = watch_.take();
     JsonWriter out;
     write_batch(out, reports);

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -16,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "debug_view.hpp"
 #include "feed.hpp"
 #include "timeline.hpp"
 #include "vsd/core/watch.hpp"
@@ -64,6 +66,8 @@ class Inspector {
   [[nodiscard]] std::uint64_t batches() const noexcept { return batches_; }
   [[nodiscard]] std::uint64_t dropped() const noexcept { return dropped_; }
   [[nodiscard]] std::size_t timeline_size() const noexcept { return timeline_.size(); }
+  /// @brief The SOML++ debugging (null when Options::debug is off).
+  [[nodiscard]] Debugging* debugging() noexcept { return debug_.get(); }
 
  private:
   Reply get(const Request& r);
@@ -91,6 +95,7 @@ class Inspector {
   const Options& options_;
   Feed& feed_;
   Timeline timeline_;
+  std::unique_ptr<Debugging> debug_;
   Watch watch_;  // every change of every instance, de-duplicated per (instance, property)
   std::atomic<bool> paused_{false};
   std::uint64_t seq_ = 0;

@@ -19,11 +19,6 @@ using soml::Arrow;
 using soml::Place;
 using soml::Transition;
 
-std::vector<soml::Program*> programs_of(Environment& env, const SimState& state) {
-  const auto* m = env.module<soml::Module>();
-  return m != nullptr ? m->programs(state) : std::vector<soml::Program*>{};
-}
-
 const char* arrow_type(soml::ArrowType t) {
   switch (t) {
     case soml::ArrowType::Inhibitor:
@@ -37,6 +32,11 @@ const char* arrow_type(soml::ArrowType t) {
 }
 
 }  // namespace
+
+std::vector<soml::Program*> programs_of(Environment& env, const SimState& state) {
+  const auto* m = env.module<soml::Module>();
+  return m != nullptr ? m->programs(state) : std::vector<soml::Program*>{};
+}
 
 void write_nets(JsonWriter& out, const SimState& state) {
   // The enabled transitions as the executors last left them (every step, firing and edit refreshes them).

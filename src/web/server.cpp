@@ -120,7 +120,22 @@ struct Server::Impl {
   std::deque<std::shared_ptr<Job>> jobs;
 
   Impl(Environment& e, SimState& s, Options o)
-      : env(e), state(s), options(std::move(o)), feed(options.client_backlog), inspector(e, s, options, feed) {}
+      : env(e), state(s), options(std::move(o)), feed(options.client_backlog), inspector(e, s, options, feed) {
+    if (detail::Debugging* d = inspector.debugging()) d->wait = [this] { serve_stopped(); };
+  }
+
+  /// A SOML++ program stopped at a breakpoint, inside its run on this thread: answer requests (the
+  /// inspector refuses all but reads and debugger commands now) until the page resumes it or the server
+  /// stops. Not listening: nobody can resume, so it goes on at once.
+  void serve_stopped() {
+    detail::Debugging& d = *inspector.debugging();
+    while (listening && !stopping && !d.resuming()) {
+      run_jobs();
+      if (d.resuming()) break;
+      std::unique_lock lock(jobs_mutex);
+      job_arrived.wait_for(lock, std::chrono::milliseconds(200), [&] { return !jobs.empty() || stopping; });
+    }
+  }
 
   /// Runs @p work on the simulation thread and waits for it. False when it timed out (it then never runs).
   bool submit(std::function<void(detail::Inspector&)> work) {

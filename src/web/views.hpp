@@ -10,6 +10,10 @@
 #include "vsd/core/fwd.hpp"
 #include "vsd/core/watch.hpp"
 
+namespace vsd::soml {
+class Program;
+}
+
 namespace vsd::web::detail {
 
 class JsonWriter;
@@ -23,6 +27,8 @@ void write_mesh(JsonWriter& out, const SimState& state, Id id);
 /// was created, and of the Node3Ds below it. Writes `"frames": [...]` as a member.
 void write_frames(JsonWriter& out, const SimState& state, const std::vector<Watch::Report>& reports);
 
+/// @brief The SOML++ programs of @p state, in the order they were loaded (none without the module).
+[[nodiscard]] std::vector<soml::Program*> programs_of(Environment& env, const SimState& state);
 /// @brief `{"nets": [...]}`: every place and transition of @p state grouped by the node that owns them.
 void write_nets(JsonWriter& out, const SimState& state);
 /// @brief Fires transition @p id if one of the state's programs has it enabled. @return false when it is

@@ -353,24 +353,6 @@ TEST_F(Server, TheFireButtonFiresAnEnabledTransitionOnly) {
   EXPECT_EQ(post("/api/fire", "{\"transition\": " + std::to_string(state.database().id()) + "}").status, 400);
 }
 
-/// Reads the event stream of @p port until @p until is in what arrived (or 5 s pass).
-std::string read_events(int port, const std::string& host, const std::string& until, std::atomic<bool>& connected) {
-  const int fd = connect_local(port, 5);
-  std::string all;
-  if (fd >= 0) {
-    (void)send_all(fd, http_text("GET", "/api/events", host, "", {}));
-    char buf[4096];
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-    for (ssize_t n; std::chrono::steady_clock::now() < deadline && (n = ::recv(fd, buf, sizeof buf, 0)) > 0;) {
-      all.append(buf, static_cast<std::size_t>(n));
-      if (all.find("event: hello") != std::string::npos) connected = true;
-      if (all.find(until) != std::string::npos) break;
-    }
-    ::close(fd);
-  }
-  return all;
-}
-
 TEST_F(Server, ChangesArePushedToTheEventStreamWithWorldFrames) {
   build_scene();
   start();

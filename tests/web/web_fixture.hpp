@@ -2,6 +2,7 @@
 // while a client thread waits for the answer — the simulation thread and the HTTP threads as in a program.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <future>
 #include <memory>
@@ -50,6 +51,24 @@ class WebTest : public ::testing::Test {
     return send(http_text("POST", path, host(), body, headers));
   }
 };
+
+/// Reads the event stream of @p port until @p until is in what arrived (or 5 s pass).
+inline std::string read_events(int port, const std::string& host, const std::string& until, std::atomic<bool>& connected) {
+  const int fd = connect_local(port, 5);
+  std::string all;
+  if (fd >= 0) {
+    (void)send_all(fd, http_text("GET", "/api/events", host, "", {}));
+    char buf[4096];
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+    for (ssize_t n; std::chrono::steady_clock::now() < deadline && (n = ::recv(fd, buf, sizeof buf, 0)) > 0;) {
+      all.append(buf, static_cast<std::size_t>(n));
+      if (all.find("event: hello") != std::string::npos) connected = true;
+      if (all.find(until) != std::string::npos) break;
+    }
+    ::close(fd);
+  }
+  return all;
+}
 
 /// Member @p name of the JSON object @p json, as raw JSON text.
 inline std::string member(std::string_view json, std::string_view name) {

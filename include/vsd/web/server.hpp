@@ -47,6 +47,12 @@ struct Options {
   std::size_t timeline_bytes = std::size_t{64} << 20;
   /// Largest request body accepted (413 beyond).
   std::size_t max_body = std::size_t{1} << 20;
+  /// Attach a SOML++ debugger to every program of the state (breakpoints, step and continue from the page)
+  /// and keep their token trace. A program that already has a debugger (the application's own) is shown
+  /// without; off, the programs are left alone.
+  bool debug = true;
+  /// Token-trace entries kept for the page (the oldest go first).
+  std::size_t trace_entries = 2000;
   /// Real-time factor of run(): simulated seconds per wall-clock second (0: as fast as possible).
   double real_time_factor = 1.0;
 };
