@@ -31,7 +31,10 @@ object cell {
 constexpr std::string_view endpoints[] = {
     "GET /api/info",     "GET /api/classes",   "GET /api/children", "GET /api/table",  "GET /api/instance",
     "GET /api/scene",    "GET /api/mesh",      "GET /api/nets",     "GET /api/timeline", "POST /api/set",
-    "POST /api/call",    "POST /api/fire",     "POST /api/pause",   "GET /api/nothing", "POST /api/nothing"};
+    "POST /api/call",    "POST /api/fire",     "POST /api/pause",   "GET /api/nothing", "POST /api/nothing",
+    // The SOML++ debugger (a stop continues at once: nobody serves it here).
+    "GET /api/debug", "GET /api/debug/source", "GET /api/debug/locals", "GET /api/debug/print", "GET /api/trace",
+    "POST /api/debug/break", "POST /api/debug/remove", "POST /api/debug/resume", "POST /api/debug/pause"};
 
 std::vector<std::pair<std::string, std::string>> parse_query(std::string_view q) {
   std::vector<std::pair<std::string, std::string>> out;

@@ -4,6 +4,7 @@
 
 #include "json.hpp"
 #include "views.hpp"
+#include "vsd/core/element_index.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/core/sim_state.hpp"
 #include "vsd/soml/net_classes.hpp"
@@ -184,10 +185,17 @@ void Debugging::write(JsonWriter& out) {
     out.member("file", e->debugger->file()).key("breakpoints").begin_array();
     for (const auto& b : e->debugger->breakpoints()) {
       out.begin_object().member("id", b.id).member("hits", b.hits);
-      if (b.transition.empty())
+      if (b.transition.empty()) {
         out.member("line", static_cast<std::uint64_t>(b.line));
-      else
-        out.member("transition", b.transition);
+      } else {
+        // The transitions it stops before (a bare name can stop several), for the page's nets view.
+        out.member("transition", b.transition).key("transitions").begin_array();
+        state_.index().for_each(soml::Transition::static_meta(), true, [&](SimStateInstance& i) {
+          const auto& t = static_cast<const soml::Transition&>(i);
+          if (t.name() == b.transition || soml::net_node_label(&t) == b.transition) out.number(t.id());
+        });
+        out.end_array();
+      }
       out.end_object();
     }
     out.end_array().end_object();

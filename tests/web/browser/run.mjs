@@ -434,6 +434,46 @@ async function runChecks(browser) {
     }
   });
 
+  await check('a breakpoint set in the Debug tab stops a firing; the page shows where; Continue goes on', async () => {
+    await page.click('nav.tabs button[data-tab="debug"]');
+    const { programs } = await apiOk('/api/debug');
+    assert(programs.length === 1 && programs[0].debuggable, `/api/debug: ${JSON.stringify(programs)}`);
+    const source = await apiOk(`/api/debug/source?program=${programs[0].program}`);
+    const line = source.text.split('\n').findIndex((l) => l.includes('fired += 1')) + 1;
+    assert(line > 0 && source.lines.includes(line), `no breakable line with 'fired += 1' (lines ${source.lines})`);
+    const gutter = page.locator(`#debug-source .line[data-line="${line}"] .gutter`);
+    await gutter.click();
+    await until('the breakpoint in the server', async () =>
+      (await apiOk('/api/debug')).programs[0].breakpoints.some((b) => b.line === line));
+    await page.locator(`#debug-source .line.bp[data-line="${line}"]`).waitFor({ timeout: 5000 });
+    // Another client fires: the firing stops at the line and its request waits for the resume.
+    const t = await until('an enabled transition', enabledTransition, 5000);
+    const firing = api('/api/fire', { method: 'POST', body: { transition: t.id }, token: TOKEN });
+    await until('the stop in the page', () => page.evaluate(() => window.vsdTest.stopped()));
+    assert((await page.textContent('#debug-banner')).includes(`:${line}`), `banner: ${await page.textContent('#debug-banner')}`);
+    await page.locator(`#debug-source .line.current[data-line="${line}"]`).waitFor({ timeout: 5000 });
+    await until('the call stack', async () => (await page.locator('#debug-stack li').count()) >= 1);
+    const refused = await api('/api/set', { method: 'POST', body: { id: target?.id ?? 1, property: 'name', value: 'x' }, token: TOKEN });
+    assert(refused.status === 409, `an edit while stopped answered ${refused.status}, expected 409`);
+    await shot(page, '09a-stopped');
+    await page.click('#debug-continue');
+    const fired = await firing;
+    assert(fired.status === 200, `the stopped firing answered ${fired.status} ${fired.text}`);
+    await until('the banner to go', async () => !(await page.evaluate(() => window.vsdTest.stopped())));
+    await until('the firing in the token trace', async () => (await page.textContent('#debug-trace')).includes(t.name));
+    await gutter.click();
+    await until('the breakpoint to be removed', async () => (await apiOk('/api/debug')).programs[0].breakpoints.length === 0);
+    // A transition breakpoint from the Nets view's Break button, and off again.
+    await page.click('nav.tabs button[data-tab="nets"]');
+    const brk = page.locator(`#nets table.transitions tr[data-id="${t.id}"] button.break`);
+    await brk.click();
+    await until('the transition breakpoint', async () =>
+      (await apiOk('/api/debug')).programs[0].breakpoints.some((b) => (b.transitions || []).includes(t.id)));
+    await page.locator(`#nets table.transitions tr[data-id="${t.id}"] button.break.on`).waitFor({ timeout: 5000 });
+    await brk.click();
+    await until('no breakpoint left', async () => (await apiOk('/api/debug')).programs[0].breakpoints.length === 0);
+  });
+
   await check('scrubbing the timeline back restores the earlier value, Live brings the edit back', async () => {
     assert(edited, 'the edit check did not pass');
     const timeline = await apiOk('/api/timeline');

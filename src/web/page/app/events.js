@@ -1,4 +1,4 @@
-// The server's push stream (docs/web.md, "Events"): hello, changes, stats, resync. Each event is
+// The server's push stream (docs/web.md, "Events"): hello, changes, stats, debug, trace, resync. Each event is
 // re-emitted on the bus; `hello` and `resync` both mean "fetch everything again" ('reload'), because a
 // late client starts from a snapshot and a client that fell behind lost the dropped batches.
 
@@ -33,6 +33,12 @@ export function connect() {
     },
     stats(stats) {
       emit('stats', stats);
+    },
+    debug(d) {
+      emit('debug', d);
+    },
+    trace(t) {
+      emit('trace', t);
     },
     resync(why) {
       emit('reload', { reason: why.reason || 'resync' });

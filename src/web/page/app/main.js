@@ -14,6 +14,7 @@ import * as timeline from './timeline.js';
 const scene3dModule = import('./scene3d.js');
 const netsModule = import('./nets.js');
 const plotsModule = import('./plots.js');
+const debugModule = import('./debug.js');
 let scene3d = null;
 let plots = null;
 scene3dModule.then((m) => (scene3d = m));
@@ -57,6 +58,7 @@ async function reloadAll(reason) {
     tree.reload(),
     scene3dModule.then((m) => m.reload()),
     netsModule.then((m) => m.reload()),
+    debugModule.then((m) => m.reload()),
     timeline.reload(),
     state.selected !== null ? inspector.show(state.selected) : null,
   ]);
@@ -115,6 +117,7 @@ window.vsdTest = {
   screenPosition: (id) => scene3d?.screenPosition(id) ?? null,
   timeline: () => timeline.current(),
   plots: () => plots?.plotted() ?? [],
+  stopped: () => !document.getElementById('debug-banner').hidden,
 };
 
 connect();

@@ -10,6 +10,9 @@
 import { post, get } from './api.js';
 import { on, select, state } from './bus.js';
 
+// The Debug view sets and removes transition breakpoints (loaded on first use, like this view).
+const debugView = import('./debug.js');
+
 const SVG = 'http://www.w3.org/2000/svg';
 const PLACE = 34;      // circle diameter (px)
 const LABEL = 14;      // room for the name under a place
@@ -22,6 +25,8 @@ let nets = [];
 let shapeKey = '';             // the structure last laid out
 const views = new Map();       // place or transition id -> {kind, group, count?, button?}
 let openPlace = null;          // the place whose tokens are listed
+let breaks = new Map();        // transition id -> its breakpoint (from the Debug view)
+let stoppedAt = null;          // the transition a stop waits before
 let elk = null;
 
 function svg(tag, attrs = {}) {
@@ -161,10 +166,15 @@ function transitionRows(net) {
       }
       refetchSoon(0);
     });
-    cell.append(button, msg);
+    const brk = document.createElement('button');
+    brk.className = 'break';
+    brk.textContent = 'Break';
+    brk.title = 'stop the program before this transition fires (Debug tab)';
+    brk.addEventListener('click', async () => (await debugView).toggleTransition(t.id));
+    cell.append(button, brk, msg);
     tr.append(name, firings, cell);
     table.append(tr);
-    Object.assign(views.get(t.id), { button, firings, row: tr });
+    Object.assign(views.get(t.id), { button, brk, firings, row: tr });
   }
   return table;
 }
@@ -186,6 +196,10 @@ function update() {
       v.row.classList.toggle('enabled', !!t.enabled);
       v.firings.textContent = `${t.firings ?? 0} firings`;
       v.button.disabled = !(t.enabled && state.writable);
+      v.brk.disabled = !state.writable;
+      v.brk.classList.toggle('on', breaks.has(t.id));
+      v.group.classList.toggle('break', breaks.has(t.id));
+      v.group.classList.toggle('stopped', stoppedAt === t.id);
     }
   }
   if (openPlace !== null) showTokens(openPlace);
@@ -288,3 +302,11 @@ function refetchSoon(delay = REFETCH_MS) {
 
 on('changes', () => nets.length && refetchSoon());
 on('writable', () => update());
+on('breakpoints', (map) => {
+  breaks = map;
+  update();
+});
+on('debug', (d) => {
+  stoppedAt = d.stopped?.transition?.id ?? null;
+  update();
+});
