@@ -368,6 +368,17 @@ async function runChecks(browser) {
     await shot(page, '05-table');
     await page.fill('#table-filter', '');
     await page.press('#table-filter', 'Enter');
+    // The Columns chooser: ticking a property not shown adds its column, unticking removes it.
+    await page.click('#table-columns summary');
+    const unticked = page.locator('#table-columns-list input:not(:checked)').first();
+    await unticked.waitFor({ timeout: 5000 });
+    const column = await unticked.getAttribute('value');
+    const headers = () => page.evaluate(() => [...document.querySelectorAll('#table-header th')].map((th) => th.textContent));
+    await unticked.check();
+    await until(`the column ${column} in the table`, async () => (await headers()).includes(column));
+    await page.locator(`#table-columns-list input[value="${column}"]`).uncheck();
+    await until(`the column ${column} to go`, async () => !(await headers()).includes(column));
+    await page.click('#table-columns summary');
     await page.click('nav.tabs button[data-tab="tree"]');
   });
 
@@ -382,6 +393,9 @@ async function runChecks(browser) {
     await page.fill(`${row} input.value-input`, String(Number(numeric.value) + 1));
     await page.click(`${row} button.set`);
     await until('the change to reach the plot', () => page.evaluate(() => window.vsdTest.plots()[0].points >= 2));
+    const plot = await page.evaluate(() => window.vsdTest.plots()[0]);
+    const { time } = await apiOk('/api/info');
+    assert(plot.axis === 'sim' && plot.x === time, `the plot's x is ${plot.x} (${plot.axis}), the simulated time ${time}`);
     await shot(page, '06-plot');
   });
 

@@ -1,6 +1,8 @@
 // Plots: numeric properties picked in the inspector (its ∿ button), drawn live with uPlot from the
-// `set` entries of the `changes` events. The x axis is the wall clock: the simulated time stands still
-// in a state that is not stepped (the vsd-web tool showing a file), and edits should still show up.
+// `set` entries of the `changes` events. The x axis is the simulated time of each batch by default; the
+// wall clock is the choice for a state that is not stepped (the vsd-web tool showing a file), where the
+// simulated time stands still while edits come in. When the simulated time goes back (the timeline was
+// scrubbed, or forked), the plot starts over from there.
 
 import uPlot from 'uplot';
 import { get } from './api.js';
@@ -10,6 +12,8 @@ const MAX_POINTS = 3000;
 const stepped = uPlot.paths.stepped({ align: 1 });
 const pane = document.getElementById('plots');
 const hint = document.getElementById('plots-hint');
+const axisSelect = document.getElementById('plots-axis');
+let simTime = 0;       // of the newest batch
 
 const series = [];     // {id, property, label, last}
 let xs = [];
@@ -53,7 +57,8 @@ function rebuild() {
     // Stepped: a property keeps its value until the next change.
     series: [{}, ...series.map((s, i) => ({ label: s.label, stroke: colors[i % colors.length], spanGaps: true,
                                              paths: stepped }))],
-    scales: { x: { time: true } },
+    scales: { x: { time: axisSelect.value === 'wall' } },
+    axes: [{ label: axisSelect.value === 'wall' ? '' : 'simulated time (s)' }, {}],
   }, [xs, ...ys], pane);
 }
 
@@ -68,7 +73,12 @@ function draw() {
 
 // One point per series: each carries its last value forward, so the lines stay aligned on one x.
 function push() {
-  xs.push(Date.now() / 1000);
+  const x = axisSelect.value === 'wall' ? Date.now() / 1000 : simTime;
+  if (xs.length && x < xs[xs.length - 1]) {
+    xs = [];
+    ys = ys.map(() => []);
+  }
+  xs.push(x);
   series.forEach((s, i) => ys[i].push(s.last));
   if (xs.length > MAX_POINTS) {
     xs = xs.slice(-MAX_POINTS);
@@ -81,6 +91,7 @@ on('plot', async ({ id, property, label }) => {
   if (series.some((s) => s.id === id && s.property === property)) return;
   let last = null;
   try {
+    simTime = (await get('/api/info')).time ?? simTime;
     const info = await get('/api/instance', { id });
     last = numeric(info.properties.find((p) => p.name === property)?.value);
   } catch { /* plotted from its next change on */ }
@@ -92,6 +103,7 @@ on('plot', async ({ id, property, label }) => {
 });
 
 on('changes', (batch) => {
+  if (typeof batch.time === 'number') simTime = batch.time;
   if (!series.length) return;
   let touched = false;
   for (const set of batch.set || []) {
@@ -108,6 +120,14 @@ on('changes', (batch) => {
 on('tab', (name) => name === 'plots' && chart && chart.setSize({
   width: Math.max(pane.clientWidth - 20, 300), height: Math.max(pane.clientHeight - 80, 200) }));
 
+axisSelect.addEventListener('change', () => {
+  xs = [];
+  ys = ys.map(() => []);
+  rebuild();
+  if (series.length) push();
+});
+
 export function plotted() {
-  return series.map((s, i) => ({ id: s.id, property: s.property, points: ys[i].filter((v) => v !== null).length }));
+  return series.map((s, i) => ({ id: s.id, property: s.property, axis: axisSelect.value, x: xs.at(-1),
+                                 points: ys[i].filter((v) => v !== null).length }));
 }

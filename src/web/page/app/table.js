@@ -1,7 +1,8 @@
 // The per-class table (the paper's "table based manner"): the instances of a class and its subclasses
 // from /api/table, filtered by a `where` expression. Virtual scrolling: the scroller is as tall as all
 // rows, but only the rows in view (plus a margin) are fetched and in the DOM, so 100,000 instances
-// cost one request of ~60 rows per scroll stop.
+// cost one request of ~60 rows per scroll stop. The Columns chooser picks the property columns per class
+// (the server's default: the class's first twelve plain values).
 
 import { get } from './api.js';
 import { on, select, state, formatValue } from './bus.js';
@@ -19,7 +20,10 @@ const sizer = document.getElementById('table-sizer');
 const table = document.getElementById('table-rows');
 const headBox = document.getElementById('table-head');
 const header = document.getElementById('table-header');
+const columnsList = document.getElementById('table-columns-list');
 let columns = [];
+const chosen = new Map();   // class -> the property columns the user picked, in the class's order
+let choicesFor = null;      // the class the chooser lists
 
 let total = 0;
 let shown = { offset: -1, count: 0 }; // the window of rows in the DOM
@@ -46,6 +50,7 @@ export function fillClasses(classes) {
 }
 
 function restart() {
+  choicesFor = null;
   total = 0;
   shown = { offset: -1, count: 0 };
   scroller.scrollTop = 0;
@@ -67,8 +72,11 @@ async function fetchWindow(force = false) {
   if (!force && w.first >= shown.offset && w.first + w.count - 2 * MARGIN <= shown.offset + shown.count) return;
   const mine = ++request;
   try {
+    const picked = chosen.get(classSelect.value);
     const reply = await get('/api/table', {
       class: classSelect.value, offset: w.offset, limit: w.count, where: filter.value.trim(),
+      // `name` alone when none is picked: it is always shown, so no property column appears.
+      columns: picked ? (picked.length ? picked.join(',') : 'name') : undefined,
     });
     if (mine !== request) return; // the user scrolled on; a newer request will draw
     errorLabel.textContent = '';
@@ -85,7 +93,29 @@ async function fetchWindow(force = false) {
   }
 }
 
+// One checkbox per property of the class (name is always shown), ticked as the answer's columns are.
+function fillChoices(reply) {
+  if (choicesFor === reply.class) return;
+  choicesFor = reply.class;
+  const properties = (state.classes.get(reply.class)?.properties || []).filter((p) => p.name !== 'name');
+  columnsList.replaceChildren(...properties.map((p) => {
+    const label = document.createElement('label');
+    const box = document.createElement('input');
+    box.type = 'checkbox';
+    box.value = p.name;
+    box.checked = reply.columns.includes(p.name);
+    box.addEventListener('change', () => {
+      chosen.set(reply.class, [...columnsList.querySelectorAll('input:checked')].map((b) => b.value));
+      fetchWindow(true);
+    });
+    label.append(box, ` ${p.name}`);
+    label.title = p.type;
+    return label;
+  }));
+}
+
 function draw(reply) {
+  fillChoices(reply);
   const s = scale();
   shown = { offset: reply.offset, count: reply.rows.length };
   table.style.transform = `translateY(${reply.offset * ROW * s}px)`;
