@@ -274,6 +274,14 @@ bool sphere_in_box(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& lo
 
 }  // namespace
 
+void add_cell_modules(vsd::Environment& env, double collision_period) {
+  env.use<vsd::robotics::Module>();
+  env.use<vsd::physics::Module>();
+  env.use<vsd::collision::Module>(collision_period);
+  env.use<CellModule>();
+  env.use<vsd::soml::Module>();
+}
+
 CellReport run_cell(const CellOptions& o) {
   using vsd::scene::GeometryKind;
   if (o.parts < 1) throw vsd::Error("parts must be at least 1");
@@ -284,10 +292,8 @@ CellReport run_cell(const CellOptions& o) {
 
   vsd::Environment env;
   env.scheduler().set_base_step(o.step);
-  env.use<vsd::robotics::Module>();
-  env.use<vsd::physics::Module>();
+  add_cell_modules(env, o.step);
   auto& collision = env.use<vsd::collision::Module>(o.step);
-  env.use<CellModule>();
   auto& soml = env.use<vsd::soml::Module>();
   vsd::SimState& s = env.main_state();
 
@@ -465,7 +471,7 @@ CellReport run_cell(const CellOptions& o) {
         for (Robot* r : robots) {
           r->step = info.step;
           r->set_time(info.time);
-          if (!r->controller->done()) r->moving_time += dt;
+          if (!r->controller->done() && report.parts_handled < o.parts) r->moving_time += dt;  // until the last part
           if (!r->arrived() && info.step > r->commanded_in_step && r->controller->done()) {
             r->set_arrived(true);
             if (tl) *tl << "t=" << Orders::fmt(now) << " s  σ " << r->name() << " arrived\n";
@@ -578,7 +584,15 @@ CellReport run_cell(const CellOptions& o) {
   }
   report.min_arm_distance = std::numeric_limits<double>::infinity();
   double quiet_since = 0;
-  while (report.parts_handled < o.parts) {
+  // Until every part is handled, then until the robots are back at rest (their nets idle) — at most 20 s.
+  double drained_at = -1;
+  for (;;) {
+    if (report.parts_handled == o.parts) {
+      if (drained_at < 0) drained_at = env.time();
+      const bool still = robots[0]->controller->done() && robots[1]->controller->done() && robots[0]->arrived() &&
+                         robots[1]->arrived() && !mrc.enabled_any() && !meta.enabled_any();
+      if (still || env.time() - drained_at > 20.0) break;
+    }
     if (env.time() >= time_limit) {
       report.timed_out = true;
       break;
@@ -603,7 +617,7 @@ CellReport run_cell(const CellOptions& o) {
           << pb.z() << ',' << in_zone[0] << ',' << in_zone[1] << ',' << d << ',' << report.parts_handled << '\n';
     }
     // Deadlock: parts left, yet nothing moves and no transition is enabled, for 10 s.
-    const bool moving = !belt.empty() || !robots[0]->controller->done() || !robots[1]->controller->done() ||
+    const bool moving = report.parts_handled == o.parts || !belt.empty() || !robots[0]->controller->done() || !robots[1]->controller->done() ||
                         std::any_of(placed.begin(), placed.end(), [](Part* p) { return !p->resting() || p->stage() == on_destination; }) ||
                         spawned < o.parts;
     if (moving || mrc.enabled_any() || meta.enabled_any()) {
@@ -615,7 +629,7 @@ CellReport run_cell(const CellOptions& o) {
     }
   }
 
-  report.time = env.time();
+  report.time = drained_at >= 0 ? drained_at : env.time();
   report.steps = env.scheduler().steps();
   report.parts_per_hour = report.time > 0 ? report.parts_handled * 3600.0 / report.time : 0;
   for (int i = 0; i < 2; ++i) report.utilisation[i] = report.time > 0 ? robots[i]->moving_time / report.time : 0;

@@ -14,6 +14,10 @@
 #include <string>
 #include <vector>
 
+namespace vsd {
+class Environment;
+}
+
 namespace vsd_workcell {
 
 /// What run_cell() needs. The defaults are the demo's.
@@ -48,6 +52,10 @@ struct CellReport {
   std::string final_marking;  ///< Multi Robot Control's places
   bool timed_out = false;
 };
+
+/// Adds the modules the cell uses to @p env — robotics, physics, collision (with the given update period),
+/// the cell's own classes (Robot, Part, Orders, Conveyor, Station), SOML++ — so that its scripts check.
+void add_cell_modules(vsd::Environment& env, double collision_period = 0.01);
 
 /// Builds the cell and runs it. @throws vsd::Error on bad options, unreadable files or a plant fault.
 CellReport run_cell(const CellOptions& options);
