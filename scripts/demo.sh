@@ -36,13 +36,16 @@ if [[ "${1:-}" == "--tour" ]]; then
   exit
 fi
 # The work cells exist only when vsd::soml, ::robotics, ::physics and ::collision were all configured.
-if [[ "${1:-}" == "--one-robot" ]] && cmake --build "$BUILD_DIR" --target help | grep -q '\bvsd_workcell\b'; then
+# (The target list is read whole first: `grep -q` would stop reading early, and under pipefail the
+# writer's SIGPIPE would count as "not found".)
+targets="$(cmake --build "$BUILD_DIR" --target help)"
+if [[ "${1:-}" == "--one-robot" ]] && grep -q '\bvsd_workcell\b' <<<"$targets"; then
   shift
   cmake --build "$BUILD_DIR" --target vsd_workcell --parallel 2
   mkdir -p "$BUILD_DIR/examples/workcell"
   "$BUILD_DIR/examples/vsd_workcell" tests/scene/data/iiwa14.urdf examples/workcell/workcell.soml \
     "$BUILD_DIR/examples/workcell" "$@"
-elif cmake --build "$BUILD_DIR" --target help | grep -q '\bvsd_two_robot_cell\b'; then
+elif grep -q '\bvsd_two_robot_cell\b' <<<"$targets"; then
   [[ "${1:-}" == "--one-robot" ]] && shift
   cmake --build "$BUILD_DIR" --target vsd_two_robot_cell --parallel 2
   if [[ $# -eq 0 ]]; then set -- --parts 20; fi
