@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "eight_axis_urdf.hpp"
+#include "scene_kit.hpp"
 #include "vsd/collision.hpp"
 #include "vsd/physics.hpp"
 #include "vsd/robotics.hpp"
@@ -52,19 +53,8 @@ constexpr double outfeed_delay = 0.3;  // s a delivered part rests on its destin
 
 enum Stage : std::int64_t { on_belt = 0, at_sensor = 1, held = 2, on_station = 3, on_destination = 4, delivered = 5 };
 
-Eigen::Isometry3d at(double x, double y, double z) {
-  Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
-  f.translation() = Eigen::Vector3d(x, y, z);
-  return f;
-}
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw vsd::Error("cannot read " + path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using vsd_example::at;
+using vsd_example::read_text;
 
 // The run's random numbers (part kinds, arrival gaps): xorshift64*, so a seed gives the same run on every
 // standard library.
@@ -312,30 +302,7 @@ CellReport run_cell(const CellOptions& o) {
   outfeed.set_name("outfeed");
   s.database().add_child(outfeed);
 
-  auto geometry = [&](GeometryKind kind, Eigen::Vector3d size, double radius = 0) -> vsd::scene::Geometry& {
-    auto& g = s.create<vsd::scene::Geometry>();
-    g.set_kind(kind);
-    g.set_size(size);
-    g.set_radius(radius);
-    cell_node.edit_geometries().push_back(g);
-    return g;
-  };
-  auto& wood = s.create<vsd::scene::Material>();
-  wood.set_name("wood");
-  wood.set_friction(0.8);
-  wood.set_restitution(0.0);
-  wood.set_density(600);
-  cell_node.edit_materials().push_back(wood);
-  auto hull = [&](vsd::scene::Hull& h, std::string name, vsd::scene::Geometry& g, const Eigen::Isometry3d& f,
-                  vsd::Node& parent) -> vsd::scene::Hull& {
-    h.set_name(std::move(name));
-    h.set_role(vsd::scene::HullRole::Collision);
-    h.set_geometry(&g);
-    h.set_material(&wood);
-    h.set_frame(f);
-    parent.add_child(h);
-    return h;
-  };
+  vsd_example::SceneKit kit(s, cell_node);
   auto marker = [&](Node3D& n, std::string name, const Eigen::Vector2d& xy) -> Node3D& {
     n.set_name(std::move(name));
     n.set_frame(at(xy.x(), xy.y(), table_top));
@@ -344,7 +311,7 @@ CellReport run_cell(const CellOptions& o) {
   };
   // The surfaces: the conveyor's belt, the station, the two destinations (static hulls: no rigid body).
   auto surface = [&](std::string name, const Eigen::Vector2d& xy, Eigen::Vector2d size) {
-    hull(s.create<vsd::scene::Hull>(), std::move(name), geometry(GeometryKind::Box, {size.x(), size.y(), 0.04}),
+    kit.hull(s.create<vsd::scene::Hull>(), std::move(name), kit.geometry(GeometryKind::Box, {size.x(), size.y(), 0.04}),
          at(xy.x(), xy.y(), table_top - 0.02), room);
   };
   surface("belt", {pick_xy.x(), (belt_start + pick_xy.y()) / 2}, {0.16, pick_xy.y() - belt_start + 0.2});
@@ -373,8 +340,8 @@ CellReport run_cell(const CellOptions& o) {
   Robot* robots[2] = {nullptr, nullptr};
   std::vector<vsd::scene::Hull*> spheres[2];
   const char* arm_links[] = {"iiwa_link_4", "iiwa_link_6"};  // elbow and wrist; the pad stands for the hand
-  auto& pad_shape = geometry(GeometryKind::Box, {0.04, 0.04, 0.01});
-  auto& sphere_shape = geometry(GeometryKind::Sphere, {}, arm_sphere);
+  auto& pad_shape = kit.geometry(GeometryKind::Box, {0.04, 0.04, 0.01});
+  auto& sphere_shape = kit.geometry(GeometryKind::Sphere, {}, arm_sphere);
   for (int i = 0; i < 2; ++i) {
     const std::string tag = i == 0 ? "a" : "b";
     auto rep = vsd::scene::load_urdf_text(s.database(), *urdf, "arm_" + tag, ".", urdf_options);
@@ -402,7 +369,7 @@ CellReport run_cell(const CellOptions& o) {
     const Node3D& gate = i == 0 ? gate_a : gate_b;
     tree.set_positions(robot.solve(gate.world_frame().translation() + Eigen::Vector3d(0, 0, 0.12 + tool_length)));
     auto& pad = s.create<vsd::scene::Hull>();
-    hull(pad, "pad_" + tag, pad_shape, flange->world_frame() * at(0, 0, tool_length - 0.005), cell_node);
+    kit.hull(pad, "pad_" + tag, pad_shape, flange->world_frame() * at(0, 0, tool_length - 0.005), cell_node);
     view.relate(pad, *flange, vsd::scene::SpatialRelation::AttachedTo);
     robot.pad = &pad;
     spheres[i].push_back(&pad);
@@ -410,7 +377,7 @@ CellReport run_cell(const CellOptions& o) {
       Node3D* l = rep.scene->find_link(link);
       if (l == nullptr) throw vsd::Error(o.urdf + ": no link " + link);
       auto& sp = s.create<vsd::scene::Hull>();
-      hull(sp, std::string(link) + "_" + tag, sphere_shape, l->world_frame(), cell_node);
+      kit.hull(sp, std::string(link) + "_" + tag, sphere_shape, l->world_frame(), cell_node);
       view.relate(sp, *l, vsd::scene::SpatialRelation::AttachedTo);
       spheres[i].push_back(&sp);
     }
@@ -453,8 +420,8 @@ CellReport run_cell(const CellOptions& o) {
 
   // --- Parts: two kinds, arriving on the belt at random gaps.
   Random random(o.seed);
-  vsd::scene::Geometry* part_shape[2] = {&geometry(GeometryKind::Box, {0.04, 0.04, 0.04}),
-                                         &geometry(GeometryKind::Box, {0.06, 0.06, 0.06})};
+  vsd::scene::Geometry* part_shape[2] = {&kit.geometry(GeometryKind::Box, {0.04, 0.04, 0.04}),
+                                         &kit.geometry(GeometryKind::Box, {0.06, 0.06, 0.06})};
   std::vector<Part*> belt;    // on the belt, front first (no rigid body: the belt carries them)
   std::vector<Part*> placed;  // with a rigid body, somewhere in the room
   int spawned = 0;
@@ -486,7 +453,7 @@ CellReport run_cell(const CellOptions& o) {
           p.set_kind(kind);
           p.set_height(kind == 1 ? 0.04 : 0.06);
           p.belt_y = belt_start;
-          hull(p, "part" + std::to_string(++spawned), *part_shape[kind - 1],
+          kit.hull(p, "part" + std::to_string(++spawned), *part_shape[kind - 1],
                at(pick_xy.x(), belt_start, table_top + p.height() / 2), room);
           belt.push_back(&p);
           next_arrival = info.time + 2.0 + 4.0 * random.uniform();
@@ -565,12 +532,23 @@ CellReport run_cell(const CellOptions& o) {
   vsd::soml::Program& meta = soml.load(s, o.meta_script, read_text(o.meta_script), run);
   for (vsd::soml::Program* p : {&mrc, &meta}) {
     if (tl == nullptr) continue;
-    p->on_firing([tl, &now](const vsd::soml::Firing& f) {
-      *tl << "t=" << Orders::fmt(now) << " s  token: " << f.transition->path();
-      for (const auto& m : f.taken) *tl << (&m == &f.taken.front() ? "  " : ", ") << m.place->path() << " -" << m.count;
-      for (const auto& m : f.given) *tl << ", " << m.place->path() << " +" << m.count;
+    // "token: multi_robot_control a.fetch: a.idle -1, a.approaching +1": net, transition, black tokens moved
+    // (places named from the script object down), and where an object token went.
+    const std::string root = p->root().path() + "/";
+    auto local = [root](const vsd::Node& n) {
+      std::string id = n.path();
+      if (id.rfind(root, 0) == 0) id.erase(0, root.size());
+      std::replace(id.begin(), id.end(), '/', '.');
+      return id;
+    };
+    p->on_firing([tl, &now, local, net = p->root().name()](const vsd::soml::Firing& f) {
+      *tl << "t=" << Orders::fmt(now) << " s  token: " << net << ' ' << local(*f.transition);
+      const char* sep = ": ";
+      for (const auto& m : f.taken) *tl << std::exchange(sep, ", ") << local(*m.place) << " -" << m.count;
+      for (const auto& m : f.given) *tl << std::exchange(sep, ", ") << local(*m.place) << " +" << m.count;
       if (f.from != nullptr || f.to != nullptr)
-        *tl << "  job " << (f.from ? f.from->name() : std::string("-")) << " -> " << (f.to ? f.to->name() : std::string("-"));
+        *tl << std::exchange(sep, ", ") << "job " << (f.from ? local(*f.from) : std::string("(new)")) << " -> "
+            << (f.to ? local(*f.to) : std::string("(out)"));
       *tl << '\n';
     });
   }
@@ -584,6 +562,7 @@ CellReport run_cell(const CellOptions& o) {
   }
   report.min_arm_distance = std::numeric_limits<double>::infinity();
   double quiet_since = 0;
+  std::map<Part*, double> belt_y_before;  // to tell a moving belt from a full, stopped one
   // Until every part is handled, then until the robots are back at rest (their nets idle) — at most 20 s.
   double drained_at = -1;
   for (;;) {
@@ -597,6 +576,8 @@ CellReport run_cell(const CellOptions& o) {
       report.timed_out = true;
       break;
     }
+    belt_y_before.clear();
+    for (Part* p : belt) belt_y_before[p] = p->belt_y;
     env.step();
     bool in_zone[2] = {false, false};
     for (int i = 0; i < 2; ++i)
@@ -617,9 +598,11 @@ CellReport run_cell(const CellOptions& o) {
           << pb.z() << ',' << in_zone[0] << ',' << in_zone[1] << ',' << d << ',' << report.parts_handled << '\n';
     }
     // Deadlock: parts left, yet nothing moves and no transition is enabled, for 10 s.
-    const bool moving = report.parts_handled == o.parts || !belt.empty() || !robots[0]->controller->done() || !robots[1]->controller->done() ||
-                        std::any_of(placed.begin(), placed.end(), [](Part* p) { return !p->resting() || p->stage() == on_destination; }) ||
-                        spawned < o.parts;
+    const bool belt_moves = std::any_of(belt.begin(), belt.end(), [&](Part* p) { return p->belt_y != belt_y_before[p]; });
+    const bool more_to_come = spawned < o.parts && (belt.empty() || belt.back()->belt_y > belt_start + belt_gap);
+    const bool moving = report.parts_handled == o.parts || belt_moves || more_to_come ||
+                        !robots[0]->controller->done() || !robots[1]->controller->done() ||
+                        std::any_of(placed.begin(), placed.end(), [](Part* p) { return !p->resting() || p->stage() == on_destination; });
     if (moving || mrc.enabled_any() || meta.enabled_any()) {
       quiet_since = env.time();
     } else if (env.time() - quiet_since > 10.0) {

@@ -116,6 +116,23 @@ TEST(MultiRobotControlAbstraction, FindsTheViolationWhenBIgnoresTheZone) {
   EXPECT_TRUE(std::any_of(all.begin(), all.end(), [&](const Marking& m) { return tokens(m, a) + tokens(m, b) == 2; }));
 }
 
+TEST(MultiRobotControlAbstraction, FindsTheDeadlockWhenAKeepsTheZone) {
+  // A's exit without giving zone.free back: the explorer must find a dead marking.
+  std::string text = read(robot_script);
+  const std::string give = "  arrow exit ~> zone.free;\n  arrow exit -> idle;\n";
+  const auto at = text.find(give);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, give.size(), "  arrow exit -> idle;\n");
+  const auto path = std::filesystem::temp_directory_path() / "vsd_mrc_keeps_zone_abstraction.soml";
+  std::ofstream(path) << text;
+  const PtNet net = vsd_workcell::pt_abstraction(path.string());
+  std::filesystem::remove(path);
+  const auto r = vsd::analysis::explore(net);
+  ASSERT_TRUE(r.complete());
+  EXPECT_TRUE(r.deadlock);
+  EXPECT_EQ(r.dead_marking[*net.find_place("zone.free")], 0u);
+}
+
 TEST(MultiRobotControlAbstraction, RefusesObjectTokensWithTheirPosition) {
   // Meta Control moves Job objects: not a place/transition net.
   try {

@@ -81,8 +81,8 @@ TEST(TwoRobotCell, TimelineShowsEventsCommandsTokensAndParts) {
   EXPECT_NE(t.find("σ part1 rests on the conveyor's sensor"), std::string::npos);
   EXPECT_NE(t.find("γ orders.post(part1"), std::string::npos);
   EXPECT_NE(t.find("γ robot_a.grasp(part1)"), std::string::npos);
-  EXPECT_NE(t.find("token: /multi_robot_control/a/fetch"), std::string::npos);
-  EXPECT_NE(t.find("token: /multi_robot_control/b/enter"), std::string::npos);
+  EXPECT_NE(t.find("token: multi_robot_control a.fetch: a.idle -1, a.approaching +1"), std::string::npos);
+  EXPECT_NE(t.find("token: multi_robot_control b.enter: b.idle -1, station.full -1, zone.free -1, b.zone_approaching +1"), std::string::npos);
   EXPECT_NE(t.find("part handled: part4 (4 of 4)"), std::string::npos);
   std::ostringstream summary;
   vsd_workcell::print_summary(summary, r);
@@ -105,6 +105,29 @@ TEST(TwoRobotCell, WritesOneCsvRowPerStep) {
   while (std::getline(in, row)) ++rows;
   EXPECT_EQ(rows, r.steps);
   std::filesystem::remove(path);
+}
+
+TEST(TwoRobotCell, ReportsADeadlockAndStops) {
+  // A Multi Robot Control that never gives the zone back after A's first hand-over: B cannot take the
+  // part, A cannot bring the next one. The run must say so and stop, not run into its time limit.
+  std::ifstream in(VSD_CELL_ROBOTS);
+  std::ostringstream text;
+  text << in.rdbuf();
+  std::string script = text.str();
+  const std::string give = "  arrow exit ~> zone.free;\n  arrow exit -> idle;\n";
+  const auto at = script.find(give);
+  ASSERT_NE(at, std::string::npos);
+  script.replace(at, give.size(), "  arrow exit -> idle;\n");
+  const auto path = std::filesystem::temp_directory_path() / "vsd_mrc_keeps_zone.soml";
+  std::ofstream(path) << script;
+  CellOptions o = options(1, 6);
+  o.robot_script = path.string();
+  const CellReport r = vsd_workcell::run_cell(o);
+  std::filesystem::remove(path);
+  EXPECT_EQ(r.deadlocks, 1);
+  EXPECT_LT(r.parts_handled, 6);
+  EXPECT_FALSE(r.timed_out);
+  EXPECT_EQ(r.zone_violations, 0);
 }
 
 TEST(TwoRobotCell, BadOptionsAreClearErrors) {
