@@ -134,6 +134,13 @@ class Station : public Node3D {
   VSD_PROPERTY(vsd::SharedRef<vsd::Node>, part, nullptr)  // σ
 };
 
+/// The shared zone's presence sensor: which arms are in it, from their geometry (every step).
+class ZoneSensor : public Node3D {
+  VSD_INSTANCE(ZoneSensor, Node3D)
+  VSD_PROPERTY(bool, occupied, false)  // σ: some arm is in the zone
+  VSD_PROPERTY(std::string, by, "")    // "robot_a", "robot_b", "robot_a and robot_b" or ""
+};
+
 /// A robot's interface to the nets: σ properties, γ methods (as the one-robot cell's Robot, with joint
 /// space motions: a Cartesian goal is solved by IK once and cached, the controller plans a trapezoidal
 /// joint trajectory to it, rail included).
@@ -252,6 +259,7 @@ class CellModule : public vsd::Module {
     r.add<Orders>();
     r.add<Conveyor>();
     r.add<Station>();
+    r.add<ZoneSensor>();
     r.add<Robot>();
   }
 };
@@ -320,6 +328,7 @@ CellReport run_cell(const CellOptions& o) {
   surface("dest_b table", dest_b_xy, {0.2, 0.2});
   auto& conveyor = static_cast<Conveyor&>(marker(s.create<Conveyor>(), "conveyor", pick_xy));
   auto& station = static_cast<Station&>(marker(s.create<Station>(), "station", station_xy));
+  auto& zone = static_cast<ZoneSensor&>(marker(s.create<ZoneSensor>(), "zone", station_xy));
   Node3D& dest_a = marker(s.create<Node3D>(), "dest_a", dest_a_xy);
   Node3D& dest_b = marker(s.create<Node3D>(), "dest_b", dest_b_xy);
   Node3D& gate_a = marker(s.create<Node3D>(), "gate_a", gate_a_xy);
@@ -425,6 +434,7 @@ CellReport run_cell(const CellOptions& o) {
   std::vector<Part*> belt;    // on the belt, front first (no rigid body: the belt carries them)
   std::vector<Part*> placed;  // with a rigid body, somewhere in the room
   int spawned = 0;
+  bool in_zone[2] = {false, false};  // this step's zone sensor
   double next_arrival = 0.5;
   CellReport report;
 
@@ -444,6 +454,21 @@ CellReport run_cell(const CellOptions& o) {
             if (tl) *tl << "t=" << Orders::fmt(now) << " s  σ " << r->name() << " arrived\n";
           }
           if (!r->controller->fault().empty()) throw vsd::Error(r->name() + " controller: " + r->controller->fault());
+        }
+        // The zone: an arm is in it when one of its spheres touches the zone's box. Both at once is a
+        // violation, counted from this geometry, whatever the nets' markings say.
+        for (int i = 0; i < 2; ++i) {
+          in_zone[i] = false;
+          for (const vsd::scene::Hull* h : spheres[i])
+            in_zone[i] = in_zone[i] || sphere_in_box(h->world_frame().translation(), arm_sphere, zone_min, zone_max);
+        }
+        const std::string by = in_zone[0] && in_zone[1] ? "robot_a and robot_b" : in_zone[0] ? "robot_a" : in_zone[1] ? "robot_b" : "";
+        if (by != zone.by() && tl) *tl << "t=" << Orders::fmt(now) << " s  σ zone occupied by " << (by.empty() ? "nobody" : by) << '\n';
+        zone.set_by(by);
+        zone.set_occupied(!by.empty());
+        if (in_zone[0] && in_zone[1]) {
+          ++report.zone_violations;
+          if (tl) *tl << "t=" << Orders::fmt(now) << " s  ZONE VIOLATION: both arms in the shared zone\n";
         }
         // The belt: a new part at the start when its gap has passed (and there is room).
         if (spawned < o.parts && info.time >= next_arrival &&
@@ -579,14 +604,6 @@ CellReport run_cell(const CellOptions& o) {
     belt_y_before.clear();
     for (Part* p : belt) belt_y_before[p] = p->belt_y;
     env.step();
-    bool in_zone[2] = {false, false};
-    for (int i = 0; i < 2; ++i)
-      for (const vsd::scene::Hull* h : spheres[i])
-        in_zone[i] = in_zone[i] || sphere_in_box(h->world_frame().translation(), arm_sphere, zone_min, zone_max);
-    if (in_zone[0] && in_zone[1]) {
-      ++report.zone_violations;
-      if (tl) *tl << "t=" << Orders::fmt(now) << " s  ZONE VIOLATION: both arms in the shared zone\n";
-    }
     double d = std::numeric_limits<double>::infinity();
     for (const auto* ha : spheres[0])
       for (const auto* hb : spheres[1]) d = std::min(d, contacts.distance(*ha, *hb).distance);

@@ -80,6 +80,9 @@ TEST(TwoRobotCell, TimelineShowsEventsCommandsTokensAndParts) {
   EXPECT_NE(t.find("reach of robot_b: conveyor no, station yes, dest_a no, dest_b yes"), std::string::npos);
   EXPECT_NE(t.find("σ part1 rests on the conveyor's sensor"), std::string::npos);
   EXPECT_NE(t.find("γ orders.post(part1"), std::string::npos);
+  EXPECT_NE(t.find("σ zone occupied by robot_a\n"), std::string::npos);
+  EXPECT_NE(t.find("σ zone occupied by robot_b\n"), std::string::npos);
+  EXPECT_EQ(t.find("ZONE VIOLATION"), std::string::npos);
   EXPECT_NE(t.find("γ robot_a.grasp(part1)"), std::string::npos);
   EXPECT_NE(t.find("token: multi_robot_control a.fetch: a.idle -1, a.approaching +1"), std::string::npos);
   EXPECT_NE(t.find("token: multi_robot_control b.enter: b.idle -1, station.full -1, zone.free -1, b.zone_approaching +1"), std::string::npos);
