@@ -17,7 +17,8 @@ inline std::optional<std::string> eight_axis_urdf(std::string xml, const std::st
   if (at == std::string::npos) return std::nullopt;
   xml.replace(at, fixed.size(),
               R"(<joint name="world_iiwa_joint" type="prismatic">
-    <axis xyz=")" + axis + R"("/><limit lower=")" + std::to_string(lower) + R"(" upper=")" +
+    <axis xyz=")" +
+                  axis + R"("/><limit lower=")" + std::to_string(lower) + R"(" upper=")" +
                   std::to_string(upper) + R"(" effort="1000" velocity="1"/>)");
   return xml;
 }

@@ -32,7 +32,8 @@ inline std::string read_text(const std::string& path) {
 /// friction 0.8, no bounce, 600 kg/m³).
 class SceneKit {
  public:
-  SceneKit(vsd::SimState& s, vsd::scene::Scene& cell) : s_(s), cell_(cell), wood_(s.create<vsd::scene::Material>()) {
+  SceneKit(vsd::SimState& s, vsd::scene::Scene& cell)
+      : s_(s), cell_(cell), wood_(s.create<vsd::scene::Material>()) {
     wood_.set_name("wood");
     wood_.set_friction(0.8);
     wood_.set_restitution(0.0);
@@ -40,7 +41,8 @@ class SceneKit {
     cell_.edit_materials().push_back(wood_);
   }
   /// A geometry of @p kind (@p size for boxes, @p radius for spheres).
-  vsd::scene::Geometry& geometry(vsd::scene::GeometryKind kind, const Eigen::Vector3d& size, double radius = 0) {
+  vsd::scene::Geometry& geometry(vsd::scene::GeometryKind kind, const Eigen::Vector3d& size,
+                                 double radius = 0) {
     auto& g = s_.create<vsd::scene::Geometry>();
     g.set_kind(kind);
     g.set_size(size);

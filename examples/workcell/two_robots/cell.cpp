@@ -43,15 +43,22 @@ const Eigen::Vector2d gate_b_xy{0.42, 0.0};
 // The shared zone: a column over the station, from the floor up.
 const Eigen::Vector3d zone_min{-0.15, -0.30, 0.0};
 const Eigen::Vector3d zone_max{0.15, 0.30, 2.0};
-constexpr double arm_sphere = 0.06;  // radius of the spheres that stand for each arm
-constexpr double belt_start = -1.60;  // y where parts come onto the belt (x = pick x)
-constexpr double belt_speed = 0.25;   // m/s
-constexpr double belt_gap = 0.10;     // m between queued parts' centres
-constexpr double rest_speed = 0.005;  // m/s: slower than this ...
-constexpr double rest_time = 0.2;     // ... for this long is "at rest"
+constexpr double arm_sphere = 0.06;    // radius of the spheres that stand for each arm
+constexpr double belt_start = -1.60;   // y where parts come onto the belt (x = pick x)
+constexpr double belt_speed = 0.25;    // m/s
+constexpr double belt_gap = 0.10;      // m between queued parts' centres
+constexpr double rest_speed = 0.005;   // m/s: slower than this ...
+constexpr double rest_time = 0.2;      // ... for this long is "at rest"
 constexpr double outfeed_delay = 0.3;  // s a delivered part rests on its destination before it goes
 
-enum Stage : std::int64_t { on_belt = 0, at_sensor = 1, held = 2, on_station = 3, on_destination = 4, delivered = 5 };
+enum Stage : std::int64_t {
+  on_belt = 0,
+  at_sensor = 1,
+  held = 2,
+  on_station = 3,
+  on_destination = 4,
+  delivered = 5
+};
 
 using vsd_example::at;
 using vsd_example::read_text;
@@ -76,13 +83,13 @@ class Part : public vsd::scene::Hull {
   VSD_INSTANCE(Part, vsd::scene::Hull)
   VSD_PROPERTY(std::int64_t, kind, 1)  // 1: small (direct to dest_a), 2: large (hand-over to dest_b)
   VSD_PROPERTY(double, height, 0.05)
-  VSD_PROPERTY(bool, resting, false)   // σ: lies still
+  VSD_PROPERTY(bool, resting, false)    // σ: lies still
   VSD_PROPERTY(std::int64_t, stage, 0)  // σ: see Stage
 
  public:
-  double belt_y = 0;        // while on the belt
-  double slow_for = 0;      // s below rest_speed
-  double resting_for = 0;   // s resting on a destination
+  double belt_y = 0;       // while on the belt
+  double slow_for = 0;     // s below rest_speed
+  double resting_for = 0;  // s resting on a destination
 };
 
 /// The order board between Meta Control (posts) and Multi Robot Control (takes).
@@ -118,8 +125,8 @@ class Orders : public vsd::Node {
 /// The conveyor's end: its frame is the pick position; its sensor reports the part lying there.
 class Conveyor : public Node3D {
   VSD_INSTANCE(Conveyor, Node3D)
-  VSD_PROPERTY(std::int64_t, arrivals, 0)                     // σ: parts that came to rest at the sensor
-  VSD_PROPERTY(vsd::SharedRef<vsd::Node>, last, nullptr)      // the last of them
+  VSD_PROPERTY(std::int64_t, arrivals, 0)                      // σ: parts that came to rest at the sensor
+  VSD_PROPERTY(vsd::SharedRef<vsd::Node>, last, nullptr)       // the last of them
   VSD_PROPERTY(vsd::SharedRef<vsd::Node>, at_sensor, nullptr)  // σ: the part lying at the sensor now
   VSD_PROPERTY(double, time, 0.0)
 
@@ -209,7 +216,8 @@ class Robot : public vsd::Node {
   /// The joints that put the flange at @p flange_at (world) pointing down, from the posture seed.
   std::vector<double> solve(const Eigen::Vector3d& flange_at) {
     const Eigen::Vector3d p = base->world_frame().inverse() * flange_at;
-    const std::array<long, 3> key{std::lround(p.x() * 1e6), std::lround(p.y() * 1e6), std::lround(p.z() * 1e6)};
+    const std::array<long, 3> key{std::lround(p.x() * 1e6), std::lround(p.y() * 1e6),
+                                  std::lround(p.z() * 1e6)};
     if (auto it = solutions.find(key); it != solutions.end()) return it->second;
     Eigen::Isometry3d goal = Eigen::Isometry3d::Identity();
     goal.translation() = p;
@@ -319,8 +327,9 @@ CellReport run_cell(const CellOptions& o) {
   };
   // The surfaces: the conveyor's belt, the station, the two destinations (static hulls: no rigid body).
   auto surface = [&](std::string name, const Eigen::Vector2d& xy, Eigen::Vector2d size) {
-    kit.hull(s.create<vsd::scene::Hull>(), std::move(name), kit.geometry(GeometryKind::Box, {size.x(), size.y(), 0.04}),
-         at(xy.x(), xy.y(), table_top - 0.02), room);
+    kit.hull(s.create<vsd::scene::Hull>(), std::move(name),
+             kit.geometry(GeometryKind::Box, {size.x(), size.y(), 0.04}),
+             at(xy.x(), xy.y(), table_top - 0.02), room);
   };
   surface("belt", {pick_xy.x(), (belt_start + pick_xy.y()) / 2}, {0.16, pick_xy.y() - belt_start + 0.2});
   surface("station table", station_xy, {0.16, 0.16});
@@ -376,7 +385,8 @@ CellReport run_cell(const CellOptions& o) {
     robot.log = tl;
     // Start at the gate, above the work height.
     const Node3D& gate = i == 0 ? gate_a : gate_b;
-    tree.set_positions(robot.solve(gate.world_frame().translation() + Eigen::Vector3d(0, 0, 0.12 + tool_length)));
+    tree.set_positions(
+        robot.solve(gate.world_frame().translation() + Eigen::Vector3d(0, 0, 0.12 + tool_length)));
     auto& pad = s.create<vsd::scene::Hull>();
     kit.hull(pad, "pad_" + tag, pad_shape, flange->world_frame() * at(0, 0, tool_length - 0.005), cell_node);
     view.relate(pad, *flange, vsd::scene::SpatialRelation::AttachedTo);
@@ -397,7 +407,8 @@ CellReport run_cell(const CellOptions& o) {
     std::string line;
     const Node3D* points[] = {&conveyor, &station, &dest_a, &dest_b};
     for (const Node3D* n : points) {
-      const bool r = robots[i]->reaches(n->world_frame().translation() + Eigen::Vector3d(0, 0, 0.1 + tool_length));
+      const bool r =
+          robots[i]->reaches(n->world_frame().translation() + Eigen::Vector3d(0, 0, 0.1 + tool_length));
       line += (line.empty() ? "" : ", ") + n->name() + (r ? " yes" : " no");
     }
     if (tl) *tl << "reach of " << robots[i]->name() << ": " << line << '\n';
@@ -417,7 +428,9 @@ CellReport run_cell(const CellOptions& o) {
     vsd::scene::Hull& pad = is_pad(a) ? a : b;
     vsd::scene::Hull& part = is_pad(a) ? b : a;
     Robot* r = robot_of(pad);
-    if (tl) *tl << "t=" << Orders::fmt(now) << " s  σ collision: " << r->name() << "'s pad touches " << part.name() << '\n';
+    if (tl)
+      *tl << "t=" << Orders::fmt(now) << " s  σ collision: " << r->name() << "'s pad touches " << part.name()
+          << '\n';
     r->set_touched(vsd::SharedRef<vsd::Node>(&part));
   });
   auto c_end = contacts.on_contact_end().connect([&](vsd::scene::Hull& a, vsd::scene::Hull& b) {
@@ -448,22 +461,30 @@ CellReport run_cell(const CellOptions& o) {
         for (Robot* r : robots) {
           r->step = info.step;
           r->set_time(info.time);
-          if (!r->controller->done() && report.parts_handled < o.parts) r->moving_time += dt;  // until the last part
+          if (!r->controller->done() && report.parts_handled < o.parts)
+            r->moving_time += dt;  // until the last part
           if (!r->arrived() && info.step > r->commanded_in_step && r->controller->done()) {
             r->set_arrived(true);
             if (tl) *tl << "t=" << Orders::fmt(now) << " s  σ " << r->name() << " arrived\n";
           }
-          if (!r->controller->fault().empty()) throw vsd::Error(r->name() + " controller: " + r->controller->fault());
+          if (!r->controller->fault().empty())
+            throw vsd::Error(r->name() + " controller: " + r->controller->fault());
         }
         // The zone: an arm is in it when one of its spheres touches the zone's box. Both at once is a
         // violation, counted from this geometry, whatever the nets' markings say.
         for (int i = 0; i < 2; ++i) {
           in_zone[i] = false;
           for (const vsd::scene::Hull* h : spheres[i])
-            in_zone[i] = in_zone[i] || sphere_in_box(h->world_frame().translation(), arm_sphere, zone_min, zone_max);
+            in_zone[i] =
+                in_zone[i] || sphere_in_box(h->world_frame().translation(), arm_sphere, zone_min, zone_max);
         }
-        const std::string by = in_zone[0] && in_zone[1] ? "robot_a and robot_b" : in_zone[0] ? "robot_a" : in_zone[1] ? "robot_b" : "";
-        if (by != zone.by() && tl) *tl << "t=" << Orders::fmt(now) << " s  σ zone occupied by " << (by.empty() ? "nobody" : by) << '\n';
+        const std::string by = in_zone[0] && in_zone[1] ? "robot_a and robot_b"
+                               : in_zone[0]             ? "robot_a"
+                               : in_zone[1]             ? "robot_b"
+                                                        : "";
+        if (by != zone.by() && tl)
+          *tl << "t=" << Orders::fmt(now) << " s  σ zone occupied by " << (by.empty() ? "nobody" : by)
+              << '\n';
         zone.set_by(by);
         zone.set_occupied(!by.empty());
         if (in_zone[0] && in_zone[1]) {
@@ -479,15 +500,19 @@ CellReport run_cell(const CellOptions& o) {
           p.set_height(kind == 1 ? 0.04 : 0.06);
           p.belt_y = belt_start;
           kit.hull(p, "part" + std::to_string(++spawned), *part_shape[kind - 1],
-               at(pick_xy.x(), belt_start, table_top + p.height() / 2), room);
+                   at(pick_xy.x(), belt_start, table_top + p.height() / 2), room);
           belt.push_back(&p);
           next_arrival = info.time + 2.0 + 4.0 * random.uniform();
-          if (tl) *tl << "t=" << Orders::fmt(now) << " s  conveyor: " << p.name() << " (kind " << kind << ") comes in\n";
+          if (tl)
+            *tl << "t=" << Orders::fmt(now) << " s  conveyor: " << p.name() << " (kind " << kind
+                << ") comes in\n";
         }
-        const bool spot_free = !conveyor.at_sensor() &&
-                               std::none_of(placed.begin(), placed.end(), [&](Part* p) { return p->stage() == on_belt; });
+        const bool spot_free =
+            !conveyor.at_sensor() &&
+            std::none_of(placed.begin(), placed.end(), [&](Part* p) { return p->stage() == on_belt; });
         for (std::size_t k = 0; k < belt.size(); ++k) {
-          const double limit = k == 0 ? (spot_free ? pick_xy.y() : pick_xy.y() - belt_gap) : belt[k - 1]->belt_y - belt_gap;
+          const double limit =
+              k == 0 ? (spot_free ? pick_xy.y() : pick_xy.y() - belt_gap) : belt[k - 1]->belt_y - belt_gap;
           belt[k]->belt_y = std::min(limit, belt[k]->belt_y + belt_speed * dt);
           belt[k]->set_frame(at(pick_xy.x(), belt[k]->belt_y, table_top + belt[k]->height() / 2));
         }
@@ -501,13 +526,15 @@ CellReport run_cell(const CellOptions& o) {
         // those in the room that neither the belt carries nor a robot holds.
         placed.clear();
         for (std::size_t k = 0; k < room.children().size(); ++k)
-          if (auto* p = dynamic_cast<Part*>(room.children()[k]); p && p->find_extension<vsd::physics::RigidBody>())
+          if (auto* p = dynamic_cast<Part*>(room.children()[k]);
+              p && p->find_extension<vsd::physics::RigidBody>())
             placed.push_back(p);
         for (Part* p : placed) {
           const auto* body = p->find_extension<vsd::physics::RigidBody>();
           const Eigen::Vector3d x = p->world_frame().translation();
           if (x.z() < table_top - 0.05) throw vsd::Error(p->name() + " fell off at t=" + Orders::fmt(now));
-          const bool slow = body->linear_velocity().norm() < rest_speed && body->angular_velocity().norm() < rest_speed / 0.02;
+          const bool slow = body->linear_velocity().norm() < rest_speed &&
+                            body->angular_velocity().norm() < rest_speed / 0.02;
           p->slow_for = slow ? p->slow_for + dt : 0;
           const bool rest = p->slow_for >= rest_time;
           if (rest && !p->resting()) {
@@ -542,7 +569,9 @@ CellReport run_cell(const CellOptions& o) {
             outfeed.add_child(*p);
             p->set_stage(delivered);
             ++report.parts_handled;
-            if (tl) *tl << "t=" << Orders::fmt(now) << " s  part handled: " << p->name() << " (" << report.parts_handled << " of " << o.parts << ")\n";
+            if (tl)
+              *tl << "t=" << Orders::fmt(now) << " s  part handled: " << p->name() << " ("
+                  << report.parts_handled << " of " << o.parts << ")\n";
           }
         }
       },
@@ -572,8 +601,8 @@ CellReport run_cell(const CellOptions& o) {
       for (const auto& m : f.taken) *tl << std::exchange(sep, ", ") << local(*m.place) << " -" << m.count;
       for (const auto& m : f.given) *tl << std::exchange(sep, ", ") << local(*m.place) << " +" << m.count;
       if (f.from != nullptr || f.to != nullptr)
-        *tl << std::exchange(sep, ", ") << "job " << (f.from ? local(*f.from) : std::string("(new)")) << " -> "
-            << (f.to ? local(*f.to) : std::string("(out)"));
+        *tl << std::exchange(sep, ", ") << "job " << (f.from ? local(*f.from) : std::string("(new)"))
+            << " -> " << (f.to ? local(*f.to) : std::string("(out)"));
       *tl << '\n';
     });
   }
@@ -593,8 +622,9 @@ CellReport run_cell(const CellOptions& o) {
   for (;;) {
     if (report.parts_handled == o.parts) {
       if (drained_at < 0) drained_at = env.time();
-      const bool still = robots[0]->controller->done() && robots[1]->controller->done() && robots[0]->arrived() &&
-                         robots[1]->arrived() && !mrc.enabled_any() && !meta.enabled_any();
+      const bool still = robots[0]->controller->done() && robots[1]->controller->done() &&
+                         robots[0]->arrived() && robots[1]->arrived() && !mrc.enabled_any() &&
+                         !meta.enabled_any();
       if (still || env.time() - drained_at > 20.0) break;
     }
     if (env.time() >= time_limit) {
@@ -611,15 +641,19 @@ CellReport run_cell(const CellOptions& o) {
     if (csv.is_open()) {
       const Eigen::Vector3d pa = robots[0]->pad->world_frame().translation();
       const Eigen::Vector3d pb = robots[1]->pad->world_frame().translation();
-      csv << env.time() << ',' << pa.x() << ',' << pa.y() << ',' << pa.z() << ',' << pb.x() << ',' << pb.y() << ','
-          << pb.z() << ',' << in_zone[0] << ',' << in_zone[1] << ',' << d << ',' << report.parts_handled << '\n';
+      csv << env.time() << ',' << pa.x() << ',' << pa.y() << ',' << pa.z() << ',' << pb.x() << ',' << pb.y()
+          << ',' << pb.z() << ',' << in_zone[0] << ',' << in_zone[1] << ',' << d << ','
+          << report.parts_handled << '\n';
     }
     // Deadlock: parts left, yet nothing moves and no transition is enabled, for 10 s.
-    const bool belt_moves = std::any_of(belt.begin(), belt.end(), [&](Part* p) { return p->belt_y != belt_y_before[p]; });
-    const bool more_to_come = spawned < o.parts && (belt.empty() || belt.back()->belt_y > belt_start + belt_gap);
+    const bool belt_moves =
+        std::any_of(belt.begin(), belt.end(), [&](Part* p) { return p->belt_y != belt_y_before[p]; });
+    const bool more_to_come =
+        spawned < o.parts && (belt.empty() || belt.back()->belt_y > belt_start + belt_gap);
     const bool moving = report.parts_handled == o.parts || belt_moves || more_to_come ||
                         !robots[0]->controller->done() || !robots[1]->controller->done() ||
-                        std::any_of(placed.begin(), placed.end(), [](Part* p) { return !p->resting() || p->stage() == on_destination; });
+                        std::any_of(placed.begin(), placed.end(),
+                                    [](Part* p) { return !p->resting() || p->stage() == on_destination; });
     if (moving || mrc.enabled_any() || meta.enabled_any()) {
       quiet_since = env.time();
     } else if (env.time() - quiet_since > 10.0) {
@@ -632,7 +666,8 @@ CellReport run_cell(const CellOptions& o) {
   report.time = drained_at >= 0 ? drained_at : env.time();
   report.steps = env.scheduler().steps();
   report.parts_per_hour = report.time > 0 ? report.parts_handled * 3600.0 / report.time : 0;
-  for (int i = 0; i < 2; ++i) report.utilisation[i] = report.time > 0 ? robots[i]->moving_time / report.time : 0;
+  for (int i = 0; i < 2; ++i)
+    report.utilisation[i] = report.time > 0 ? robots[i]->moving_time / report.time : 0;
   report.firings = mrc.firings() + meta.firings();
   report.condition_tests = mrc.condition_tests() + meta.condition_tests();
   for (vsd::soml::Program* p : {&mrc, &meta})
@@ -642,7 +677,8 @@ CellReport run_cell(const CellOptions& o) {
     vsd::Node* n = mrc.object(obj);
     n->visit([&](vsd::Node& c) {
       if (auto* pl = dynamic_cast<vsd::soml::Place*>(&c); pl != nullptr && pl->count() > 0)
-        marking += (marking.empty() ? "" : ", ") + std::string(obj) + "." + pl->name() + " " + std::to_string(pl->count());
+        marking += (marking.empty() ? "" : ", ") + std::string(obj) + "." + pl->name() + " " +
+                   std::to_string(pl->count());
     });
   }
   report.final_marking = marking;
@@ -710,16 +746,26 @@ void parse_options(const std::vector<std::string>& args, CellOptions& o) {
   };
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a == "--seed") o.seed = static_cast<std::uint64_t>(whole(i, 0, 1e15));
-    else if (a == "--parts") o.parts = static_cast<int>(whole(i, 1, 1e6));
-    else if (a == "--step") o.step = number(i, 1e-4, 0.05);
-    else if (a == "--physics-step") o.physics_step = number(i, 1e-4, 0.05);
-    else if (a == "--time-limit") o.time_limit = number(i, 1, 1e9);
-    else if (a == "--csv") o.csv = value(i);
-    else if (a == "--urdf") o.urdf = value(i);
-    else if (a == "--meta") o.meta_script = value(i);
-    else if (a == "--robots") o.robot_script = value(i);
-    else throw vsd::Error("unknown option '" + a + "'");
+    if (a == "--seed")
+      o.seed = static_cast<std::uint64_t>(whole(i, 0, 1e15));
+    else if (a == "--parts")
+      o.parts = static_cast<int>(whole(i, 1, 1e6));
+    else if (a == "--step")
+      o.step = number(i, 1e-4, 0.05);
+    else if (a == "--physics-step")
+      o.physics_step = number(i, 1e-4, 0.05);
+    else if (a == "--time-limit")
+      o.time_limit = number(i, 1, 1e9);
+    else if (a == "--csv")
+      o.csv = value(i);
+    else if (a == "--urdf")
+      o.urdf = value(i);
+    else if (a == "--meta")
+      o.meta_script = value(i);
+    else if (a == "--robots")
+      o.robot_script = value(i);
+    else
+      throw vsd::Error("unknown option '" + a + "'");
   }
   if (o.physics_step > o.step) throw vsd::Error("--physics-step must not exceed --step");
 }

@@ -22,31 +22,31 @@ namespace vsd_workcell {
 
 /// What run_cell() needs. The defaults are the demo's.
 struct CellOptions {
-  std::string urdf;                      ///< the iiwa14 URDF (tests/scene/data/iiwa14.urdf)
-  std::string meta_script;               ///< meta_control.soml
-  std::string robot_script;              ///< multi_robot_control.soml
-  std::uint64_t seed = 1;                ///< part kinds and arrival times; the nets' choices
-  int parts = 20;                        ///< run until this many parts are handled
-  double step = 0.01;                    ///< s: the scheduler's base step (control, sensors, checks)
-  double physics_step = 0.001;           ///< s: ODE's fixed step inside a scheduler step
-  std::string csv;                       ///< when not empty: one row per step (robots, distance, zone)
-  std::ostream* timeline = nullptr;      ///< when set: σ events, γ commands, token moves, parts handled
-  double time_limit = 0;                 ///< s of simulated time; 0: 60 s per part
+  std::string urdf;                  ///< the iiwa14 URDF (tests/scene/data/iiwa14.urdf)
+  std::string meta_script;           ///< meta_control.soml
+  std::string robot_script;          ///< multi_robot_control.soml
+  std::uint64_t seed = 1;            ///< part kinds and arrival times; the nets' choices
+  int parts = 20;                    ///< run until this many parts are handled
+  double step = 0.01;                ///< s: the scheduler's base step (control, sensors, checks)
+  double physics_step = 0.001;       ///< s: ODE's fixed step inside a scheduler step
+  std::string csv;                   ///< when not empty: one row per step (robots, distance, zone)
+  std::ostream* timeline = nullptr;  ///< when set: σ events, γ commands, token moves, parts handled
+  double time_limit = 0;             ///< s of simulated time; 0: 60 s per part
 };
 
 /// What a run did: the summary's figures.
 struct CellReport {
   int parts_arrived = 0;
-  int parts_handled = 0;    ///< resting on their destination, taken away by the outfeed
-  int handovers = 0;        ///< parts that went through the hand-over station
-  double time = 0;          ///< s simulated
+  int parts_handled = 0;  ///< resting on their destination, taken away by the outfeed
+  int handovers = 0;      ///< parts that went through the hand-over station
+  double time = 0;        ///< s simulated
   double parts_per_hour = 0;
   std::uint64_t steps = 0;
-  int zone_violations = 0;  ///< steps in which both arms were in the shared zone (geometry)
-  int deadlocks = 0;        ///< 1 when the cell stopped with parts left and nothing enabled or moving
-  double min_arm_distance = 0;  ///< m, between the arms' collision spheres, over every step
+  int zone_violations = 0;         ///< steps in which both arms were in the shared zone (geometry)
+  int deadlocks = 0;               ///< 1 when the cell stopped with parts left and nothing enabled or moving
+  double min_arm_distance = 0;     ///< m, between the arms' collision spheres, over every step
   double utilisation[2] = {0, 0};  ///< fraction of the time each robot (A, B) was moving
-  std::uint64_t firings = 0;          ///< both nets
+  std::uint64_t firings = 0;       ///< both nets
   std::uint64_t condition_tests = 0;  ///< both nets
   std::vector<std::string> condition_errors;
   std::string final_marking;  ///< Multi Robot Control's places

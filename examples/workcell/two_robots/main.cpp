@@ -23,8 +23,10 @@ int main(int argc, char** argv) {
   std::vector<std::string> args;
   bool quiet = false;
   for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) == "--quiet") quiet = true;
-    else args.emplace_back(argv[i]);
+    if (std::string(argv[i]) == "--quiet")
+      quiet = true;
+    else
+      args.emplace_back(argv[i]);
   }
   try {
     vsd_workcell::parse_options(args, o);

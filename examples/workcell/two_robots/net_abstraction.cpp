@@ -26,8 +26,8 @@ struct Builder {
   std::string source;
 
   [[noreturn]] void refuse(const Decl& d, const std::string& what) const {
-    throw vsd::Error(source + ":" + std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + ": " + what +
-                     " is outside the place/transition abstraction");
+    throw vsd::Error(source + ":" + std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + ": " +
+                     what + " is outside the place/transition abstraction");
   }
 
   // Places and transitions of a static instance, then of its static objects.
@@ -77,8 +77,10 @@ struct Builder {
       for (const ArrowDecl* a : t->inputs) {
         if (a->condition) ++conditions;
         const auto w = static_cast<std::uint32_t>(a->weight);
-        if (a->arrow == ArrowKind::Inhibitor) net.add_inhibitor(index, place_of(*a, a->from_decl), w);
-        else net.add_input(index, place_of(*a, a->from_decl), w);
+        if (a->arrow == ArrowKind::Inhibitor)
+          net.add_inhibitor(index, place_of(*a, a->from_decl), w);
+        else
+          net.add_input(index, place_of(*a, a->from_decl), w);
       }
       for (const ArrowDecl* a : t->outputs) {
         if (a->condition) ++conditions;

@@ -113,7 +113,8 @@ TEST(MultiRobotControlAbstraction, FindsTheViolationWhenBIgnoresTheZone) {
   const auto a = zone_places(net, "a");
   const auto b = zone_places(net, "b");
   const auto all = reachable(net);
-  EXPECT_TRUE(std::any_of(all.begin(), all.end(), [&](const Marking& m) { return tokens(m, a) + tokens(m, b) == 2; }));
+  EXPECT_TRUE(std::any_of(all.begin(), all.end(),
+                          [&](const Marking& m) { return tokens(m, a) + tokens(m, b) == 2; }));
 }
 
 TEST(MultiRobotControlAbstraction, FindsTheDeadlockWhenAKeepsTheZone) {
@@ -140,7 +141,8 @@ TEST(MultiRobotControlAbstraction, RefusesObjectTokensWithTheirPosition) {
     FAIL() << "no error";
   } catch (const vsd::Error& e) {
     EXPECT_NE(std::string(e.what()).find("meta_control.soml:"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("outside the place/transition abstraction"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("outside the place/transition abstraction"), std::string::npos)
+        << e.what();
   }
 }
 

@@ -1,8 +1,6 @@
 // The two-robot work cell (examples/workcell/two_robots) run headless: seeded runs over many parts, each
 // part handled, the shared zone never held by both arms (checked every step from the arms' geometry,
 // not from the net's marking), no deadlock; the timeline, the CSV and the option errors.
-#include "cell.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -10,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "cell.hpp"
 #include "vsd/core/error.hpp"
 
 namespace {
@@ -66,7 +65,8 @@ TEST(TwoRobotCell, Soak) {
   if (soak == nullptr) GTEST_SKIP() << "set VSD_WORKCELL_SOAK=<parts> to run";
   const int parts = std::atoi(soak);
   ASSERT_GT(parts, 0);
-  for (std::uint64_t seed = 100; seed < 104; ++seed) expect_clean(vsd_workcell::run_cell(options(seed, parts)), parts);
+  for (std::uint64_t seed = 100; seed < 104; ++seed)
+    expect_clean(vsd_workcell::run_cell(options(seed, parts)), parts);
 }
 
 TEST(TwoRobotCell, TimelineShowsEventsCommandsTokensAndParts) {
@@ -85,7 +85,9 @@ TEST(TwoRobotCell, TimelineShowsEventsCommandsTokensAndParts) {
   EXPECT_EQ(t.find("ZONE VIOLATION"), std::string::npos);
   EXPECT_NE(t.find("γ robot_a.grasp(part1)"), std::string::npos);
   EXPECT_NE(t.find("token: multi_robot_control a.fetch: a.idle -1, a.approaching +1"), std::string::npos);
-  EXPECT_NE(t.find("token: multi_robot_control b.enter: b.idle -1, station.full -1, zone.free -1, b.zone_approaching +1"), std::string::npos);
+  EXPECT_NE(t.find("token: multi_robot_control b.enter: b.idle -1, station.full -1, zone.free -1, "
+                   "b.zone_approaching +1"),
+            std::string::npos);
   EXPECT_NE(t.find("part handled: part4 (4 of 4)"), std::string::npos);
   std::ostringstream summary;
   vsd_workcell::print_summary(summary, r);
