@@ -226,8 +226,11 @@ class Robot : public vsd::Node {
     // this posture, so consecutive solutions stay in one family and joint-space moves stay short.
     const std::vector<double> seed{p.y(), 0.0, 0.3, 0.0, -1.5, 0.0, 1.2, 0.0};
     // A solver per goal: the tree's model is rebuilt when the tree changes, and solving is rare (cached).
+    // A bounded number of restarts rather than a time budget: a run must not depend on how busy the
+    // machine is (a budget cut short on a loaded machine would turn "reachable" into "not").
     vsd::robotics::IkOptions options;
-    options.time_budget = 0.05;
+    options.time_budget = 60.0;
+    options.max_restarts = 50;
     const vsd::robotics::Model& model = tree->model();
     vsd::robotics::IkSolver ik(model, model.find_body("iiwa_link_ee_kuka"), options);
     const auto r = ik.solve(goal, seed);
