@@ -1,13 +1,17 @@
 #!/usr/bin/env bash
-# Builds and runs the main vsd demo: the virtual work cell (examples/workcell), in which a SOML++ net
-# supervises a 3D simulation of the iiwa14 moving boxes. When a module it needs was skipped at configure
-# time (a missing Debian package), the core-only tour (examples/demo) runs instead, and says so.
-#   bash scripts/demo.sh            the work cell (writes workcell.csv, and workcell.png with gnuplot,
-#                                   into build/examples/workcell)
+# Builds and runs the main vsd demo: the paper's two-robot work cell (examples/workcell/two_robots,
+# docs/workcell.md), two 8-axis robots under the SOML++ nets meta_control.soml and
+# multi_robot_control.soml. When a module it needs was skipped at configure time (a missing Debian
+# package), the core-only tour (examples/demo) runs instead, and says so.
+#   bash scripts/demo.sh            the two-robot cell, 20 parts; further arguments go to it
+#                                   (--seed N, --parts N, --csv FILE, --quiet, ...)
+#   bash scripts/demo.sh --one-robot  the smaller one-robot cell (examples/workcell: writes workcell.csv,
+#                                   and workcell.png with gnuplot, into build/examples/workcell)
 #   bash scripts/demo.sh --tour     the core-only tour (examples/demo); further arguments go to it
 # It installs only what it runs (scripts/install-deps.sh, groups): the work cell needs the core, vsd::scene
 # (urdfdom, assimp), vsd::collision (FCL, libccd) and vsd::physics (ODE); the tour the core only. gnuplot
-# (for the PNG) is not installed: the work cell writes its CSV without it. The tests are not configured.
+# (for the one-robot cell's PNG) is not installed: that cell writes its CSV without it. The tests are not
+# configured.
 # Environment: BUILD_DIR (default build), VSD_SKIP_DEPS=1 to skip the dependency check.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -31,12 +35,21 @@ if [[ "${1:-}" == "--tour" ]]; then
   tour "$@"
   exit
 fi
-# The work cell exists only when vsd::soml, ::robotics, ::physics and ::collision were all configured.
-if cmake --build "$BUILD_DIR" --target help | grep -q '\bvsd_workcell\b'; then
+# The work cells exist only when vsd::soml, ::robotics, ::physics and ::collision were all configured.
+# (The target list is read whole first: `grep -q` would stop reading early, and under pipefail the
+# writer's SIGPIPE would count as "not found".)
+targets="$(cmake --build "$BUILD_DIR" --target help)"
+if [[ "${1:-}" == "--one-robot" ]] && grep -q '\bvsd_workcell\b' <<<"$targets"; then
+  shift
   cmake --build "$BUILD_DIR" --target vsd_workcell --parallel 2
   mkdir -p "$BUILD_DIR/examples/workcell"
   "$BUILD_DIR/examples/vsd_workcell" tests/scene/data/iiwa14.urdf examples/workcell/workcell.soml \
-    "$BUILD_DIR/examples/workcell"
+    "$BUILD_DIR/examples/workcell" "$@"
+elif grep -q '\bvsd_two_robot_cell\b' <<<"$targets"; then
+  [[ "${1:-}" == "--one-robot" ]] && shift
+  cmake --build "$BUILD_DIR" --target vsd_two_robot_cell --parallel 2
+  if [[ $# -eq 0 ]]; then set -- --parts 20; fi
+  "$BUILD_DIR/examples/vsd_two_robot_cell" "$@"
 else
   echo "demo: the work cell needs vsd::soml, vsd::robotics, vsd::physics and vsd::collision (see the" \
        "configure messages above); running the core tour instead" >&2

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "eight_axis_urdf.hpp"
 #include "simulator_process.hpp"
 #include "vsd/robotics.hpp"
 
@@ -102,15 +103,12 @@ int main(int argc, char** argv) {
   }
   const std::filesystem::path out = argc > 3 ? argv[3] : ".";
   std::filesystem::create_directories(out);
-  std::string xml = read_text(argv[1]);
-  const std::string fixed = R"(<joint name="world_iiwa_joint" type="fixed">)";
-  const auto at = xml.find(fixed);
-  if (at == std::string::npos) {
+  const auto urdf = vsd_example::eight_axis_urdf(read_text(argv[1]));
+  if (!urdf) {
     std::cerr << argv[1] << ": no fixed joint 'world_iiwa_joint' to turn into the linear axis\n";
     return 1;
   }
-  xml.replace(at, fixed.size(), R"(<joint name="world_iiwa_joint" type="prismatic">
-    <axis xyz="0.6 0.8 0"/><limit lower="-2" upper="3" effort="1000" velocity="1"/>)");
+  const std::string& xml = *urdf;
 
   try {
     const Run sim = follow(xml, "sim");

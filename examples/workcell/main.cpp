@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "scene_kit.hpp"
 #include "vsd/collision.hpp"
 #include "vsd/physics.hpp"
 #include "vsd/robotics.hpp"
@@ -152,19 +153,8 @@ class CellModule : public vsd::Module {
   }
 };
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw vsd::Error("cannot read " + path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-Eigen::Isometry3d at(double x, double y, double z) {
-  Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
-  f.translation() = Eigen::Vector3d(x, y, z);
-  return f;
-}
+using vsd_example::at;
+using vsd_example::read_text;
 
 std::string where(const Node3D& n) {
   const Eigen::Vector3d p = n.world_frame().translation();
@@ -250,41 +240,19 @@ int main(int argc, char** argv) try {
   cell_node.add_child(room);
   room.add_extension(s.create<vsd::physics::World>());
 
-  auto geometry = [&](GeometryKind kind, Eigen::Vector3d size) -> vsd::scene::Geometry& {
-    auto& g = s.create<vsd::scene::Geometry>();
-    g.set_kind(kind);
-    g.set_size(size);
-    cell_node.edit_geometries().push_back(g);
-    return g;
-  };
-  auto& wood = s.create<vsd::scene::Material>();
-  wood.set_name("wood");
-  wood.set_friction(0.8);
-  wood.set_restitution(0.0);
-  wood.set_density(600);
-  cell_node.edit_materials().push_back(wood);
-  auto hull = [&](vsd::scene::Hull& h, std::string name, vsd::scene::Geometry& g, const Eigen::Isometry3d& f,
-                  vsd::Node& parent) -> vsd::scene::Hull& {
-    h.set_name(std::move(name));
-    h.set_role(vsd::scene::HullRole::Collision);
-    h.set_geometry(&g);
-    h.set_material(&wood);
-    h.set_frame(f);
-    parent.add_child(h);
-    return h;
-  };
-  hull(s.create<vsd::scene::Hull>(), "floor", geometry(GeometryKind::Plane, {}), at(0, 0, 0), room);
-  hull(s.create<vsd::scene::Hull>(), "table", geometry(GeometryKind::Box, {0.45, 1.0, 0.04}),
+  vsd_example::SceneKit kit(s, cell_node);
+  kit.hull(s.create<vsd::scene::Hull>(), "floor", kit.geometry(GeometryKind::Plane, {}), at(0, 0, 0), room);
+  kit.hull(s.create<vsd::scene::Hull>(), "table", kit.geometry(GeometryKind::Box, {0.45, 1.0, 0.04}),
        at(0.525, 0, table_top - 0.02), room);
 
   // Three boxes dropped onto the infeed area (y < 0); three slots on the target area (y > 0).
-  auto& box_shape = geometry(GeometryKind::Box, {box_size, box_size, box_size});
+  auto& box_shape = kit.geometry(GeometryKind::Box, {box_size, box_size, box_size});
   std::vector<Box*> boxes;
   std::vector<Node3D*> slots;
   for (int i = 0; i < 3; ++i) {
     const double x = 0.42 + 0.1 * i;
     auto& b = s.create<Box>();
-    hull(b, "box" + std::to_string(i + 1), box_shape, at(x, -0.3, table_top + 0.1 + 0.05 * i), room);
+    kit.hull(b, "box" + std::to_string(i + 1), box_shape, at(x, -0.3, table_top + 0.1 + 0.05 * i), room);
     b.add_extension(s.create<vsd::physics::RigidBody>());
     boxes.push_back(&b);
     auto& slot = s.create<Node3D>();
@@ -297,7 +265,7 @@ int main(int argc, char** argv) try {
   // The gripper pad: a thin collision hull "attached to" the flange through the SpatialView (a tool
   // on the flange), its contact face tool_length in front of the flange.
   auto& pad = s.create<vsd::scene::Hull>();
-  hull(pad, "gripper pad", geometry(GeometryKind::Box, {0.04, 0.04, 0.01}), Eigen::Isometry3d::Identity(),
+  kit.hull(pad, "gripper pad", kit.geometry(GeometryKind::Box, {0.04, 0.04, 0.01}), Eigen::Isometry3d::Identity(),
        cell_node);
   vsd::scene::SpatialView view(s);
 

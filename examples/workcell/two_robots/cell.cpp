@@ -1,0 +1,776 @@
+// The two-robot work cell: the plant (robots, conveyor, parts under physics, sensors, geometric checks)
+// and the run loop. See cell.hpp for what it is; docs/workcell.md for the layout.
+#include "cell.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <utility>
+
+#include "eight_axis_urdf.hpp"
+#include "scene_kit.hpp"
+#include "vsd/collision.hpp"
+#include "vsd/physics.hpp"
+#include "vsd/robotics.hpp"
+#include "vsd/soml.hpp"
+
+namespace vsd_workcell {
+
+using vsd::scene::Node3D;
+
+namespace {
+
+// --- The layout (m, world frame, z up). Robot A's rail runs along y at x = -0.65, robot B's at x = +0.65,
+// each arm facing the other; between them the shared zone, with the hand-over station in its middle.
+// The conveyor ends at `pick`, which only A reaches; `dest_a` only A reaches, `dest_b` only B (each is
+// more than the iiwa14's 0.82 m reach from the other rail).
+constexpr double rail_x = 0.65;
+constexpr double table_top = 0.25;  // every work surface
+constexpr double tool_length = 0.05;
+const Eigen::Vector2d pick_xy{-0.30, -0.75};
+const Eigen::Vector2d dest_a_xy{-0.30, 0.75};
+const Eigen::Vector2d dest_b_xy{0.30, 0.75};
+const Eigen::Vector2d station_xy{0.0, 0.0};
+const Eigen::Vector2d gate_a_xy{-0.42, 0.0};
+const Eigen::Vector2d gate_b_xy{0.42, 0.0};
+// The shared zone: a column over the station, from the floor up.
+const Eigen::Vector3d zone_min{-0.15, -0.30, 0.0};
+const Eigen::Vector3d zone_max{0.15, 0.30, 2.0};
+constexpr double arm_sphere = 0.06;    // radius of the spheres that stand for each arm
+constexpr double belt_start = -1.60;   // y where parts come onto the belt (x = pick x)
+constexpr double belt_speed = 0.25;    // m/s
+constexpr double belt_gap = 0.10;      // m between queued parts' centres
+constexpr double rest_speed = 0.005;   // m/s: slower than this ...
+constexpr double rest_time = 0.2;      // ... for this long is "at rest"
+constexpr double outfeed_delay = 0.3;  // s a delivered part rests on its destination before it goes
+
+enum Stage : std::int64_t {
+  on_belt = 0,
+  at_sensor = 1,
+  held = 2,
+  on_station = 3,
+  on_destination = 4,
+  delivered = 5
+};
+
+using vsd_example::at;
+using vsd_example::read_text;
+
+// The run's random numbers (part kinds, arrival gaps): xorshift64*, so a seed gives the same run on every
+// standard library.
+struct Random {
+  std::uint64_t s;
+  explicit Random(std::uint64_t seed) : s(seed * 0x9E3779B97F4A7C15ull + 1) {}
+  double uniform() {
+    s ^= s >> 12;
+    s ^= s << 25;
+    s ^= s >> 27;
+    return static_cast<double>((s * 0x2545F4914F6CDD1Dull) >> 11) * 0x1.0p-53;
+  }
+};
+
+}  // namespace
+
+/// A part: a collision hull that gets a rigid body whenever it lies somewhere (not on the belt, not held).
+class Part : public vsd::scene::Hull {
+  VSD_INSTANCE(Part, vsd::scene::Hull)
+  VSD_PROPERTY(std::int64_t, kind, 1)  // 1: small (direct to dest_a), 2: large (hand-over to dest_b)
+  VSD_PROPERTY(double, height, 0.05)
+  VSD_PROPERTY(bool, resting, false)    // σ: lies still
+  VSD_PROPERTY(std::int64_t, stage, 0)  // σ: see Stage
+
+ public:
+  double belt_y = 0;       // while on the belt
+  double slow_for = 0;     // s below rest_speed
+  double resting_for = 0;  // s resting on a destination
+};
+
+/// The order board between Meta Control (posts) and Multi Robot Control (takes).
+class Orders : public vsd::Node {
+  VSD_INSTANCE(Orders, vsd::Node)
+  VSD_PROPERTY(vsd::SharedRef<vsd::Node>, part, nullptr)  // σ: the part to pick next
+  VSD_PROPERTY(std::int64_t, route, 0)
+
+ public:
+  std::ostream* log = nullptr;
+  double* clock = nullptr;
+  /// γ: posts @p p with @p r (1 direct, 2 hand-over).
+  void post(vsd::SharedRef<vsd::Node> p, std::int64_t r) {
+    if (part()) throw vsd::Error("orders.post: the board already holds " + part()->name());
+    if (log) *log << "t=" << fmt(*clock) << " s  γ orders.post(" << p->name() << ", route " << r << ")\n";
+    set_route(r);
+    set_part(p);
+  }
+  /// γ: takes the order off the board.
+  void clear() {
+    set_part(nullptr);
+    set_route(0);
+  }
+  static std::string fmt(double t) {
+    char s[32];
+    std::snprintf(s, sizeof s, "%.2f", t);
+    return s;
+  }
+  VSD_METHOD(post)
+  VSD_METHOD(clear)
+};
+
+/// The conveyor's end: its frame is the pick position; its sensor reports the part lying there.
+class Conveyor : public Node3D {
+  VSD_INSTANCE(Conveyor, Node3D)
+  VSD_PROPERTY(std::int64_t, arrivals, 0)                      // σ: parts that came to rest at the sensor
+  VSD_PROPERTY(vsd::SharedRef<vsd::Node>, last, nullptr)       // the last of them
+  VSD_PROPERTY(vsd::SharedRef<vsd::Node>, at_sensor, nullptr)  // σ: the part lying at the sensor now
+  VSD_PROPERTY(double, time, 0.0)
+
+ public:
+  std::string clock() const { return Orders::fmt(time()); }
+  VSD_METHOD(clock)
+};
+
+/// The hand-over station: its sensor reports the part resting on it.
+class Station : public Node3D {
+  VSD_INSTANCE(Station, Node3D)
+  VSD_PROPERTY(vsd::SharedRef<vsd::Node>, part, nullptr)  // σ
+};
+
+/// The shared zone's presence sensor: which arms are in it, from their geometry (every step).
+class ZoneSensor : public Node3D {
+  VSD_INSTANCE(ZoneSensor, Node3D)
+  VSD_PROPERTY(bool, occupied, false)  // σ: some arm is in the zone
+  VSD_PROPERTY(std::string, by, "")    // "robot_a", "robot_b", "robot_a and robot_b" or ""
+};
+
+/// A robot's interface to the nets: σ properties, γ methods (as the one-robot cell's Robot, with joint
+/// space motions: a Cartesian goal is solved by IK once and cached, the controller plans a trapezoidal
+/// joint trajectory to it, rail included).
+class Robot : public vsd::Node {
+  VSD_INSTANCE(Robot, vsd::Node)
+  VSD_PROPERTY(double, time, 0.0)
+  VSD_PROPERTY(bool, arrived, true)                          // σ
+  VSD_PROPERTY(vsd::SharedRef<vsd::Node>, touched, nullptr)  // σ: collision, pad against a part
+  VSD_PROPERTY(vsd::SharedRef<vsd::Node>, holding, nullptr)
+
+ public:
+  vsd::robotics::JointController* controller = nullptr;
+  vsd::robotics::KinematicTree* tree = nullptr;
+  vsd::scene::SpatialView* view = nullptr;
+  Node3D* base = nullptr;
+  Node3D* pad = nullptr;
+  Conveyor* conveyor = nullptr;
+  Station* station = nullptr;
+  std::ostream* log = nullptr;
+  std::uint64_t step = 0;
+  std::uint64_t commanded_in_step = 0;
+  double moving_time = 0;
+  std::map<std::array<long, 3>, std::vector<double>> solutions;  // goal in the base frame (µm) -> joints
+
+  /// γ: moves the pad's contact face to @p height above @p where's origin, the tool pointing down.
+  void move_to(vsd::SharedRef<vsd::Node> where, double height) {
+    auto* n = dynamic_cast<Node3D*>(where.get());
+    if (n == nullptr) throw vsd::Error(name() + ".move_to: the target is not a 3D node");
+    const Eigen::Vector3d p = n->world_frame().translation() + Eigen::Vector3d(0, 0, height + tool_length);
+    if (log)
+      *log << "t=" << Orders::fmt(time()) << " s  γ " << name() << ".move_to(" << n->name() << ", "
+           << Orders::fmt(height) << ")\n";
+    command(solve(p));
+  }
+  /// γ: closes the gripper on @p part: the arm stops, the part is carried by the pad (no rigid body).
+  void grasp(vsd::SharedRef<vsd::Node> part) {
+    auto* b = dynamic_cast<Part*>(part.get());
+    if (b == nullptr) throw vsd::Error(name() + ".grasp: not a part");
+    if (holding()) throw vsd::Error(name() + ".grasp: already holding " + holding()->name());
+    if (log) *log << "t=" << Orders::fmt(time()) << " s  γ " << name() << ".grasp(" << b->name() << ")\n";
+    command(tree->positions());
+    view->relate(*b, *pad, vsd::scene::SpatialRelation::GrabbedBy);
+    if (auto* body = b->find_extension<vsd::physics::RigidBody>()) b->remove_extension(*body);
+    b->set_resting(false);
+    b->slow_for = 0;
+    b->set_stage(held);
+    if (conveyor->at_sensor().get() == b) conveyor->set_at_sensor(nullptr);
+    if (station->part().get() == b) station->set_part(nullptr);
+    set_holding(part);
+  }
+  /// γ: opens the gripper: the part gets its rigid body back.
+  void release() {
+    auto* b = dynamic_cast<Part*>(holding().get());
+    if (b == nullptr) throw vsd::Error(name() + ".release: holding nothing");
+    if (log) *log << "t=" << Orders::fmt(time()) << " s  γ " << name() << ".release(" << b->name() << ")\n";
+    view->release(*b);
+    b->add_extension(b->state().create<vsd::physics::RigidBody>());
+    set_holding(nullptr);
+  }
+  std::string clock() const { return Orders::fmt(time()); }
+  VSD_METHOD(move_to)
+  VSD_METHOD(grasp)
+  VSD_METHOD(release)
+  VSD_METHOD(clock)
+
+  /// The joints that put the flange at @p flange_at (world) pointing down, from the posture seed.
+  std::vector<double> solve(const Eigen::Vector3d& flange_at) {
+    const Eigen::Vector3d p = base->world_frame().inverse() * flange_at;
+    const std::array<long, 3> key{std::lround(p.x() * 1e6), std::lround(p.y() * 1e6),
+                                  std::lround(p.z() * 1e6)};
+    if (auto it = solutions.find(key); it != solutions.end()) return it->second;
+    Eigen::Isometry3d goal = Eigen::Isometry3d::Identity();
+    goal.translation() = p;
+    goal.rotate(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()));
+    // The rail where the goal is, the arm elbow up with the wrist bent down: every goal is solved from
+    // this posture, so consecutive solutions stay in one family and joint-space moves stay short.
+    const std::vector<double> seed{p.y(), 0.0, 0.3, 0.0, -1.5, 0.0, 1.2, 0.0};
+    // A solver per goal: the tree's model is rebuilt when the tree changes, and solving is rare (cached).
+    // A bounded number of restarts rather than a time budget: a run must not depend on how busy the
+    // machine is (a budget cut short on a loaded machine would turn "reachable" into "not").
+    vsd::robotics::IkOptions options;
+    options.time_budget = 60.0;
+    options.max_restarts = 50;
+    const vsd::robotics::Model& model = tree->model();
+    vsd::robotics::IkSolver ik(model, model.find_body("iiwa_link_ee_kuka"), options);
+    const auto r = ik.solve(goal, seed);
+    if (!r.success) {
+      char s[96];
+      std::snprintf(s, sizeof s, "(%.3f, %.3f, %.3f)", flange_at.x(), flange_at.y(), flange_at.z());
+      throw vsd::Error(name() + ": no IK solution for the flange at " + s);
+    }
+    solutions.emplace(key, r.q);
+    return r.q;
+  }
+  bool reaches(const Eigen::Vector3d& flange_at) {
+    try {
+      solve(flange_at);
+      return true;
+    } catch (const vsd::Error&) {
+      return false;
+    }
+  }
+
+ private:
+  void command(const std::vector<double>& q) {
+    controller->set_target(q);
+    controller->set_mode(vsd::robotics::ControlMode::Position);
+    set_arrived(false);
+    commanded_in_step = step;
+  }
+};
+
+namespace {
+
+class CellModule : public vsd::Module {
+ public:
+  std::string_view name() const override { return "two-robot workcell"; }
+  void register_types(vsd::Registry& r) override {
+    r.add<Part>();
+    r.add<Orders>();
+    r.add<Conveyor>();
+    r.add<Station>();
+    r.add<ZoneSensor>();
+    r.add<Robot>();
+  }
+};
+
+// True when a sphere of radius r at c touches the box [lo, hi].
+bool sphere_in_box(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const Eigen::Vector3d nearest = c.cwiseMax(lo).cwiseMin(hi);
+  return (c - nearest).norm() <= r;
+}
+
+}  // namespace
+
+void add_cell_modules(vsd::Environment& env, double collision_period) {
+  env.use<vsd::robotics::Module>();
+  env.use<vsd::physics::Module>();
+  env.use<vsd::collision::Module>(collision_period);
+  env.use<CellModule>();
+  env.use<vsd::soml::Module>();
+}
+
+CellReport run_cell(const CellOptions& o) {
+  using vsd::scene::GeometryKind;
+  if (o.parts < 1) throw vsd::Error("parts must be at least 1");
+  if (!(o.step > 0) || !(o.physics_step > 0) || o.physics_step > o.step)
+    throw vsd::Error("the physics step must be positive and at most the step");
+  std::ostream* tl = o.timeline;
+  const double time_limit = o.time_limit > 0 ? o.time_limit : 60.0 * o.parts;
+
+  vsd::Environment env;
+  env.scheduler().set_base_step(o.step);
+  add_cell_modules(env, o.step);
+  auto& collision = env.use<vsd::collision::Module>(o.step);
+  auto& soml = env.use<vsd::soml::Module>();
+  vsd::SimState& s = env.main_state();
+
+  // --- The cell: what collision detection watches (the room, the pads, the arm spheres); the room is the
+  // physics world (surfaces and parts). The robots' own links stay outside both.
+  auto& cell_node = s.create<vsd::scene::Scene>();
+  cell_node.set_name("cell");
+  s.database().add_child(cell_node);
+  auto& room = s.create<vsd::scene::Scene>();
+  room.set_name("room");
+  cell_node.add_child(room);
+  auto& world = s.create<vsd::physics::World>();
+  world.set_step(o.physics_step);
+  room.add_extension(world);
+  auto& outfeed = s.create<vsd::Node>();  // delivered parts, out of both worlds
+  outfeed.set_name("outfeed");
+  s.database().add_child(outfeed);
+
+  vsd_example::SceneKit kit(s, cell_node);
+  auto marker = [&](Node3D& n, std::string name, const Eigen::Vector2d& xy) -> Node3D& {
+    n.set_name(std::move(name));
+    n.set_frame(at(xy.x(), xy.y(), table_top));
+    cell_node.add_child(n);
+    return n;
+  };
+  // The surfaces: the conveyor's belt, the station, the two destinations (static hulls: no rigid body).
+  auto surface = [&](std::string name, const Eigen::Vector2d& xy, Eigen::Vector2d size) {
+    kit.hull(s.create<vsd::scene::Hull>(), std::move(name),
+             kit.geometry(GeometryKind::Box, {size.x(), size.y(), 0.04}),
+             at(xy.x(), xy.y(), table_top - 0.02), room);
+  };
+  surface("belt", {pick_xy.x(), (belt_start + pick_xy.y()) / 2}, {0.16, pick_xy.y() - belt_start + 0.2});
+  surface("station table", station_xy, {0.16, 0.16});
+  surface("dest_a table", dest_a_xy, {0.2, 0.2});
+  surface("dest_b table", dest_b_xy, {0.2, 0.2});
+  auto& conveyor = static_cast<Conveyor&>(marker(s.create<Conveyor>(), "conveyor", pick_xy));
+  auto& station = static_cast<Station&>(marker(s.create<Station>(), "station", station_xy));
+  auto& zone = static_cast<ZoneSensor&>(marker(s.create<ZoneSensor>(), "zone", station_xy));
+  Node3D& dest_a = marker(s.create<Node3D>(), "dest_a", dest_a_xy);
+  Node3D& dest_b = marker(s.create<Node3D>(), "dest_b", dest_b_xy);
+  Node3D& gate_a = marker(s.create<Node3D>(), "gate_a", gate_a_xy);
+  Node3D& gate_b = marker(s.create<Node3D>(), "gate_b", gate_b_xy);
+  auto& orders = s.create<Orders>();
+  orders.set_name("orders");
+  s.database().add_child(orders);
+  double now = 0;
+  orders.log = tl;
+  orders.clock = &now;
+  vsd::scene::SpatialView view(s);
+
+  // --- The robots: the 8-axis URDF twice, each base on its rail, facing the zone.
+  const auto urdf = vsd_example::eight_axis_urdf(read_text(o.urdf), "0 1 0", -1.2, 1.2);
+  if (!urdf) throw vsd::Error(o.urdf + ": no fixed joint 'world_iiwa_joint' to turn into the linear axis");
+  vsd::scene::UrdfOptions urdf_options;
+  urdf_options.load_meshes = false;
+  Robot* robots[2] = {nullptr, nullptr};
+  std::vector<vsd::scene::Hull*> spheres[2];
+  const char* arm_links[] = {"iiwa_link_4", "iiwa_link_6"};  // elbow and wrist; the pad stands for the hand
+  auto& pad_shape = kit.geometry(GeometryKind::Box, {0.04, 0.04, 0.01});
+  auto& sphere_shape = kit.geometry(GeometryKind::Sphere, {}, arm_sphere);
+  for (int i = 0; i < 2; ++i) {
+    const std::string tag = i == 0 ? "a" : "b";
+    auto rep = vsd::scene::load_urdf_text(s.database(), *urdf, "arm_" + tag, ".", urdf_options);
+    rep.scene->set_name("arm_" + tag);
+    Eigen::Isometry3d base = at(i == 0 ? -rail_x : rail_x, 0, 0);
+    if (i == 1) base.rotate(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
+    rep.scene->set_frame(base);
+    auto& tree = vsd::robotics::build_kinematics(*rep.scene);
+    auto& controller = s.create<vsd::robotics::JointController>();
+    rep.scene->add_extension(controller);
+    controller.set_default_velocity(1.0);
+    Node3D* flange = rep.scene->find_link("iiwa_link_ee_kuka");
+    if (flange == nullptr) throw vsd::Error(o.urdf + ": no link iiwa_link_ee_kuka");
+    auto& robot = s.create<Robot>();
+    robot.set_name("robot_" + tag);
+    s.database().add_child(robot);
+    robot.controller = &controller;
+    robot.tree = &tree;
+    robot.view = &view;
+    robot.base = rep.scene;
+    robot.conveyor = &conveyor;
+    robot.station = &station;
+    robot.log = tl;
+    // Start at the gate, above the work height.
+    const Node3D& gate = i == 0 ? gate_a : gate_b;
+    tree.set_positions(
+        robot.solve(gate.world_frame().translation() + Eigen::Vector3d(0, 0, 0.12 + tool_length)));
+    auto& pad = s.create<vsd::scene::Hull>();
+    kit.hull(pad, "pad_" + tag, pad_shape, flange->world_frame() * at(0, 0, tool_length - 0.005), cell_node);
+    view.relate(pad, *flange, vsd::scene::SpatialRelation::AttachedTo);
+    robot.pad = &pad;
+    spheres[i].push_back(&pad);
+    for (const char* link : arm_links) {
+      Node3D* l = rep.scene->find_link(link);
+      if (l == nullptr) throw vsd::Error(o.urdf + ": no link " + link);
+      auto& sp = s.create<vsd::scene::Hull>();
+      kit.hull(sp, std::string(link) + "_" + tag, sphere_shape, l->world_frame(), cell_node);
+      view.relate(sp, *l, vsd::scene::SpatialRelation::AttachedTo);
+      spheres[i].push_back(&sp);
+    }
+    robots[i] = &robot;
+  }
+  // Who reaches what (the reason for the hand-over): checked by IK, not assumed.
+  for (int i = 0; i < 2; ++i) {
+    std::string line;
+    const Node3D* points[] = {&conveyor, &station, &dest_a, &dest_b};
+    for (const Node3D* n : points) {
+      const bool r =
+          robots[i]->reaches(n->world_frame().translation() + Eigen::Vector3d(0, 0, 0.1 + tool_length));
+      line += (line.empty() ? "" : ", ") + n->name() + (r ? " yes" : " no");
+    }
+    if (tl) *tl << "reach of " << robots[i]->name() << ": " << line << '\n';
+  }
+
+  // --- Collision: pad against part contacts (σ touched); distances between the arms on request.
+  auto is_pad = [&](const vsd::scene::Hull& h) { return &h == robots[0]->pad || &h == robots[1]->pad; };
+  vsd::collision::Options copt;
+  copt.root = &cell_node;
+  copt.pair_filter = [&](const vsd::scene::Hull& a, const vsd::scene::Hull& b) {
+    return (is_pad(a) && dynamic_cast<const Part*>(&b) != nullptr) ||
+           (is_pad(b) && dynamic_cast<const Part*>(&a) != nullptr);
+  };
+  auto& contacts = collision.world(s, copt);
+  auto robot_of = [&](const vsd::scene::Hull& pad) { return &pad == robots[0]->pad ? robots[0] : robots[1]; };
+  auto c_begin = contacts.on_contact_begin().connect([&](vsd::scene::Hull& a, vsd::scene::Hull& b) {
+    vsd::scene::Hull& pad = is_pad(a) ? a : b;
+    vsd::scene::Hull& part = is_pad(a) ? b : a;
+    Robot* r = robot_of(pad);
+    if (tl)
+      *tl << "t=" << Orders::fmt(now) << " s  σ collision: " << r->name() << "'s pad touches " << part.name()
+          << '\n';
+    r->set_touched(vsd::SharedRef<vsd::Node>(&part));
+  });
+  auto c_end = contacts.on_contact_end().connect([&](vsd::scene::Hull& a, vsd::scene::Hull& b) {
+    vsd::scene::Hull& pad = is_pad(a) ? a : b;
+    vsd::scene::Hull& part = is_pad(a) ? b : a;
+    Robot* r = robot_of(pad);
+    if (r->touched().get() == &part) r->set_touched(nullptr);
+  });
+
+  // --- Parts: two kinds, arriving on the belt at random gaps.
+  Random random(o.seed);
+  vsd::scene::Geometry* part_shape[2] = {&kit.geometry(GeometryKind::Box, {0.04, 0.04, 0.04}),
+                                         &kit.geometry(GeometryKind::Box, {0.06, 0.06, 0.06})};
+  std::vector<Part*> belt;    // on the belt, front first (no rigid body: the belt carries them)
+  std::vector<Part*> placed;  // with a rigid body, somewhere in the room
+  int spawned = 0;
+  bool in_zone[2] = {false, false};  // this step's zone sensor
+  double next_arrival = 0.5;
+  CellReport report;
+
+  // --- The sensors, after control, physics and collision in each step: only changes reach the nets.
+  env.scheduler().add_periodic(
+      "cell sensors", o.step,
+      [&](const vsd::StepInfo& info) {
+        now = info.time;
+        conveyor.set_time(info.time);
+        const double dt = o.step;
+        for (Robot* r : robots) {
+          r->step = info.step;
+          r->set_time(info.time);
+          if (!r->controller->done() && report.parts_handled < o.parts)
+            r->moving_time += dt;  // until the last part
+          if (!r->arrived() && info.step > r->commanded_in_step && r->controller->done()) {
+            r->set_arrived(true);
+            if (tl) *tl << "t=" << Orders::fmt(now) << " s  σ " << r->name() << " arrived\n";
+          }
+          if (!r->controller->fault().empty())
+            throw vsd::Error(r->name() + " controller: " + r->controller->fault());
+        }
+        // The zone: an arm is in it when one of its spheres touches the zone's box. Both at once is a
+        // violation, counted from this geometry, whatever the nets' markings say.
+        for (int i = 0; i < 2; ++i) {
+          in_zone[i] = false;
+          for (const vsd::scene::Hull* h : spheres[i])
+            in_zone[i] =
+                in_zone[i] || sphere_in_box(h->world_frame().translation(), arm_sphere, zone_min, zone_max);
+        }
+        const std::string by = in_zone[0] && in_zone[1] ? "robot_a and robot_b"
+                               : in_zone[0]             ? "robot_a"
+                               : in_zone[1]             ? "robot_b"
+                                                        : "";
+        if (by != zone.by() && tl)
+          *tl << "t=" << Orders::fmt(now) << " s  σ zone occupied by " << (by.empty() ? "nobody" : by)
+              << '\n';
+        zone.set_by(by);
+        zone.set_occupied(!by.empty());
+        if (in_zone[0] && in_zone[1]) {
+          ++report.zone_violations;
+          if (tl) *tl << "t=" << Orders::fmt(now) << " s  ZONE VIOLATION: both arms in the shared zone\n";
+        }
+        // The belt: a new part at the start when its gap has passed (and there is room).
+        if (spawned < o.parts && info.time >= next_arrival &&
+            (belt.empty() || belt.back()->belt_y > belt_start + belt_gap)) {
+          auto& p = s.create<Part>();
+          const int kind = random.uniform() < 0.5 ? 1 : 2;
+          p.set_kind(kind);
+          p.set_height(kind == 1 ? 0.04 : 0.06);
+          p.belt_y = belt_start;
+          kit.hull(p, "part" + std::to_string(++spawned), *part_shape[kind - 1],
+                   at(pick_xy.x(), belt_start, table_top + p.height() / 2), room);
+          belt.push_back(&p);
+          next_arrival = info.time + 2.0 + 4.0 * random.uniform();
+          if (tl)
+            *tl << "t=" << Orders::fmt(now) << " s  conveyor: " << p.name() << " (kind " << kind
+                << ") comes in\n";
+        }
+        const bool spot_free =
+            !conveyor.at_sensor() &&
+            std::none_of(placed.begin(), placed.end(), [&](Part* p) { return p->stage() == on_belt; });
+        for (std::size_t k = 0; k < belt.size(); ++k) {
+          const double limit =
+              k == 0 ? (spot_free ? pick_xy.y() : pick_xy.y() - belt_gap) : belt[k - 1]->belt_y - belt_gap;
+          belt[k]->belt_y = std::min(limit, belt[k]->belt_y + belt_speed * dt);
+          belt[k]->set_frame(at(pick_xy.x(), belt[k]->belt_y, table_top + belt[k]->height() / 2));
+        }
+        if (!belt.empty() && spot_free && belt.front()->belt_y >= pick_xy.y() - 1e-9) {
+          Part* p = belt.front();  // at the stop: physics takes it over until the sensor sees it at rest
+          belt.erase(belt.begin());
+          p->add_extension(s.create<vsd::physics::RigidBody>());
+          placed.push_back(p);
+        }
+        // Rest: where a part lies still decides what the sensors report. The parts with a rigid body are
+        // those in the room that neither the belt carries nor a robot holds.
+        placed.clear();
+        for (std::size_t k = 0; k < room.children().size(); ++k)
+          if (auto* p = dynamic_cast<Part*>(room.children()[k]);
+              p && p->find_extension<vsd::physics::RigidBody>())
+            placed.push_back(p);
+        for (Part* p : placed) {
+          const auto* body = p->find_extension<vsd::physics::RigidBody>();
+          const Eigen::Vector3d x = p->world_frame().translation();
+          if (x.z() < table_top - 0.05) throw vsd::Error(p->name() + " fell off at t=" + Orders::fmt(now));
+          const bool slow = body->linear_velocity().norm() < rest_speed &&
+                            body->angular_velocity().norm() < rest_speed / 0.02;
+          p->slow_for = slow ? p->slow_for + dt : 0;
+          const bool rest = p->slow_for >= rest_time;
+          if (rest && !p->resting()) {
+            p->set_resting(true);
+            const Eigen::Vector2d xy = x.head<2>();
+            const char* where = nullptr;
+            if ((xy - pick_xy).norm() < 0.05) {
+              where = "the conveyor's sensor";
+              p->set_stage(at_sensor);
+              conveyor.set_at_sensor(vsd::SharedRef<vsd::Node>(p));
+              conveyor.set_last(vsd::SharedRef<vsd::Node>(p));
+              conveyor.set_arrivals(conveyor.arrivals() + 1);
+              ++report.parts_arrived;
+            } else if ((xy - station_xy).norm() < 0.06) {
+              where = "the station";
+              p->set_stage(on_station);
+              station.set_part(vsd::SharedRef<vsd::Node>(p));
+              ++report.handovers;
+            } else if ((xy - (p->kind() == 1 ? dest_a_xy : dest_b_xy)).norm() < 0.06) {
+              where = p->kind() == 1 ? "dest_a" : "dest_b";
+              p->set_stage(on_destination);
+            } else {
+              throw vsd::Error(p->name() + " came to rest at a wrong place at t=" + Orders::fmt(now));
+            }
+            if (tl) *tl << "t=" << Orders::fmt(now) << " s  σ " << p->name() << " rests on " << where << '\n';
+          } else if (!rest) {
+            p->set_resting(false);
+          }
+          if (p->stage() == on_destination && (p->resting_for += dt) >= outfeed_delay) {
+            // The outfeed takes it away: out of the physics and collision worlds.
+            p->remove_extension(*p->find_extension<vsd::physics::RigidBody>());
+            outfeed.add_child(*p);
+            p->set_stage(delivered);
+            ++report.parts_handled;
+            if (tl)
+              *tl << "t=" << Orders::fmt(now) << " s  part handled: " << p->name() << " ("
+                  << report.parts_handled << " of " << o.parts << ")\n";
+          }
+        }
+      },
+      vsd::Phase::sensors);
+
+  // --- The nets.
+  vsd::soml::RunOptions run;
+  run.seed = o.seed;
+  std::ostringstream discard;
+  run.out = tl != nullptr ? tl : &discard;
+  vsd::soml::Program& mrc = soml.load(s, o.robot_script, read_text(o.robot_script), run);
+  vsd::soml::Program& meta = soml.load(s, o.meta_script, read_text(o.meta_script), run);
+  for (vsd::soml::Program* p : {&mrc, &meta}) {
+    if (tl == nullptr) continue;
+    // "token: multi_robot_control a.fetch: a.idle -1, a.approaching +1": net, transition, black tokens moved
+    // (places named from the script object down), and where an object token went.
+    const std::string root = p->root().path() + "/";
+    auto local = [root](const vsd::Node& n) {
+      std::string id = n.path();
+      if (id.rfind(root, 0) == 0) id.erase(0, root.size());
+      std::replace(id.begin(), id.end(), '/', '.');
+      return id;
+    };
+    p->on_firing([tl, &now, local, net = p->root().name()](const vsd::soml::Firing& f) {
+      *tl << "t=" << Orders::fmt(now) << " s  token: " << net << ' ' << local(*f.transition);
+      const char* sep = ": ";
+      for (const auto& m : f.taken) *tl << std::exchange(sep, ", ") << local(*m.place) << " -" << m.count;
+      for (const auto& m : f.given) *tl << std::exchange(sep, ", ") << local(*m.place) << " +" << m.count;
+      if (f.from != nullptr || f.to != nullptr)
+        *tl << std::exchange(sep, ", ") << "job " << (f.from ? local(*f.from) : std::string("(new)"))
+            << " -> " << (f.to ? local(*f.to) : std::string("(out)"));
+      *tl << '\n';
+    });
+  }
+
+  // --- The run, with the geometric checks every step.
+  std::ofstream csv;
+  if (!o.csv.empty()) {
+    csv.open(o.csv);
+    if (!csv) throw vsd::Error("cannot write " + o.csv);
+    csv << "time,a_x,a_y,a_z,b_x,b_y,b_z,a_in_zone,b_in_zone,arm_distance,parts_handled\n";
+  }
+  report.min_arm_distance = std::numeric_limits<double>::infinity();
+  double quiet_since = 0;
+  std::map<Part*, double> belt_y_before;  // to tell a moving belt from a full, stopped one
+  // Until every part is handled, then until the robots are back at rest (their nets idle) — at most 20 s.
+  double drained_at = -1;
+  for (;;) {
+    if (report.parts_handled == o.parts) {
+      if (drained_at < 0) drained_at = env.time();
+      const bool still = robots[0]->controller->done() && robots[1]->controller->done() &&
+                         robots[0]->arrived() && robots[1]->arrived() && !mrc.enabled_any() &&
+                         !meta.enabled_any();
+      if (still || env.time() - drained_at > 20.0) break;
+    }
+    if (env.time() >= time_limit) {
+      report.timed_out = true;
+      break;
+    }
+    belt_y_before.clear();
+    for (Part* p : belt) belt_y_before[p] = p->belt_y;
+    env.step();
+    double d = std::numeric_limits<double>::infinity();
+    for (const auto* ha : spheres[0])
+      for (const auto* hb : spheres[1]) d = std::min(d, contacts.distance(*ha, *hb).distance);
+    report.min_arm_distance = std::min(report.min_arm_distance, d);
+    if (csv.is_open()) {
+      const Eigen::Vector3d pa = robots[0]->pad->world_frame().translation();
+      const Eigen::Vector3d pb = robots[1]->pad->world_frame().translation();
+      csv << env.time() << ',' << pa.x() << ',' << pa.y() << ',' << pa.z() << ',' << pb.x() << ',' << pb.y()
+          << ',' << pb.z() << ',' << in_zone[0] << ',' << in_zone[1] << ',' << d << ','
+          << report.parts_handled << '\n';
+    }
+    // Deadlock: parts left, yet nothing moves and no transition is enabled, for 10 s.
+    const bool belt_moves =
+        std::any_of(belt.begin(), belt.end(), [&](Part* p) { return p->belt_y != belt_y_before[p]; });
+    const bool more_to_come =
+        spawned < o.parts && (belt.empty() || belt.back()->belt_y > belt_start + belt_gap);
+    const bool moving = report.parts_handled == o.parts || belt_moves || more_to_come ||
+                        !robots[0]->controller->done() || !robots[1]->controller->done() ||
+                        std::any_of(placed.begin(), placed.end(),
+                                    [](Part* p) { return !p->resting() || p->stage() == on_destination; });
+    if (moving || mrc.enabled_any() || meta.enabled_any()) {
+      quiet_since = env.time();
+    } else if (env.time() - quiet_since > 10.0) {
+      report.deadlocks = 1;
+      if (tl) *tl << "t=" << Orders::fmt(now) << " s  DEADLOCK: parts left, nothing moves, nothing enabled\n";
+      break;
+    }
+  }
+
+  report.time = drained_at >= 0 ? drained_at : env.time();
+  report.steps = env.scheduler().steps();
+  report.parts_per_hour = report.time > 0 ? report.parts_handled * 3600.0 / report.time : 0;
+  for (int i = 0; i < 2; ++i)
+    report.utilisation[i] = report.time > 0 ? robots[i]->moving_time / report.time : 0;
+  report.firings = mrc.firings() + meta.firings();
+  report.condition_tests = mrc.condition_tests() + meta.condition_tests();
+  for (vsd::soml::Program* p : {&mrc, &meta})
+    for (const std::string& e : p->condition_errors()) report.condition_errors.push_back(e);
+  std::string marking;
+  for (const char* obj : {"a", "b", "zone", "station"}) {
+    vsd::Node* n = mrc.object(obj);
+    n->visit([&](vsd::Node& c) {
+      if (auto* pl = dynamic_cast<vsd::soml::Place*>(&c); pl != nullptr && pl->count() > 0)
+        marking += (marking.empty() ? "" : ", ") + std::string(obj) + "." + pl->name() + " " +
+                   std::to_string(pl->count());
+    });
+  }
+  report.final_marking = marking;
+  return report;
+}
+
+void print_summary(std::ostream& out, const CellReport& r) {
+  char line[160];
+  auto put = [&](const char* fmt, auto... v) {
+    std::snprintf(line, sizeof line, fmt, v...);
+    out << line << '\n';
+  };
+  put("simulated: %.1f s in %llu steps", r.time, static_cast<unsigned long long>(r.steps));
+  put("parts arrived: %d", r.parts_arrived);
+  put("parts handled: %d", r.parts_handled);
+  put("hand-overs: %d", r.handovers);
+  put("parts/hour: %.1f", r.parts_per_hour);
+  put("zone violations: %d", r.zone_violations);
+  put("deadlocks: %d", r.deadlocks);
+  put("min arm distance: %.3f m", r.min_arm_distance);
+  put("utilisation: robot A %.0f %%, robot B %.0f %%", 100 * r.utilisation[0], 100 * r.utilisation[1]);
+  put("firings: %llu", static_cast<unsigned long long>(r.firings));
+  put("condition tests: %llu", static_cast<unsigned long long>(r.condition_tests));
+  out << "final marking (multi robot control): " << r.final_marking << '\n';
+  for (const std::string& e : r.condition_errors) out << "condition error: " << e << '\n';
+  if (r.timed_out) out << "stopped: time limit reached\n";
+}
+
+}  // namespace vsd_workcell
+
+namespace vsd_workcell {
+
+void parse_options(const std::vector<std::string>& args, CellOptions& o) {
+  auto value = [&](std::size_t& i) -> const std::string& {
+    if (i + 1 >= args.size()) throw vsd::Error(args[i] + ": needs a value");
+    return args[++i];
+  };
+  auto number = [&](std::size_t& i, double lo, double hi) {
+    const std::string& flag = args[i];
+    const std::string& v = value(i);
+    std::size_t used = 0;
+    double x = 0;
+    try {
+      x = std::stod(v, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != v.size() || v.empty() || !(x >= lo && x <= hi)) {
+      std::ostringstream m;
+      m << flag << ": '" << v << "' is not a number in [" << lo << ", " << hi << "]";
+      throw vsd::Error(m.str());
+    }
+    return x;
+  };
+  auto whole = [&](std::size_t& i, double lo, double hi) {
+    const std::string& flag = args[i];
+    const std::string& v = value(i);
+    if (v.empty() || v.find_first_not_of("0123456789") != std::string::npos || v.size() > 15 ||
+        std::stod(v) < lo || std::stod(v) > hi) {
+      std::ostringstream m;
+      m << flag << ": '" << v << "' is not a whole number in [" << lo << ", " << hi << "]";
+      throw vsd::Error(m.str());
+    }
+    return std::stoll(v);
+  };
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--seed")
+      o.seed = static_cast<std::uint64_t>(whole(i, 0, 1e15));
+    else if (a == "--parts")
+      o.parts = static_cast<int>(whole(i, 1, 1e6));
+    else if (a == "--step")
+      o.step = number(i, 1e-4, 0.05);
+    else if (a == "--physics-step")
+      o.physics_step = number(i, 1e-4, 0.05);
+    else if (a == "--time-limit")
+      o.time_limit = number(i, 1, 1e9);
+    else if (a == "--csv")
+      o.csv = value(i);
+    else if (a == "--urdf")
+      o.urdf = value(i);
+    else if (a == "--meta")
+      o.meta_script = value(i);
+    else if (a == "--robots")
+      o.robot_script = value(i);
+    else
+      throw vsd::Error("unknown option '" + a + "'");
+  }
+  if (o.physics_step > o.step) throw vsd::Error("--physics-step must not exceed --step");
+}
+
+}  // namespace vsd_workcell

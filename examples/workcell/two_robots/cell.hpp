@@ -1,0 +1,70 @@
+// The paper's work cell (section 4.2, figures 11 and 12) in one process: two 8-axis robots (an iiwa14 on a
+// linear axis each) facing a shared zone, a conveyor bringing parts of two kinds, a hand-over station in
+// the zone, and two SOML++ supervisory controls: "Meta Control" (meta_control.soml: arriving parts become
+// jobs with a route) and "Multi Robot Control" (multi_robot_control.soml: each robot's motion sequence,
+// the shared zone mutually exclusive, hand-overs synchronised by communication arrows).
+//
+// run_cell() builds the cell, runs it until the requested number of parts is handled and returns what
+// the summary prints. main.cpp is the command line; tests/examples/workcell/two_robot_cell_test.cpp runs
+// it on several seeds.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace vsd {
+class Environment;
+}
+
+namespace vsd_workcell {
+
+/// What run_cell() needs. The defaults are the demo's.
+struct CellOptions {
+  std::string urdf;                  ///< the iiwa14 URDF (tests/scene/data/iiwa14.urdf)
+  std::string meta_script;           ///< meta_control.soml
+  std::string robot_script;          ///< multi_robot_control.soml
+  std::uint64_t seed = 1;            ///< part kinds and arrival times; the nets' choices
+  int parts = 20;                    ///< run until this many parts are handled
+  double step = 0.01;                ///< s: the scheduler's base step (control, sensors, checks)
+  double physics_step = 0.001;       ///< s: ODE's fixed step inside a scheduler step
+  std::string csv;                   ///< when not empty: one row per step (robots, distance, zone)
+  std::ostream* timeline = nullptr;  ///< when set: σ events, γ commands, token moves, parts handled
+  double time_limit = 0;             ///< s of simulated time; 0: 60 s per part
+};
+
+/// What a run did: the summary's figures.
+struct CellReport {
+  int parts_arrived = 0;
+  int parts_handled = 0;  ///< resting on their destination, taken away by the outfeed
+  int handovers = 0;      ///< parts that went through the hand-over station
+  double time = 0;        ///< s simulated
+  double parts_per_hour = 0;
+  std::uint64_t steps = 0;
+  int zone_violations = 0;         ///< steps in which both arms were in the shared zone (geometry)
+  int deadlocks = 0;               ///< 1 when the cell stopped with parts left and nothing enabled or moving
+  double min_arm_distance = 0;     ///< m, between the arms' collision spheres, over every step
+  double utilisation[2] = {0, 0};  ///< fraction of the time each robot (A, B) was moving
+  std::uint64_t firings = 0;       ///< both nets
+  std::uint64_t condition_tests = 0;  ///< both nets
+  std::vector<std::string> condition_errors;
+  std::string final_marking;  ///< Multi Robot Control's places
+  bool timed_out = false;
+};
+
+/// Adds the modules the cell uses to @p env — robotics, physics, collision (with the given update period),
+/// the cell's own classes (Robot, Part, Orders, Conveyor, Station), SOML++ — so that its scripts check.
+void add_cell_modules(vsd::Environment& env, double collision_period = 0.01);
+
+/// Builds the cell and runs it. @throws vsd::Error on bad options, unreadable files or a plant fault.
+CellReport run_cell(const CellOptions& options);
+
+/// Writes the summary lines (`parts handled: N`, `parts/hour: X`, `zone violations: N`, ...).
+void print_summary(std::ostream& out, const CellReport& report);
+
+/// Parses the command line (argv[0] excluded) into @p options.
+/// @throws vsd::Error naming the bad option and why.
+void parse_options(const std::vector<std::string>& args, CellOptions& options);
+
+}  // namespace vsd_workcell
