@@ -16,69 +16,19 @@
 #include "vsd/core.hpp"
 #include "vsd/scene.hpp"
 #include "vsd/web.hpp"
+#include "web_inspected.hpp"
 #ifdef VSD_BENCH_WEB_PHYSICS
 #include "physics_scene.hpp"
 #endif
 
 namespace {
 
-using vsd_web_test::connect_local;
+using vsd_bench::host_of;
+using vsd_bench::Inspected;
+using vsd_bench::StreamReader;
 using vsd_web_test::http_text;
 using vsd_web_test::raw_http;
-using vsd_web_test::send_all;
 
-std::string host_of(const vsd::web::Server& s) { return "127.0.0.1:" + std::to_string(s.port()); }
-
-/// Reads the event stream until stopped; counts bytes and calls @p on_data with what arrived.
-class StreamReader {
- public:
-  template <class F>
-  StreamReader(const vsd::web::Server& s, F on_data) {
-    fd_ = connect_local(s.port(), 1);
-    (void)send_all(fd_, http_text("GET", "/api/events", host_of(s), "", {}));
-    thread_ = std::thread([this, on_data] {
-      char buf[65536];
-      while (!stop_) {
-        const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
-        if (n == 0) break;
-        if (n < 0) continue;  // the receive timeout: look at stop_ again
-        bytes_ += static_cast<std::size_t>(n);
-        on_data(std::string_view(buf, static_cast<std::size_t>(n)));
-      }
-    });
-  }
-  ~StreamReader() {
-    stop_ = true;
-    ::shutdown(fd_, SHUT_RDWR);
-    thread_.join();
-    ::close(fd_);
-  }
-  [[nodiscard]] std::size_t bytes() const { return bytes_; }
-
- private:
-  int fd_ = -1;
-  std::atomic<bool> stop_{false};
-  std::atomic<std::size_t> bytes_{0};
-  std::thread thread_;
-};
-
-/// The three cases of the step benchmarks: @p mode 0 no server, 1 a server with one page connected to its
-/// event stream, 2 the same with the timeline off.
-struct Inspected {
-  std::unique_ptr<vsd::web::Server> server;
-  std::unique_ptr<StreamReader> page;
-  Inspected(vsd::Environment& env, vsd::SimState& s, std::int64_t mode) {
-    if (mode == 0) return;
-    vsd::web::Options o;
-    o.port = 0;
-    if (mode == 2) o.timeline_bytes = 0;
-    server = std::make_unique<vsd::web::Server>(env, s, o);
-    server->start();
-    page = std::make_unique<StreamReader>(*server, [](std::string_view) {});
-    while (server->stats().clients == 0) server->serve_for(std::chrono::milliseconds(1));
-  }
-  ~Inspected() { page.reset(); }  // the page goes before its server
-};
 
 /// A cell-sized scene: @p n boxes (a Node3D with a box hull each) that move every step.
 std::vector<vsd::scene::Node3D*> boxes(vsd::SimState& s, int n) {

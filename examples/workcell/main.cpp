@@ -37,12 +37,13 @@
 #include <vector>
 
 #include "scene_kit.hpp"
+#include "serve_option.hpp"
 #include "vsd/collision.hpp"
 #include "vsd/physics.hpp"
 #include "vsd/robotics.hpp"
 #include "vsd/soml.hpp"
 #ifdef VSD_WORKCELL_WEB
-#include "vsd/web.hpp"
+#include "live_view.hpp"
 #endif
 
 #ifndef VSD_WORKCELL_SCRIPT
@@ -165,31 +166,15 @@ std::string where(const Node3D& n) {
 
 }  // namespace cell
 
-namespace {
-std::atomic<bool> interrupted{false};  // Ctrl-C or SIGTERM while serving
-extern "C" void on_stop_signal(int) { interrupted = true; }
-}  // namespace
-
 int main(int argc, char** argv) try {
   using namespace cell;
   using vsd::scene::GeometryKind;
   // Positional arguments, and --serve [PORT] anywhere.
-  std::vector<std::string> args;
+  std::vector<std::string> args(argv + 1, argv + argc);
   int serve_port = -1;  // -1: not serving
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a != "--serve") {
-      args.push_back(a);
-      continue;
-    }
-    serve_port = 8080;
-    if (i + 1 < argc && std::string(argv[i + 1]).find_first_not_of("0123456789") == std::string::npos) {
-      serve_port = std::atoi(argv[++i]);
-      if (serve_port > 65535) {
-        std::cerr << "vsd_workcell: --serve: port " << serve_port << " is not in 0..65535\n";
-        return 2;
-      }
-    }
+  if (std::string error; !vsd_example::take_serve_option(args, serve_port, error)) {
+    std::cerr << "vsd_workcell: " << error << '\n';
+    return 2;
   }
   if (args.empty() || args.size() > 3) {
     std::cerr << "usage: vsd_workcell IIWA14.URDF [workcell.soml] [OUTDIR] [--serve [PORT]]\n";
@@ -373,30 +358,12 @@ int main(int argc, char** argv) try {
 #ifdef VSD_WORKCELL_WEB
   // --serve: the cell in the browser. The server answers between steps (its scheduler tasks); the loop
   // keeps real time and waits while the page has paused it.
-  std::unique_ptr<vsd::web::Server> server;
-  if (serve_port >= 0) {
-    vsd::web::Options web_options;
-    web_options.port = serve_port;
-    server = std::make_unique<vsd::web::Server>(env, s, web_options);
-    server->start();
-    std::signal(SIGINT, on_stop_signal);
-    std::signal(SIGTERM, on_stop_signal);
-    std::printf("web: serving %s (write token %s); Ctrl-C stops\n", server->url().c_str(), server->token().c_str());
-    std::fflush(stdout);
-  }
-  const auto wall_start = std::chrono::steady_clock::now();
-  double paused_for = 0;  // wall-clock seconds spent paused, not owed to real time
+  std::unique_ptr<vsd_example::LiveView> live;
+  if (serve_port >= 0) live = std::make_unique<vsd_example::LiveView>(env, s, serve_port);
 #endif
   while (env.time() < time_limit && done->count() < static_cast<std::int64_t>(boxes.size())) {
 #ifdef VSD_WORKCELL_WEB
-    if (server) {
-      if (interrupted) break;
-      const auto pause_start = std::chrono::steady_clock::now();
-      while (server->paused() && !interrupted) server->serve_for(std::chrono::milliseconds(20));
-      paused_for += std::chrono::duration<double>(std::chrono::steady_clock::now() - pause_start).count();
-      const double ahead = env.time() - (std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count() - paused_for);
-      if (ahead > 0) server->serve_for(std::chrono::milliseconds(static_cast<long>(ahead * 1000)));
-    }
+    if (live && !live->pace(env)) break;
 #endif
     // The scenario's disturbance (the plant's, not the supervisor's): while the robot comes down onto
     // box2, an operator slides the box 7 cm aside. The descent then ends without a contact, and the
@@ -468,13 +435,7 @@ int main(int argc, char** argv) try {
                       net.place("robot_free", supervisor)->count() == 1;
   std::printf("check: final marking %s\n", marked ? "all jobs done, robot free" : "NOT complete");
 #ifdef VSD_WORKCELL_WEB
-  if (server) {
-    std::printf("web: the cell stays on %s until Ctrl-C\n", server->url().c_str());
-    std::fflush(stdout);
-    server->pause(true);
-    while (!interrupted) server->serve_for(std::chrono::milliseconds(100));
-    std::printf("web: stopped\n");
-  }
+  if (live) live->linger();
 #endif
   return all && marked && net.condition_errors().empty() ? 0 : 1;
 } catch (const std::exception& e) {

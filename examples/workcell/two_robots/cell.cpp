@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -300,6 +301,16 @@ CellReport run_cell(const CellOptions& o) {
   const double time_limit = o.time_limit > 0 ? o.time_limit : 60.0 * o.parts;
 
   vsd::Environment env;
+  // on_finished runs before the Environment goes, however the run ends.
+  bool completed = false;
+  struct Finish {
+    const CellOptions& o;
+    vsd::Environment& env;
+    const bool& completed;
+    ~Finish() {
+      if (o.on_finished) o.on_finished(env, completed);
+    }
+  } finish{o, env, completed};
   env.scheduler().set_base_step(o.step);
   add_cell_modules(env, o.step);
   auto& collision = env.use<vsd::collision::Module>(o.step);
@@ -622,6 +633,8 @@ CellReport run_cell(const CellOptions& o) {
   std::map<Part*, double> belt_y_before;  // to tell a moving belt from a full, stopped one
   // Until every part is handled, then until the robots are back at rest (their nets idle) — at most 20 s.
   double drained_at = -1;
+  std::vector<double> step_times;  // s of wall time per env.step()
+  if (o.on_built) o.on_built(env);
   for (;;) {
     if (report.parts_handled == o.parts) {
       if (drained_at < 0) drained_at = env.time();
@@ -636,7 +649,13 @@ CellReport run_cell(const CellOptions& o) {
     }
     belt_y_before.clear();
     for (Part* p : belt) belt_y_before[p] = p->belt_y;
+    if (o.before_step && !o.before_step(env)) {
+      report.interrupted = true;
+      break;
+    }
+    const auto step_start = std::chrono::steady_clock::now();
     env.step();
+    step_times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count());
     double d = std::numeric_limits<double>::infinity();
     for (const auto* ha : spheres[0])
       for (const auto* hb : spheres[1]) d = std::min(d, contacts.distance(*ha, *hb).distance);
@@ -666,6 +685,16 @@ CellReport run_cell(const CellOptions& o) {
     }
   }
 
+  if (!step_times.empty()) {
+    const auto quantile = [&](double q) {
+      const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(step_times.size() - 1));
+      std::nth_element(step_times.begin(), step_times.begin() + k, step_times.end());
+      return step_times[static_cast<std::size_t>(k)];
+    };
+    for (double t : step_times) report.step_total += t;
+    report.step_p50 = quantile(0.5);
+    report.step_p99 = quantile(0.99);
+  }
   report.time = drained_at >= 0 ? drained_at : env.time();
   report.steps = env.scheduler().steps();
   report.parts_per_hour = report.time > 0 ? report.parts_handled * 3600.0 / report.time : 0;
@@ -685,6 +714,7 @@ CellReport run_cell(const CellOptions& o) {
     });
   }
   report.final_marking = marking;
+  completed = true;
   return report;
 }
 
@@ -707,7 +737,9 @@ void print_summary(std::ostream& out, const CellReport& r) {
   put("condition tests: %llu", static_cast<unsigned long long>(r.condition_tests));
   out << "final marking (multi robot control): " << r.final_marking << '\n';
   for (const std::string& e : r.condition_errors) out << "condition error: " << e << '\n';
+  put("step time: p50 %.3f ms, p99 %.3f ms (wall, both robots and both nets)", 1e3 * r.step_p50, 1e3 * r.step_p99);
   if (r.timed_out) out << "stopped: time limit reached\n";
+  if (r.interrupted) out << "stopped: interrupted\n";
 }
 
 }  // namespace vsd_workcell

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -32,6 +33,13 @@ struct CellOptions {
   std::string csv;                   ///< when not empty: one row per step (robots, distance, zone)
   std::ostream* timeline = nullptr;  ///< when set: σ events, γ commands, token moves, parts handled
   double time_limit = 0;             ///< s of simulated time; 0: 60 s per part
+  /// Called once the cell is built, before the first step (the `--serve` inspector attaches here).
+  std::function<void(vsd::Environment&)> on_built;
+  /// Called before every step; false ends the run there (`interrupted` in the report).
+  std::function<bool(vsd::Environment&)> before_step;
+  /// Called when the run ends, before the cell is torn down — also when it ends by an error (@p completed
+  /// false then). Whatever on_built attached to the Environment must let go of it here.
+  std::function<void(vsd::Environment&, bool completed)> on_finished;
 };
 
 /// What a run did: the summary's figures.
@@ -51,6 +59,10 @@ struct CellReport {
   std::vector<std::string> condition_errors;
   std::string final_marking;  ///< Multi Robot Control's places
   bool timed_out = false;
+  bool interrupted = false;  ///< before_step ended the run
+  double step_p50 = 0;       ///< s of wall time per step (Environment::step: control, physics, collision,
+  double step_p99 = 0;       ///< sensors, both nets), median and 99th percentile
+  double step_total = 0;     ///< s of wall time in Environment::step over the run
 };
 
 /// Adds the modules the cell uses to @p env — robotics, physics, collision (with the given update period),
