@@ -18,6 +18,7 @@
 #include "vsd/core/value.hpp"
 #include "vsd/core/watch.hpp"
 #include "dep_table.hpp"
+#include "opcodes.hpp"
 #include "vsd/soml/checker.hpp"
 #include "vsd/soml/net_classes.hpp"
 #include "vsd/soml/runtime.hpp"
@@ -44,117 +45,6 @@ struct VecReg {
 // Register kinds of a static type (V: a vector, its elements of kind vector_elem_kind(); X: any other
 // value as a vsd::Value in the fourth parallel array: structs, and vectors of structs and enums).
 enum class RK : std::uint8_t { I, D, S, R, V, X, None };
-
-enum Op : std::uint8_t {
-  OP_NOP,
-  OP_LOADI,  // a = (int16) b
-  OP_LOADK,  // a = consts[b]            (ints and doubles as raw bits)
-  OP_LOADS,  // S[a] = strings[b]
-  OP_MOV,    // a = b
-  OP_MOVS,   // S[a] = S[b]
-  OP_ADDI,
-  OP_SUBI,
-  OP_MULI,
-  OP_DIVI,
-  OP_MODI,
-  OP_ADDD,
-  OP_SUBD,
-  OP_MULD,
-  OP_DIVD,
-  OP_ADDIK,  // a = b + (int16) c
-  OP_MULIK,  // a = b * (int16) c
-  OP_DIVIK,  // a = b / (int16) c   (c not 0 or -1)
-  OP_MODIK,  // a = b % (int16) c   (c not 0 or -1)
-  OP_NEGI,
-  OP_NEGD,
-  OP_NOT,
-  OP_I2D,
-  OP_D2I,
-  OP_LTI,
-  OP_LEI,
-  OP_EQI,
-  OP_NEI,
-  OP_LTD,
-  OP_LED,
-  OP_EQD,
-  OP_NED,
-  OP_LTS,
-  OP_LES,
-  OP_EQS,
-  OP_NES,
-  OP_CONCAT,   // S[a] = S[b] + S[c]
-  OP_TOSTR,    // S[a] = text of b; c: 0 int, 1 double, 2 bool, 3+k enum k
-  OP_STR2B,    // a = !S[b].empty()
-  OP_JMP,      // pc = target
-  OP_JMPF,     // if (!a) pc = target
-  OP_JMPT,     // if (a) pc = target
-  OP_JGEI,     // if (a >= b) pc = target   (fused loop test)
-  OP_JGTI,     // if (a > b) pc = target
-  OP_CALL,     // call functions[b] with frame at a, self in register c; result in a
-  OP_VCALL,    // like CALL, but b is a virtual slot resolved on the class of self
-  OP_RET,      // return register a
-  OP_RET0,     // return nothing
-  OP_RETV,     // return vector register a (a function whose result is a vector)
-  OP_SELF,     // a = instance of scope b levels out (outer plan b)
-  OP_MARK,     // a = mark
-  OP_OBJ,      // a = id of object consts[b]
-  OP_GETP,     // a = property props[c] of instance b
-  OP_SETP,     // property props[c] of instance a = b
-  OP_PLACE,    // a = place node number c of the net instance b (c & kPortPlace: a port net's, of copy b)
-  OP_PCOUNT,   // a = count of place b
-  OP_PPUT,     // place a .put(b)
-  OP_PCLEAR,   // place a .clear()
-  OP_LSIZE,    // a = size of list props[c] of b
-  OP_LGET,     // a = element (id) R[a] of list props[c] of b   (a holds the index on entry)
-  OP_LPUSH,    // list props[c] of a .push(b)
-  OP_NEW,      // a = new classes[b]; arguments from a+1, c of them
-  OP_ISA,      // a = instance b is_a classes[c]
-  OP_AS,       // a = instance b if is_a classes[c] else null
-  OP_MCALL,    // a = MetaMethod methods[b] on instance R[a], arguments from a+1 (count in the method)
-  OP_BUILTIN,  // a = builtin b over registers a.. (c: variant)
-  OP_PRINT,    // print registers a .. a+b-1; kinds from print_kinds[c]
-  OP_NULLCHK,  // error "null" unless a
-  OP_RANGE,    // check that a fits the storage type consts[b] (int properties narrower than int64)
-  OP_FAIL,     // run-time error strings[b]
-  OP_BREAK,    // debugger: patched over a line start; calls the hook, then runs Function::tramp[2 pc]
-  OP_RESUME,   // the second instruction of a trampoline: pc = target (no budget)
-  // Vectors (x: 1 when the elements are strings, else 0; for OP_EQV 0 int, 1 double, 2 string).
-  OP_MOVV,    // V[a] = V[b] (a copy: vectors are values)
-  OP_VCLEAR,  // V[a] = {}
-  OP_VSIZE,   // a = size of V[b]
-  OP_VGET,    // a = V[b][R[c]]            (range-checked)
-  OP_VSET,    // V[a][R[b]] = c            (range-checked)
-  OP_VPUSH,   // V[a].push(b)
-  OP_EQV,     // a = V[b] == V[c]
-  OP_PVSIZE,  // a = size of vector property props[c] of instance b (no copy)
-  OP_PVGET,   // a = element R[a] of vector property props[c] of instance b (no copy; range-checked)
-  OP_FIND,    // a = the node at path S[b] from the database, or null
-  // Values (X registers: structs, vectors of structs and enums; out of line like the vector ones).
-  OP_XDEF,    // X[a] = default value of xtypes[b]
-  OP_MOVX,    // X[a] = X[b] (a copy)
-  OP_XGETF,   // a = field x of struct X[b]          (register kind from the field's type)
-  OP_XSETF,   // field x of struct X[a] = b
-  OP_EQX,     // a = X[b] == X[c]
-  OP_RETX,    // return X register a (a function whose result is a Value)
-  OP_XVSIZE,  // a = size of vector X[b]
-  OP_XVGET,   // a = X[b][R[c]]                     (range-checked)
-  OP_XVSET,   // X[a][R[b]] = c                     (range-checked)
-  OP_XVPUSH,  // X[a].push(b)
-  OP_XOP      // a = StructOp x over b and c (struct_ops.cpp): structs in X, scalars in D, Text into S
-};
-
-// OP_PLACE's operand c with this bit: a place of a port net (index into port_places_), found from the
-// copy's instance.
-inline constexpr std::size_t kPortPlace = 0x8000;
-
-struct Ins {
-  std::uint8_t op;
-  std::uint8_t x;  // spare
-  std::uint16_t a;
-  std::uint16_t b;
-  std::uint16_t c;
-};
-static_assert(sizeof(Ins) == 8);
 
 struct Function {
   std::string name;  // "Demo.time_to", "cell.go (condition)"
