@@ -174,4 +174,9 @@ struct ProgramImage {
   std::unordered_map<const FunctionDecl*, int> function_index;
 };
 
+/// The bytecode of @p img as text (disasm.cpp; `vsd-soml disasm`): per function its name, file:line,
+/// parameters, registers, locals and instructions (index, opcode name, operands, line:column), then the
+/// constants and strings.
+std::string disassemble(const ProgramImage& img);
+
 }  // namespace vsd::soml

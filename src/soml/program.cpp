@@ -1316,6 +1316,8 @@ void Program::on_firing(std::function<void(const Firing&)> fn) { impl_->trace_ =
 std::size_t Program::watched_properties() const noexcept { return impl_->deps_map_.size(); }
 std::size_t Program::executor_entries() const noexcept { return impl_->tis_.size(); }
 std::uint64_t Program::condition_tests() const noexcept { return impl_->tests_; }
+std::string Program::disassemble() const { return soml::disassemble(impl_->image()); }
+
 const std::vector<std::string>& Program::condition_errors() const noexcept {
   return impl_->condition_errors_;
 }
