@@ -111,7 +111,8 @@ std::unique_ptr<NetInst> ProgramImpl::find_net(const ClassInfo& ci, SimStateInst
   net->transitions.assign(nc.transitions.size(), nullptr);
   const std::string who = owner.meta().name() + " '" + on.name() + "' (#" + std::to_string(owner.id()) + ")";
   auto disagree = [&](const std::string& what) {
-    throw Error(checked_->source->name() + ": the net of " + who + " does not match the script: " + what);
+    throw Error(image().checked->source->name() + ": the net of " + who +
+                " does not match the script: " + what);
   };
   auto meta_of = [&](const Decl* d, const MetaInstance& fallback) {
     auto it = scope_meta_.find(d);
@@ -166,22 +167,22 @@ std::unique_ptr<NetInst> ProgramImpl::find_net(const ClassInfo& ci, SimStateInst
 }
 
 void ProgramImpl::attach_content() {
-  const ClassDecl& root = *checked_->script.root;
-  const std::string& file = checked_->source->name();
+  const ClassDecl& root = *image().checked->script.root;
+  const std::string& file = image().checked->source->name();
   Node& db = state_.database();
   // The script object, its objects (by name and class, as load made them).
-  const MetaInstance& root_meta = *class_info_.at(&root)->meta;
+  const MetaInstance& root_meta = *image().class_info.at(&root)->meta;
   for (Node* c : db.children())
-    if (c != nullptr && c->name() == stem_ && &c->meta() == &root_meta) root_ = c;
+    if (c != nullptr && c->name() == image().stem && &c->meta() == &root_meta) root_ = c;
   if (root_ == nullptr)
-    throw Error(file + ": the state holds no script object '" + stem_ + "' (a node of class " +
+    throw Error(file + ": the state holds no script object '" + image().stem + "' (a node of class " +
                 root_meta.name() + " under the Database): nothing to attach to");
   std::function<void(const ClassDecl&, SimStateInstance&, const std::string&)> find =
       [&](const ClassDecl& c, SimStateInstance& inst, const std::string& path) {
         object_ids_[&c] = inst.id();
         for (const DeclPtr& m : c.members) {
           if (m->kind != DeclKind::Object) continue;
-          const MetaInstance& meta = *class_info_.at(&m->as<ClassDecl>())->meta;
+          const MetaInstance& meta = *image().class_info.at(&m->as<ClassDecl>())->meta;
           Node* found = nullptr;
           for (Node* x : inst.as<Node>()->children())
             if (x != nullptr && x->name() == m->name && &x->meta() == &meta) found = x;
@@ -192,22 +193,19 @@ void ProgramImpl::attach_content() {
         }
       };
   find(root, *root_, "");
-  for (auto& [slot, decl] : object_refs_)
-    consts_[static_cast<std::size_t>(slot)] = static_cast<std::int64_t>(object_ids_.at(decl));
-  for (OuterPlan& p : outer_plans_)
-    if (p.static_decl != nullptr) p.static_id = object_ids_.at(p.static_decl);
+  link_objects();
 
   // The source: the same text, or the bytecode would not be the state's.
   for (Node* c : db.children())
     if (auto* f = c != nullptr ? c->as<SourceFile>() : nullptr;
-        f != nullptr && f->name() == stem_ + " (source)")
+        f != nullptr && f->name() == image().stem + " (source)")
       source_node_ = f;
   if (source_node_ == nullptr)
-    throw Error(file + ": the state holds no source of script '" + stem_ + "' (a soml::SourceFile named '" +
-                stem_ + " (source)')");
-  if (source_node_->text() != checked_->source->text()) {
+    throw Error(file + ": the state holds no source of script '" + image().stem +
+                "' (a soml::SourceFile named '" + image().stem + " (source)')");
+  if (source_node_->text() != image().checked->source->text()) {
     const std::string& a = source_node_->text();
-    const std::string& b = checked_->source->text();
+    const std::string& b = image().checked->source->text();
     std::size_t line = 1, i = 0;
     for (; i < a.size() && i < b.size() && a[i] == b[i]; ++i)
       if (a[i] == '\n') ++line;
@@ -236,7 +234,7 @@ void ProgramImpl::attach_content() {
   for (Node* c : root_->children())
     if (auto* e = c != nullptr ? c->as<Executor>() : nullptr; e != nullptr) exec_ = e;
   if (exec_ == nullptr)
-    throw Error(file + ": script object '" + stem_ +
+    throw Error(file + ": script object '" + image().stem +
                 "' has no executor state (a soml::Executor child named "
                 "'(executor)'): the state was not made by a running program");
   rng_ = exec_->rng();

@@ -83,7 +83,8 @@ bool x_vector(const Type& t) { return t.kind == K::Vector && reg_kind(t) == RK::
 }  // namespace
 
 std::string where(const ProgramImpl& p, SourceLoc loc) {
-  return p.checked_->source->name() + ":" + std::to_string(loc.line) + ":" + std::to_string(loc.column);
+  return p.image().checked->source->name() + ":" + std::to_string(loc.line) + ":" +
+         std::to_string(loc.column);
 }
 
 void not_supported(const ProgramImpl& p, SourceLoc loc, const std::string& what) {
@@ -149,10 +150,10 @@ class Compiler {
     F.code[at].x = static_cast<std::uint8_t>(target >> 16);
   }
   int xtype(const MetaType* t) {
-    auto it = std::find(P.xtypes_.begin(), P.xtypes_.end(), t);
-    if (it != P.xtypes_.end()) return static_cast<int>(it - P.xtypes_.begin());
-    P.xtypes_.push_back(t);
-    return static_cast<int>(P.xtypes_.size() - 1);
+    auto it = std::find(P.build().xtypes.begin(), P.build().xtypes.end(), t);
+    if (it != P.build().xtypes.end()) return static_cast<int>(it - P.build().xtypes.begin());
+    P.build().xtypes.push_back(t);
+    return static_cast<int>(P.build().xtypes.size() - 1);
   }
   int temp() {
     const int r = top_++;
@@ -179,14 +180,16 @@ class Compiler {
   };
 
   int konst(std::int64_t v) {
-    if (P.consts_.size() >= 65535) not_supported(P, SourceLoc{}, "more than 65535 constants in one script");
-    P.consts_.push_back(v);
-    return static_cast<int>(P.consts_.size() - 1);
+    if (P.build().consts.size() >= 65535)
+      not_supported(P, SourceLoc{}, "more than 65535 constants in one script");
+    P.build().consts.push_back(v);
+    return static_cast<int>(P.build().consts.size() - 1);
   }
   int string_const(const std::string& s) {
-    if (P.strings_.size() >= 65535) not_supported(P, SourceLoc{}, "more than 65535 strings in one script");
-    P.strings_.push_back(s);
-    return static_cast<int>(P.strings_.size() - 1);
+    if (P.build().strings.size() >= 65535)
+      not_supported(P, SourceLoc{}, "more than 65535 strings in one script");
+    P.build().strings.push_back(s);
+    return static_cast<int>(P.build().strings.size() - 1);
   }
   void load_int(int r, std::int64_t v) {
     if (v >= -32768 && v <= 32767)
@@ -212,8 +215,8 @@ class Compiler {
       }
       s = ps;
     }
-    P.outer_plans_.push_back(plan);
-    return static_cast<int>(P.outer_plans_.size() - 1);
+    P.build().outer_plans.push_back(plan);
+    return static_cast<int>(P.build().outer_plans.size() - 1);
   }
   int self_at(int outer, SourceLoc loc) {
     const int r = temp();
@@ -223,21 +226,21 @@ class Compiler {
 
   int prop_slot(const Binding& b, SourceLoc loc) {
     if (b.kind == BK::Property) {
-      auto it = P.prop_slot_.find(&b.decl->as<PropertyDecl>());
-      if (it == P.prop_slot_.end()) not_supported(P, loc, "this property");
+      auto it = P.build().prop_slot.find(&b.decl->as<PropertyDecl>());
+      if (it == P.build().prop_slot.end()) not_supported(P, loc, "this property");
       return it->second;
     }
     const int slot = meta_slot(b.property);
     // What the VM cannot move between a property and a register is refused here, at load, never at run
     // time (every kind is handled today; a new one must be added to meta_slot and the VM first).
-    const PropSlot& ps = P.props_[static_cast<std::size_t>(slot)];
+    const PropSlot& ps = P.build().props[static_cast<std::size_t>(slot)];
     if (ps.kind == PK::Other && ps.prop->type().kind() != TypeKind::Float)
       not_supported(P, loc, "property '" + ps.prop->name() + "' of type " + ps.prop->type().name());
     return slot;
   }
   int meta_slot(const MetaProperty* mp) {
-    auto it = P.meta_prop_slot_.find(mp);
-    if (it != P.meta_prop_slot_.end()) return it->second;
+    auto it = P.build().meta_prop_slot.find(mp);
+    if (it != P.build().meta_prop_slot.end()) return it->second;
     PropSlot s;
     s.prop = mp;
     const MetaType& t = mp->type();
@@ -281,9 +284,9 @@ class Compiler {
       default:
         s.kind = PK::Other;  // float: through the MetaType's width (the VM's default cases)
     }
-    P.props_.push_back(s);
-    const int i = static_cast<int>(P.props_.size() - 1);
-    P.meta_prop_slot_[mp] = i;
+    P.build().props.push_back(s);
+    const int i = static_cast<int>(P.build().props.size() - 1);
+    P.build().meta_prop_slot[mp] = i;
     return i;
   }
 
@@ -293,15 +296,16 @@ class Compiler {
   }
   // A place of a port net, named in its code: each copy has its own places (a port is its copy's
   // socket), so OP_PLACE finds it at run time from the copy's instance, the substitution transition's
-  // node (operand c: kPortPlace | index into port_places_).
+  // node (operand c: kPortPlace | index into build().port_places).
   int port_place(const PlaceDecl& pd, SourceLoc loc) {
-    auto it = std::find(P.port_places_.begin(), P.port_places_.end(), &pd);
-    if (it == P.port_places_.end()) {
-      if (P.port_places_.size() >= kPortPlace - 1) not_supported(P, loc, "this many places of port nets");
-      P.port_places_.push_back(&pd);
-      it = P.port_places_.end() - 1;
+    auto it = std::find(P.build().port_places.begin(), P.build().port_places.end(), &pd);
+    if (it == P.build().port_places.end()) {
+      if (P.build().port_places.size() >= kPortPlace - 1)
+        not_supported(P, loc, "this many places of port nets");
+      P.build().port_places.push_back(&pd);
+      it = P.build().port_places.end() - 1;
     }
-    return static_cast<int>(kPortPlace | static_cast<std::size_t>(it - P.port_places_.begin()));
+    return static_cast<int>(kPortPlace | static_cast<std::size_t>(it - P.build().port_places.begin()));
   }
 
   int place_index(const PlaceDecl& pd, SourceLoc loc) {
@@ -309,8 +313,8 @@ class Compiler {
     if (in_port_net(pd))
       not_supported(P, loc, "naming place '" + pd.name + "' of a port net through another instance");
     if (owner == nullptr || !owner->is_class_like()) not_supported(P, loc, "this place");
-    auto it = P.class_info_.find(&owner->as<ClassDecl>());
-    if (it == P.class_info_.end() || !it->second->net) not_supported(P, loc, "this place");
+    auto it = P.build().class_info.find(&owner->as<ClassDecl>());
+    if (it == P.build().class_info.end() || !it->second->net) not_supported(P, loc, "this place");
     const auto& places = it->second->net->places;
     for (std::size_t i = 0; i < places.size(); ++i)
       if (places[i] == &pd) return static_cast<int>(i);
@@ -321,14 +325,14 @@ class Compiler {
     const MetaInstance* m = c.meta;
     const ClassInfo* ci = nullptr;
     if (c.decl != nullptr) {
-      auto it = P.class_info_.find(c.decl);
-      if (it == P.class_info_.end()) not_supported(P, loc, "this class");
+      auto it = P.build().class_info.find(c.decl);
+      if (it == P.build().class_info.end()) not_supported(P, loc, "this class");
       ci = it->second.get();
       m = ci->meta;
     }
-    P.classes_.push_back(ci);
-    P.class_metas_.push_back(m);
-    return static_cast<int>(P.classes_.size() - 1);
+    P.build().classes.push_back(ci);
+    P.build().class_metas.push_back(m);
+    return static_cast<int>(P.build().classes.size() - 1);
   }
 
   // ---- expressions ----
@@ -479,8 +483,8 @@ class Compiler {
       case BK::Object: {
         if (!is_static_instance(*b.decl)) not_supported(P, e.loc, "naming an object nested in a class");
         const int r = temp();
-        P.object_refs_.push_back({konst(0), &b.decl->as<ClassDecl>()});
-        emit(OP_OBJ, r, P.object_refs_.back().first);
+        P.build().object_refs.push_back({konst(0), &b.decl->as<ClassDecl>()});
+        emit(OP_OBJ, r, P.build().object_refs.back().first);
         return r;
       }
       case BK::Place: {
@@ -560,13 +564,13 @@ class Compiler {
       const auto& m = e.as<MemberExpr>();
       if (m.binding.kind == BK::Property || m.binding.kind == BK::MetaProperty) {
         const int slot = prop_slot(m.binding, e.loc);
-        if (P.props_[slot].kind == PK::List) return {expr(*m.object), slot};
+        if (P.build().props[slot].kind == PK::List) return {expr(*m.object), slot};
       }
     } else if (e.kind == ExprKind::Name) {
       const auto& n = e.as<NameExpr>();
       if (n.binding.kind == BK::Property || n.binding.kind == BK::MetaProperty) {
         const int slot = prop_slot(n.binding, e.loc);
-        if (P.props_[slot].kind == PK::List) return {self_at(n.binding.outer, e.loc), slot};
+        if (P.build().props[slot].kind == PK::List) return {self_at(n.binding.outer, e.loc), slot};
       }
     }
     not_supported(P, e.loc, "this list or vector expression (lists are reached as properties)");
@@ -580,7 +584,8 @@ class Compiler {
       b = e.kind == ExprKind::Member ? &e.as<MemberExpr>().binding : &e.as<NameExpr>().binding;
     if (b == nullptr || (b->kind != BK::Property && b->kind != BK::MetaProperty)) return {-1, -1};
     const int slot = prop_slot(*b, e.loc);
-    if (P.props_[slot].kind != PK::Vector && !(P.props_[slot].kind == PK::Value && x_vector(e.type)))
+    if (P.build().props[slot].kind != PK::Vector &&
+        !(P.build().props[slot].kind == PK::Value && x_vector(e.type)))
       not_supported(P, e.loc, "a value of type '" + e.type.name() + "'");
     const int h = e.kind == ExprKind::Member ? expr(*e.as<MemberExpr>().object) : self_at(b->outer, e.loc);
     return {h, slot};
@@ -782,8 +787,8 @@ class Compiler {
           if (it != P.enums_.end()) m = it->second;
         }
         if (m == nullptr) not_supported(P, SourceLoc{}, "this enum");
-        P.enum_types_.push_back(m);
-        variant = 3 + static_cast<int>(P.enum_types_.size() - 1);
+        P.build().enum_types.push_back(m);
+        variant = 3 + static_cast<int>(P.build().enum_types.size() - 1);
         break;
       }
       case K::Ref:
@@ -1073,11 +1078,11 @@ class Compiler {
         const int base = args_at(e.args, want);
         if (base == top_) temp();  // the result register
         at(e.loc);
-        auto v = P.vslot_of_.find(&fd);
-        if (v != P.vslot_of_.end())
+        auto v = P.build().vslot_of.find(&fd);
+        if (v != P.build().vslot_of.end())
           emit(OP_VCALL, base, v->second, self);
         else
-          emit(OP_CALL, base, P.function_index_.at(&fd), self);
+          emit(OP_CALL, base, P.build().function_index.at(&fd), self);
         top_ = base + 1;
         return base;
       }
@@ -1095,16 +1100,16 @@ class Compiler {
         args_at(e.args, want);
         if (reg_kind(e.type) == RK::None && e.type.kind != K::Void)
           not_supported(P, e.loc, "a method returning '" + e.type.name() + "'");
-        P.methods_.push_back(b.method);
-        P.method_kinds_.emplace_back();
+        P.build().methods.push_back(b.method);
+        P.build().method_kinds.emplace_back();
         for (const ExprPtr& a : e.args) {
           if (reg_kind(a->type) == RK::None)
             not_supported(P, a->loc, "an argument of type '" + a->type.name() + "'");
-          P.method_kinds_.back().push_back(reg_kind(a->type));
+          P.build().method_kinds.back().push_back(reg_kind(a->type));
         }
-        P.method_results_.push_back(reg_kind(e.type));
+        P.build().method_results.push_back(reg_kind(e.type));
         at(e.loc);
-        emit(OP_MCALL, r, static_cast<int>(P.methods_.size() - 1));
+        emit(OP_MCALL, r, static_cast<int>(P.build().methods.size() - 1));
         top_ = r + 1;
         return r;
       }
@@ -1199,10 +1204,11 @@ class Compiler {
           types.push_back(k == RK::V ? a.type.meta : nullptr);
           top_ = save;
         }
-        P.print_kinds_.push_back(std::move(kinds));
-        P.print_types_.push_back(std::move(types));
+        P.build().print_kinds.push_back(std::move(kinds));
+        P.build().print_types.push_back(std::move(types));
         at(e.loc);
-        emit(OP_PRINT, base, static_cast<int>(e.args.size()), static_cast<int>(P.print_kinds_.size() - 1));
+        emit(OP_PRINT, base, static_cast<int>(e.args.size()),
+             static_cast<int>(P.build().print_kinds.size() - 1));
         top_ = base;
         return -1;
       }
@@ -1528,8 +1534,8 @@ class Compiler {
     const Decl* d = F.scope;
     for (; d != nullptr && d->kind != DeclKind::Net; d = d->parent) ++outer;
     if (d == nullptr) not_supported(P, r.loc, "'finish' outside an invoked net");
-    auto it = P.class_info_.find(&d->as<ClassDecl>());
-    if (it == P.class_info_.end()) not_supported(P, r.loc, "'finish' in this net");
+    auto it = P.build().class_info.find(&d->as<ClassDecl>());
+    if (it == P.build().class_info.end()) not_supported(P, r.loc, "'finish' in this net");
     const ClassInfo& ci = *it->second;
     if (r.value && ci.result_slot >= 0) {
       const int v = temp();
@@ -1579,7 +1585,7 @@ class Compiler {
 }  // namespace
 
 int compile_function(ProgramImpl& p, int index, const FunctionDecl& fd) {
-  Function& f = *p.functions_[index];
+  Function& f = *p.build().functions[index];
   f.result_type = fd.result_type;
   f.result = reg_kind(fd.result_type);
   Compiler c(p, f, parent_scope(fd), fd.slots);
@@ -1603,14 +1609,14 @@ int compile_function(ProgramImpl& p, int index, const FunctionDecl& fd) {
 }
 
 int new_function(ProgramImpl& p, std::string name) {
-  p.functions_.push_back(std::make_unique<Function>());
-  p.functions_.back()->name = std::move(name);
-  return static_cast<int>(p.functions_.size() - 1);
+  p.build().functions.push_back(std::make_unique<Function>());
+  p.build().functions.back()->name = std::move(name);
+  return static_cast<int>(p.build().functions.size() - 1);
 }
 
 int compile_condition(ProgramImpl& p, const TransitionDecl& t, const std::string& name) {
   const int i = new_function(p, name);
-  Function& f = *p.functions_[i];
+  Function& f = *p.build().functions[i];
   f.result = RK::I;
   f.result_type = Type::of(K::Bool);
   Compiler c(p, f, &t, t.when_slots);
@@ -1629,7 +1635,7 @@ int compile_condition(ProgramImpl& p, const TransitionDecl& t, const std::string
 
 int compile_action(ProgramImpl& p, const TransitionDecl& t, const std::string& name) {
   const int i = new_function(p, name);
-  Function& f = *p.functions_[i];
+  Function& f = *p.build().functions[i];
   Compiler c(p, f, &t, t.action_slots);
   c.block(*t.action);
   c.emit(OP_RET0);
@@ -1639,7 +1645,7 @@ int compile_action(ProgramImpl& p, const TransitionDecl& t, const std::string& n
 
 int compile_arrow_condition(ProgramImpl& p, const ArrowDecl& a, const std::string& name) {
   const int i = new_function(p, name);
-  Function& f = *p.functions_[i];
+  Function& f = *p.build().functions[i];
   f.result = RK::I;
   f.result_type = Type::of(K::Bool);
   Compiler c(p, f, parent_scope(a), a.condition_slots);
@@ -1654,7 +1660,7 @@ int compile_arrow_condition(ProgramImpl& p, const ArrowDecl& a, const std::strin
 // Property initialisers of a class-like declaration, place or transition (self: the new instance).
 int compile_init(ProgramImpl& p, const ScopeDecl& s, const std::string& name) {
   const int i = new_function(p, name);
-  Function& f = *p.functions_[i];
+  Function& f = *p.build().functions[i];
   Compiler c(p, f, &s, 0);
   for (const DeclPtr& m : s.members) {
     if (m->kind != DeclKind::Property) continue;
@@ -1667,7 +1673,7 @@ int compile_init(ProgramImpl& p, const ScopeDecl& s, const std::string& name) {
     c.expr_to(*pd.init, v, pd.type);
     const int self = c.self_at(0, pd.loc);
     c.at(pd.loc);
-    c.emit(OP_SETP, self, v, p.prop_slot_.at(&pd));
+    c.emit(OP_SETP, self, v, p.build().prop_slot.at(&pd));
     c.top_ = 0;
   }
   c.emit(OP_RET0);
@@ -1679,7 +1685,7 @@ int compile_init(ProgramImpl& p, const ScopeDecl& s, const std::string& name) {
 // self is the object's parent scope (where the arguments are evaluated).
 int compile_object_ctor(ProgramImpl& p, const ClassDecl& obj, int ctor, const FunctionDecl& fd) {
   const int i = new_function(p, obj.name + " (constructor arguments)");
-  Function& f = *p.functions_[i];
+  Function& f = *p.build().functions[i];
   f.nparams = 1;
   f.param_kinds = {RK::R};
   Compiler c(p, f, parent_scope(obj), 1);
@@ -1698,7 +1704,7 @@ int compile_object_ctor(ProgramImpl& p, const ClassDecl& obj, int ctor, const Fu
 // evaluated where the transition is (its mark included) and set as the value parameter's property.
 int compile_invoke_args(ProgramImpl& p, const TransitionDecl& t, const std::string& name) {
   const int i = new_function(p, name);
-  Function& f = *p.functions_[i];
+  Function& f = *p.build().functions[i];
   f.nparams = 1;
   f.param_kinds = {RK::R};
   Compiler c(p, f, &t, 1);
@@ -1708,8 +1714,8 @@ int compile_invoke_args(ProgramImpl& p, const TransitionDecl& t, const std::stri
     for (const DeclPtr& m : net.members)
       if (m->kind == DeclKind::Property && m->as<PropertyDecl>().is_param && m->name == net.params[k].name)
         pd = &m->as<PropertyDecl>();
-    auto slot = pd != nullptr ? p.prop_slot_.find(pd) : p.prop_slot_.end();
-    if (slot == p.prop_slot_.end()) not_supported(p, t.invoke_args[k]->loc, "this net parameter");
+    auto slot = pd != nullptr ? p.build().prop_slot.find(pd) : p.build().prop_slot.end();
+    if (slot == p.build().prop_slot.end()) not_supported(p, t.invoke_args[k]->loc, "this net parameter");
     if (reg_kind(pd->type) == RK::None)
       not_supported(p, t.invoke_args[k]->loc, "a net parameter of type '" + pd->type.name() + "'");
     const int v = c.temp();

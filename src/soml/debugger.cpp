@@ -1,9 +1,9 @@
 // The SOML++ debugger (docs/soml.md, section 9). It costs nothing while it needs no stop: breakpoints
-// and stepping patch OP_BREAK over the first instruction of the lines concerned (the original code is
-// kept in Function::original), and the VM meets no extra test on any other instruction. The stop
-// handler runs inside the VM's OP_BREAK (or before a firing), reads the frames and registers through the
-// compiler's tables (line per instruction, locals with their slots and visible ranges), and says how to
-// go on; the debugger then re-patches what the next stop needs.
+// and stepping patch OP_BREAK over the first instruction of the lines concerned in the code the VM runs
+// (ProgramImpl::run_, a run-time copy; the program image's code stays the original), and the VM meets no
+// extra test on any other instruction. The stop handler runs inside the VM's OP_BREAK (or before a firing),
+// reads the frames and registers through the compiler's tables (line per instruction, locals with their slots
+// and visible ranges), and says how to go on; the debugger then re-patches what the next stop needs.
 #include "vsd/soml/debugger.hpp"
 
 #include <algorithm>
@@ -109,10 +109,10 @@ class Debugger::Impl final : public DebugHooks {
   void detach() noexcept {
     if (gone_) return;
     gone_ = true;
-    for (auto& f : P_.functions_) {
-      if (f->original.empty()) continue;
-      f->code = f->original;
-      f->original.clear();
+    for (RunCode& rc : P_.run_) {
+      if (!rc.patched) continue;
+      rc.code = rc.fn->code;  // (the same size: frames that point into it stay valid)
+      rc.patched = false;
     }
     P_.trace_ = previous_trace_;
     P_.debug_ = nullptr;
@@ -148,11 +148,11 @@ class Debugger::Impl final : public DebugHooks {
   std::vector<std::vector<std::uint8_t>> starts_;
 
   const std::vector<std::uint8_t>& starts(std::size_t fi) {
-    if (starts_.size() < P_.functions_.size()) starts_.resize(P_.functions_.size());
+    if (starts_.size() < P_.image().functions.size()) starts_.resize(P_.image().functions.size());
     auto& s = starts_[fi];
-    const Function& f = *P_.functions_[fi];
+    const Function& f = *P_.image().functions[fi];
     if (s.size() == f.code.size()) return s;
-    const std::vector<Ins>& code = f.original.empty() ? f.code : f.original;
+    const std::vector<Ins>& code = f.code;  // the image's: never patched
     s.assign(code.size(), 0);
     for (std::size_t i = 0; i < code.size(); ++i) {
       if (is_jump(code[i].op)) {
@@ -177,28 +177,29 @@ class Debugger::Impl final : public DebugHooks {
     for (const Breakpoint& b : bps_)
       if (b.line != 0) lines.insert(b.line);
     const bool stepping = mode_ != Mode::Run;
-    for (std::size_t fi = 0; fi < P_.functions_.size(); ++fi) {
-      Function& f = *P_.functions_[fi];
+    for (std::size_t fi = 0; fi < P_.image().functions.size(); ++fi) {
+      const Function& f = *P_.image().functions[fi];
+      RunCode& rc = P_.run_[fi];
       if (f.code.empty()) continue;
       const auto& s = starts(fi);
       bool any = false;
       for (std::size_t i = 0; i < s.size() && !any; ++i)
         any = s[i] != 0 && (stepping || (s[i] == 1 && lines.count(f.lines[i]) != 0));
-      if (!any && f.original.empty()) continue;
-      if (f.original.empty()) {
-        f.original = f.code;
-        f.tramp.resize(2 * f.code.size());
+      if (!any && !rc.patched) continue;
+      if (!rc.patched) {
+        rc.patched = true;
+        rc.tramp.resize(2 * f.code.size());
         for (std::size_t i = 0; i < f.code.size(); ++i) {
-          f.tramp[2 * i] = f.code[i];
-          f.tramp[2 * i + 1] = Ins{OP_RESUME, static_cast<std::uint8_t>((i + 1) >> 16), 0, 0,
-                                   static_cast<std::uint16_t>((i + 1) & 0xFFFF)};
+          rc.tramp[2 * i] = f.code[i];
+          rc.tramp[2 * i + 1] = Ins{OP_RESUME, static_cast<std::uint8_t>((i + 1) >> 16), 0, 0,
+                                    static_cast<std::uint16_t>((i + 1) & 0xFFFF)};
         }
       }
       for (std::size_t i = 0; i < s.size(); ++i) {
-        const bool want = s[i] != 0 && f.original[i].op != OP_JMP &&
-                          (stepping || (s[i] == 1 && lines.count(f.lines[i]) != 0));
-        f.code[i] = f.original[i];
-        if (want) f.code[i].op = OP_BREAK;
+        const bool want =
+            s[i] != 0 && f.code[i].op != OP_JMP && (stepping || (s[i] == 1 && lines.count(f.lines[i]) != 0));
+        rc.code[i] = f.code[i];
+        if (want) rc.code[i].op = OP_BREAK;
       }
     }
     stepping_patched_ = stepping;
@@ -219,7 +220,7 @@ class Debugger::Impl final : public DebugHooks {
     const std::size_t depth = P_.frames_.size();
     const std::uint32_t line = at < f.lines.size() ? f.lines[at] : 0;
     const std::size_t fi = index_of(f);
-    const bool run_start = fi < P_.functions_.size() && starts(fi)[at] == 1;
+    const bool run_start = fi < P_.image().functions.size() && starts(fi)[at] == 1;
     int hit = 0;
     if (run_start)
       for (Breakpoint& b : bps_)
@@ -319,9 +320,9 @@ class Debugger::Impl final : public DebugHooks {
   }
 
   std::size_t index_of(const Function& f) const {
-    for (std::size_t i = 0; i < P_.functions_.size(); ++i)
-      if (P_.functions_[i].get() == &f) return i;
-    return P_.functions_.size();
+    for (std::size_t i = 0; i < P_.image().functions.size(); ++i)
+      if (P_.image().functions[i].get() == &f) return i;
+    return P_.image().functions.size();
   }
 
   // ---- reading the stopped program ----
@@ -451,8 +452,8 @@ int Debugger::break_at_line(std::uint32_t line) {
   ProgramImpl& P = impl_->live();
   bool found = false;
   std::uint32_t before = 0, after = 0;
-  for (std::size_t fi = 0; fi < P.functions_.size(); ++fi) {
-    const Function& f = *P.functions_[fi];
+  for (std::size_t fi = 0; fi < P.image().functions.size(); ++fi) {
+    const Function& f = *P.image().functions[fi];
     const auto& s = impl_->starts(fi);
     for (std::size_t i = 0; i < s.size(); ++i) {
       if (s[i] != 1) continue;
@@ -462,7 +463,7 @@ int Debugger::break_at_line(std::uint32_t line) {
       if (l > line && (after == 0 || l < after)) after = l;
     }
   }
-  const std::string& file = P.checked_->source->name();
+  const std::string& file = P.image().checked->source->name();
   if (!found) {
     std::string near;
     if (before != 0) near += " " + std::to_string(before);
@@ -490,7 +491,7 @@ int Debugger::break_at(std::string_view location) {
   if (num.empty() || r.ec != std::errc() || r.ptr != num.data() + num.size() || line == 0)
     throw Error("SOML++ debugger: '" + std::string(location) + "' is not FILE:LINE or LINE");
   if (!file.empty()) {
-    const std::string& name = impl_->live().checked_->source->name();
+    const std::string& name = impl_->live().image().checked->source->name();
     const auto slash = name.find_last_of('/');
     const std::string base = slash == std::string::npos ? name : name.substr(slash + 1);
     if (file != name && file != base)
@@ -550,7 +551,7 @@ std::vector<StackFrame> Debugger::call_stack() const {
     const std::size_t at = Impl::pc_of(f);
     StackFrame s;
     s.function = f.fn->name;
-    s.file = P.checked_->source->name();
+    s.file = P.image().checked->source->name();
     s.line = at < f.fn->lines.size() ? f.fn->lines[at] : 0;
     s.self = f.self;
     s.mark = f.mark;
@@ -712,17 +713,17 @@ Program& Debugger::program() const {
 
 bool Debugger::attached() const noexcept { return !impl_->gone_; }
 
-const std::string& Debugger::source() const { return impl_->live().checked_->source->text(); }
+const std::string& Debugger::source() const { return impl_->live().image().checked->source->text(); }
 
-const std::string& Debugger::file() const { return impl_->live().checked_->source->name(); }
+const std::string& Debugger::file() const { return impl_->live().image().checked->source->name(); }
 
 std::vector<std::uint32_t> Debugger::lines() const {
   const ProgramImpl& P = impl_->live();
   std::vector<std::uint32_t> out;
-  for (std::size_t fi = 0; fi < P.functions_.size(); ++fi) {
+  for (std::size_t fi = 0; fi < P.image().functions.size(); ++fi) {
     const auto& s = impl_->starts(fi);
     for (std::size_t i = 0; i < s.size(); ++i)
-      if (s[i] == 1) out.push_back(P.functions_[fi]->lines[i]);
+      if (s[i] == 1) out.push_back(P.image().functions[fi]->lines[i]);
   }
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());

@@ -1,8 +1,8 @@
 // The SOML++ net executor (docs/soml.md, 5.2 and 5.3): transitions are re-tested only when something
 // they read changed — an input place (known from the arrows) or a property their condition or arrow
 // conditions read the last time they ran (recorded by the VM) — heard through a vsd::Watch that covers
-// just the class properties some test read. Among the enabled transitions one is chosen with a seeded generator, so runs are
-// reproducible. Every firing changes markings through the setters of the place nodes.
+// just the class properties some test read. Among the enabled transitions one is chosen with a seeded
+// generator, so runs are reproducible. Every firing changes markings through the setters of the place nodes.
 #include <algorithm>
 #include <limits>
 #include <utility>
@@ -120,12 +120,12 @@ void ProgramImpl::set_enabled(std::uint32_t i, bool on) {
 
 std::uint64_t ProgramImpl::port_place_id(std::uint64_t copy, std::size_t k) const {
   auto it = node_net_.find(copy);
-  if (it == node_net_.end() || it->second->dead || k >= port_places_.size()) return 0;
+  if (it == node_net_.end() || it->second->dead || k >= image().port_places.size()) return 0;
   const NetInst& n = *it->second;
   for (std::size_t t = 0; t < n.transitions.size(); ++t) {
     if (n.transitions[t]->id() != copy) continue;
     const auto& sub = n.cls->transitions[t].sub_places;
-    auto p = sub.find(port_places_[k]);
+    auto p = sub.find(image().port_places[k]);
     return p == sub.end() ? 0 : n.places[static_cast<std::size_t>(p->second)]->id();
   }
   return 0;

@@ -117,7 +117,7 @@ std::pair<NetInst*, int> ProgramImpl::complete_action(const NetInst& inner) {
       Value x;
       Val r{};
       if (ci->result_slot >= 0)
-        r = load_value(props_[static_cast<std::size_t>(ci->result_slot)], inv, str, vec, x);
+        r = load_value(image().props[static_cast<std::size_t>(ci->result_slot)], inv, str, vec, x);
       run(t.action, parent->id(), mark, &r, &str, nullptr, &vec, nullptr, &x);
     }
     return {outer, index};

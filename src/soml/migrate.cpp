@@ -142,7 +142,7 @@ class Migration {
 };
 
 void Migration::collect() {
-  for (const auto& [decl, ci] : nw_.class_info_) new_classes_[class_key(*decl)] = ci.get();
+  for (const auto& [decl, ci] : nw_.image().class_info) new_classes_[class_key(*decl)] = ci.get();
   for (const auto& [decl, id] : old_.object_ids_) old_statics_[class_key(*decl)] = id;
   for (const auto& [id, net] : old_.node_net_) old_ids_.insert(id);
   std::unordered_map<std::string, std::size_t> removed_classes;
@@ -152,7 +152,7 @@ void Migration::collect() {
     old_ids_.insert(x->id());
     const ClassDecl& d = *it->second->decl;
     if (d.kind == DeclKind::Net)
-      throw Error("cannot reload '" + old_.checked_->source->name() + "' now: an invocation of net '" +
+      throw Error("cannot reload '" + old_.image().checked->source->name() + "' now: an invocation of net '" +
                   qualified(d) + "' is in progress (reload when it has finished)");
     if (d.kind == DeclKind::Object || d.kind == DeclKind::Script) continue;  // by make_statics
     auto nc = new_classes_.find(class_key(d));
@@ -166,7 +166,7 @@ void Migration::collect() {
     std::string what;
     for (const auto& [cls, n] : removed_classes)
       what += (what.empty() ? "" : ", ") + ("'" + cls + "' (" + std::to_string(n) + " live)");
-    throw Error("cannot reload '" + old_.checked_->source->name() +
+    throw Error("cannot reload '" + old_.image().checked->source->name() +
                 "': the new version removes classes that still have instances: " + what +
                 " (delete them first)");
   }
@@ -175,8 +175,8 @@ void Migration::collect() {
 // The new version's static instances (the script object and its objects), like ProgramImpl::populate:
 // an object the running version had becomes a migrated pair, one it had not a fresh object.
 void Migration::make_statics(const ClassDecl& c, Node* parent) {
-  const ClassInfo& ci = *nw_.class_info_.at(&c);
-  SimStateInstance& y = nw_.create_node(ci, parent, c.kind == DeclKind::Script ? nw_.stem_ : c.name);
+  const ClassInfo& ci = *nw_.image().class_info.at(&c);
+  SimStateInstance& y = nw_.create_node(ci, parent, c.kind == DeclKind::Script ? nw_.image().stem : c.name);
   nw_.object_ids_[&c] = y.id();
   auto it = old_statics_.find(class_key(c));
   SimStateInstance* x = it != old_statics_.end() ? state_.find(it->second) : nullptr;
@@ -333,21 +333,18 @@ void Migration::run() {
   // ---- everything that may fail, before anything of the running version goes ----
   nw_.connect_listeners();
   nw_.make_source();
-  make_statics(*nw_.checked_->script.root, &state_.database());
-  nw_.root_ = state_.find(nw_.object_ids_.at(nw_.checked_->script.root.get()))->as<Node>();
+  make_statics(*nw_.image().checked->script.root, &state_.database());
+  nw_.root_ = state_.find(nw_.object_ids_.at(nw_.image().checked->script.root.get()))->as<Node>();
   for (auto& [x, ci] : old_dynamic_) {
     SimStateInstance& y = nw_.create_node(*ci, nullptr, "");
     pairs_.push_back(Pair{x, &y, ci});
     map_[x->id()] = &y;
   }
-  for (auto& [slot, decl] : nw_.object_refs_)
-    nw_.consts_[static_cast<std::size_t>(slot)] = static_cast<std::int64_t>(nw_.object_ids_.at(decl));
-  for (OuterPlan& op : nw_.outer_plans_)
-    if (op.static_decl != nullptr) op.static_id = nw_.object_ids_.at(op.static_decl);
+  nw_.link_objects();
   for (const Pair& p : pairs_) init(p);
   for (const Pair& p : pairs_) map_nets(p);
   for (const Pair& p : pairs_) {
-    const std::string cls = label(*p.ci->decl, nw_.stem_);
+    const std::string cls = label(*p.ci->decl, nw_.image().stem);
     report_properties(p.from->meta(), p.to->meta(), cls);
     copy_properties(*p.from, *p.to);
     const NetInst* on = old_.net_of(p.from->id());
@@ -368,7 +365,7 @@ void Migration::run() {
     }
   }
   for (const Pair& p : pairs_) adopt_children(p);
-  for (auto& [decl, y] : fresh_) nw_.setup(*nw_.class_info_.at(decl), *y, nullptr, nullptr, 0);
+  for (auto& [decl, y] : fresh_) nw_.setup(*nw_.image().class_info.at(decl), *y, nullptr, nullptr, 0);
   // References to the old instances from outside the running version (C++ nodes, other programs): each
   // must accept the new instance's class.
   struct Redirect {
@@ -604,7 +601,7 @@ void Program::follow_reload(std::string name, std::string text, const Transactio
         auto again = std::make_shared<ProgramImpl>(state, old.opt_);
         again->weak_self_ = again;
         again->attaching_ = true;
-        again->load_or_undo(old.checked_->source->name(), old.checked_->source->text());
+        again->load_or_undo(old.image().checked->source->name(), old.image().checked->source->text());
         again->attaching_ = false;
         again->on_dirty_ = old.on_dirty_;
         again->trace_ = old.trace_;

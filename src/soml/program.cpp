@@ -2,8 +2,8 @@
 // classes and enums, the linkage table, compilation, and the instances of the script object, its objects
 // and their nets.
 #include <algorithm>
-#include <limits>
 #include <cctype>
+#include <limits>
 #include <mutex>
 
 #include "program_impl.hpp"
@@ -162,8 +162,8 @@ const MetaInstance& ProgramImpl::class_for(ClassBuilder& b, const std::string& n
 }
 
 const MetaType& ProgramImpl::enum_for(EnumBuilder& b, const std::string& name, const EnumDecl& decl) {
-  const MetaType* t = !attaching_ && registry_.find_type(name) == nullptr ? &define_enum(b)
-                                                                          : &adopt_enum(b, name, decl);
+  const MetaType* t =
+      !attaching_ && registry_.find_type(name) == nullptr ? &define_enum(b) : &adopt_enum(b, name, decl);
   used_enums_.push_back(t);
   return *t;
 }
@@ -290,19 +290,31 @@ void ProgramImpl::undefine_own() noexcept {
 }
 
 void ProgramImpl::define(std::string name, std::string text) {
+  auto fresh = std::make_shared<ProgramImage>();
+  build_ = fresh.get();
+  image_ = std::move(fresh);
+  struct Done {  // build() is over when define() returns or throws
+    ProgramImage*& b;
+    ~Done() { b = nullptr; }
+  } done{build_};
+  define_image(std::move(name), std::move(text));
+  prepare_run();
+}
+
+void ProgramImpl::define_image(std::string name, std::string text) {
   Registry& reg = state_.environment().registry();
   sweep_leftovers();
-  checked_ = check_source(name, std::move(text), reg);
-  if (!checked_->ok()) throw Error(checked_->diagnostics.format());
+  build().checked = check_source(name, std::move(text), reg);
+  if (!build().checked->ok()) throw Error(build().checked->diagnostics.format());
   {
     std::string base = name.substr(name.find_last_of("/\\") + 1);
     base = base.substr(0, base.find('.'));
     for (char& c : base)
       if (std::isalnum(static_cast<unsigned char>(c)) == 0) c = '_';
     if (base.empty() || std::isdigit(static_cast<unsigned char>(base[0])) != 0) base = "script_" + base;
-    stem_ = base;
+    build().stem = base;
   }
-  const ClassDecl& root = *checked_->script.root;
+  const ClassDecl& root = *build().checked->script.root;
 
   // 1. What the runtime cannot run yet is refused with its position, never ignored.
   walk(root, [&](const Decl& d) {
@@ -357,7 +369,7 @@ void ProgramImpl::define(std::string name, std::string text) {
       placed[d] = true;
       chain.push_back(d);
     }
-    class_order_.insert(class_order_.end(), chain.rbegin(), chain.rend());
+    build().class_order.insert(build().class_order.end(), chain.rbegin(), chain.rend());
     chain.clear();
   }
 
@@ -367,7 +379,7 @@ void ProgramImpl::define(std::string name, std::string text) {
     const auto& fd = d.as<FunctionDecl>();
     const std::string owner =
         d.parent != nullptr && d.parent->kind != DeclKind::Script ? qualified(*d.parent) + "." : "";
-    function_index_[&fd] =
+    build().function_index[&fd] =
         new_function(*this, owner + (fd.is_constructor ? fd.name + " (constructor)" : fd.name));
   });
 
@@ -389,11 +401,11 @@ void ProgramImpl::define(std::string name, std::string text) {
         }
         const MetaType* result =
             fd.result_type.kind == K::Void ? nullptr : storage_type(*this, reg, fd.result_type);
-        const int fi = function_index_.at(&fd);
+        const int fi = build().function_index.at(&fd);
         std::weak_ptr<ProgramImpl> weak = weak_self_;
         adopted_methods_.push_back(AdoptedMethod{fd.name, args, result});
         b.method(fd.name, std::move(args), result,
-                 [weak, fi, fname = functions_[static_cast<std::size_t>(fi)]->name](
+                 [weak, fi, fname = build().functions[static_cast<std::size_t>(fi)]->name](
                      SimStateInstance& self, std::span<const Value> a) {
                    return dispatch(weak, fi, fname, self, a);
                  });
@@ -422,12 +434,12 @@ void ProgramImpl::define(std::string name, std::string text) {
       scope_meta_[m.get()] = &class_for(pb, cname + "::" + m->name, sb, s);
     }
   };
-  for (const ClassDecl* c : class_order_) {
+  for (const ClassDecl* c : build().class_order) {
     auto ci = std::make_unique<ClassInfo>();
     ci->decl = c;
     const MetaInstance* base = &Node::static_meta();
     if (c->base.decl != nullptr) {
-      ci->base = class_info_.at(c->base.decl).get();
+      ci->base = build().class_info.at(c->base.decl).get();
       base = ci->base->meta;
     } else if (c->base.meta != nullptr) {
       base = c->base.meta;
@@ -436,7 +448,8 @@ void ProgramImpl::define(std::string name, std::string text) {
     }
     if (!base->is_a(Node::static_meta()))
       not_supported(*this, c->base_loc, "a class derived from '" + base->name() + "' (not a Node)");
-    const std::string cname = c->kind == DeclKind::Script ? "soml::" + stem_ : "soml::" + qualified(*c);
+    const std::string cname =
+        c->kind == DeclKind::Script ? "soml::" + build().stem : "soml::" + qualified(*c);
     ClassBuilder b(cname, *base);
     add_members(b, *c);
     if (c->kind == DeclKind::Net && c->result_type.kind != K::Void) {
@@ -449,7 +462,7 @@ void ProgramImpl::define(std::string name, std::string text) {
     scope_meta_[c] = ci->meta;
     by_meta_[ci->meta] = ci.get();
     member_classes(*c, cname);
-    class_info_[c] = std::move(ci);
+    build().class_info[c] = std::move(ci);
   }
   // A port net (4.11, 5.5) with properties or functions of its own is a run-time class derived from
   // soml::Transition: the class of the node of every substitution transition that copies the net, which
@@ -474,7 +487,7 @@ void ProgramImpl::define(std::string name, std::string text) {
     if (auto it = scope_meta_.find(t.substituted); it != scope_meta_.end()) scope_meta_[&t] = it->second;
   });
 
-  // 4. Linkage: property declarations -> MetaProperties (props_ slots).
+  // 4. Linkage: property declarations -> MetaProperties (build().props slots).
   walk(root, [&](const Decl& d) {
     if (d.kind != DeclKind::Property) return;
     const MetaInstance* m = scope_meta_.at(d.parent);
@@ -484,24 +497,24 @@ void ProgramImpl::define(std::string name, std::string text) {
     s.prop = mp;
     const auto& pd = d.as<PropertyDecl>();
     s.kind = prop_kind(pd.type, *mp);
-    props_.push_back(s);
-    prop_slot_[&pd] = static_cast<int>(props_.size() - 1);
-    meta_prop_slot_[mp] = prop_slot_[&pd];
+    build().props.push_back(s);
+    build().prop_slot[&pd] = static_cast<int>(build().props.size() - 1);
+    build().meta_prop_slot[mp] = build().prop_slot[&pd];
   });
 
   // The `result` property of invocable nets (read when an instance finishes, written by `finish`).
-  for (const ClassDecl* c : class_order_) {
+  for (const ClassDecl* c : build().class_order) {
     if (c->kind != DeclKind::Net || c->result_type.kind == K::Void) continue;
-    ClassInfo& ci = *class_info_.at(c);
+    ClassInfo& ci = *build().class_info.at(c);
     const MetaProperty* mp = ci.meta->find_property("result");
-    props_.push_back(PropSlot{mp, prop_kind(c->result_type, *mp)});
-    ci.result_slot = static_cast<int>(props_.size() - 1);
-    meta_prop_slot_[mp] = ci.result_slot;
+    build().props.push_back(PropSlot{mp, prop_kind(c->result_type, *mp)});
+    ci.result_slot = static_cast<int>(build().props.size() - 1);
+    build().meta_prop_slot[mp] = ci.result_slot;
   }
 
   // 5. Overrides: a function with the name of a base class's function is called virtually.
-  for (const ClassDecl* c : class_order_) {
-    ClassInfo& ci = *class_info_.at(c);
+  for (const ClassDecl* c : build().class_order) {
+    ClassInfo& ci = *build().class_info.at(c);
     if (ci.base != nullptr) ci.vtable = ci.base->vtable;
     for (const DeclPtr& m : c->members) {
       if (m->kind != DeclKind::Function || m->as<FunctionDecl>().is_constructor) continue;
@@ -511,13 +524,13 @@ void ProgramImpl::define(std::string name, std::string text) {
         for (const DeclPtr& bm : b->decl->members)
           if (bm->kind == DeclKind::Function && bm->name == fd.name) rootf = &bm->as<FunctionDecl>();
       if (rootf != &fd) {
-        if (vslot_of_.find(rootf) == vslot_of_.end()) {
-          vslot_of_[rootf] = static_cast<int>(vslots_.size());
-          vslots_.push_back(rootf);
-          vslot_default_.push_back(function_index_.at(rootf));
+        if (build().vslot_of.find(rootf) == build().vslot_of.end()) {
+          build().vslot_of[rootf] = static_cast<int>(build().vslots.size());
+          build().vslots.push_back(rootf);
+          build().vslot_default.push_back(build().function_index.at(rootf));
         }
-        vslot_of_[&fd] = vslot_of_[rootf];
-        ci.vtable[rootf] = function_index_.at(&fd);
+        build().vslot_of[&fd] = build().vslot_of[rootf];
+        ci.vtable[rootf] = build().function_index.at(&fd);
       }
     }
   }
@@ -572,8 +585,8 @@ void ProgramImpl::define(std::string name, std::string text) {
                     "nets this large through inheritance (the classes would hold more than " +
                         std::to_string(kMaxInherited) + " places and transitions of their bases)");
   };
-  for (const ClassDecl* c : class_order_) {
-    ClassInfo& ci = *class_info_.at(c);
+  for (const ClassDecl* c : build().class_order) {
+    ClassInfo& ci = *build().class_info.at(c);
     auto net = std::make_unique<NetClass>();
     if (ci.base != nullptr && ci.base->net) {
       inherit(*c, ci.base->net->places.size());
@@ -602,12 +615,13 @@ void ProgramImpl::define(std::string name, std::string text) {
   auto place_index = [&](const NetClass& n, const Decl* d) {
     auto [it, fresh] = place_indices.try_emplace(&n);
     if (fresh)
-      for (std::size_t i = 0; i < n.places.size(); ++i) it->second.try_emplace(n.places[i], static_cast<int>(i));
+      for (std::size_t i = 0; i < n.places.size(); ++i)
+        it->second.try_emplace(n.places[i], static_cast<int>(i));
     const auto at = it->second.find(d);
     return at == it->second.end() ? -1 : at->second;
   };
-  for (const ClassDecl* c : class_order_) {
-    ClassInfo& ci = *class_info_.at(c);
+  for (const ClassDecl* c : build().class_order) {
+    ClassInfo& ci = *build().class_info.at(c);
     bool has_transitions = false;
     for (const DeclPtr& m : c->members) has_transitions = has_transitions || m->kind == DeclKind::Transition;
     if (has_transitions && !ci.net) ci.net = std::make_unique<NetClass>();
@@ -665,16 +679,16 @@ void ProgramImpl::define(std::string name, std::string text) {
   };
 
   // 7. Compile.
-  for (auto& [fd, fi] : function_index_) compile_function(*this, fi, *fd);
-  for (const ClassDecl* c : class_order_) {
-    ClassInfo& ci = *class_info_.at(c);
-    const std::string cname = c->kind == DeclKind::Script ? stem_ : qualified(*c);
+  for (auto& [fd, fi] : build().function_index) compile_function(*this, fi, *fd);
+  for (const ClassDecl* c : build().class_order) {
+    ClassInfo& ci = *build().class_info.at(c);
+    const std::string cname = c->kind == DeclKind::Script ? build().stem : qualified(*c);
     const std::string prefix = c->kind == DeclKind::Script ? "" : cname + ".";
     ci.init = compile_init(*this, *c, cname + " (initialisers)");
-    if (c->constructor != nullptr) ci.ctor = function_index_.at(c->constructor);
+    if (c->constructor != nullptr) ci.ctor = build().function_index.at(c->constructor);
     if (c->kind == DeclKind::Object && c->has_args && c->base.decl != nullptr &&
         c->base.decl->constructor != nullptr)
-      ci.object_ctor = compile_object_ctor(*this, *c, function_index_.at(c->base.decl->constructor),
+      ci.object_ctor = compile_object_ctor(*this, *c, build().function_index.at(c->base.decl->constructor),
                                            *c->base.decl->constructor);
     std::size_t next_expansion = 0;
     // One transition of the class's net, or of a sub-net copied into it (map: the copy's places).
@@ -705,13 +719,13 @@ void ProgramImpl::define(std::string name, std::string text) {
             ti.action = compile_action(*this, t, pre + t.name + " (action)");
             if (t.invoked != nullptr && t.invoked->result_type.kind != K::Void) {
               // The action of an invoking transition runs when the net finished: `result` is its slot 0.
-              Function& f = *functions_[static_cast<std::size_t>(ti.action)];
+              Function& f = *build().functions[static_cast<std::size_t>(ti.action)];
               f.nparams = 1;
               f.param_kinds = {reg_kind(t.invoked->result_type)};
             }
           }
           if (t.invoked != nullptr) {
-            ti.invoke = class_info_.at(t.invoked).get();
+            ti.invoke = build().class_info.at(t.invoked).get();
             if (!t.invoke_args.empty())
               ti.invoke_args = compile_invoke_args(*this, t, pre + t.name + " (invocation arguments)");
           }
@@ -770,7 +784,8 @@ void ProgramImpl::define(std::string name, std::string text) {
         };
     for (const DeclPtr& m : c->members) {
       if (m->kind == DeclKind::Place || m->kind == DeclKind::Transition)
-        scope_init_[m.get()] = compile_init(*this, m->as<ScopeDecl>(), prefix + m->name + " (initialisers)");
+        build().scope_init[m.get()] =
+            compile_init(*this, m->as<ScopeDecl>(), prefix + m->name + " (initialisers)");
       if (m->kind != DeclKind::Transition) continue;
       make_transition(m->as<TransitionDecl>(), nullptr, -1, prefix);
     }
@@ -782,7 +797,7 @@ void ProgramImpl::define(std::string name, std::string text) {
     const auto& n = d.as<ClassDecl>();
     for (const DeclPtr& m : n.members)
       if (m->kind == DeclKind::Place || m->kind == DeclKind::Transition)
-        scope_init_[m.get()] =
+        build().scope_init[m.get()] =
             compile_init(*this, m->as<ScopeDecl>(), qualified(n) + "." + m->name + " (initialisers)");
   });
   std::unordered_map<const ClassDecl*, int> port_init;
@@ -793,11 +808,11 @@ void ProgramImpl::define(std::string name, std::string text) {
     auto it = port_init.find(&n);
     if (it == port_init.end())
       it = port_init.emplace(&n, compile_init(*this, n, qualified(n) + " (initialisers)")).first;
-    scope_init_[&d] = it->second;
+    build().scope_init[&d] = it->second;
   });
   // Subclasses copied their bases' transitions before these were compiled: copy again.
-  for (const ClassDecl* c : class_order_) {
-    ClassInfo& ci = *class_info_.at(c);
+  for (const ClassDecl* c : build().class_order) {
+    ClassInfo& ci = *build().class_info.at(c);
     if (ci.base == nullptr || !ci.base->net || !ci.net) continue;
     inherit(*c, ci.base->net->transitions.size());
     std::vector<TransitionInfo> own = std::move(ci.net->transitions);
@@ -818,6 +833,22 @@ void ProgramImpl::define(std::string name, std::string text) {
         h += offset;
     }
   }
+}
+
+void ProgramImpl::prepare_run() {
+  consts_ = image().consts;
+  outer_ids_.assign(image().outer_plans.size(), 0);
+  run_.clear();
+  run_.reserve(image().functions.size());
+  for (const auto& f : image().functions) run_.push_back(RunCode{f.get(), f->code, {}, false});
+}
+
+void ProgramImpl::link_objects() {
+  for (const auto& [slot, decl] : image().object_refs)
+    consts_[static_cast<std::size_t>(slot)] = static_cast<std::int64_t>(object_ids_.at(decl));
+  for (std::size_t i = 0; i < image().outer_plans.size(); ++i)
+    if (const ClassDecl* d = image().outer_plans[i].static_decl; d != nullptr)
+      outer_ids_[i] = object_ids_.at(d);
 }
 
 void ProgramImpl::connect_listeners() {
@@ -863,13 +894,13 @@ std::vector<const MetaInstance*> ProgramImpl::runtime_classes() const {
 
 void ProgramImpl::make_source() {
   source_node_ = &state_.create<SourceFile>();
-  source_node_->set_name(stem_ + " (source)");
-  source_node_->set_file(checked_->source->name());
-  source_node_->set_text(checked_->source->text());
+  source_node_->set_name(image().stem + " (source)");
+  source_node_->set_file(image().checked->source->name());
+  source_node_->set_text(image().checked->source->text());
   state_.database().add_child(*source_node_);
   std::function<void(const Decl&, Node&)> component = [&](const Decl& d, Node& parent) {
     auto& sc = state_.create<SourceComponent>();
-    sc.set_name(d.kind == DeclKind::Script ? stem_ : d.name);
+    sc.set_name(d.kind == DeclKind::Script ? image().stem : d.name);
     sc.set_kind(std::string(d.kind_name()));
     sc.set_line(d.loc.line);
     sc.set_column(d.loc.column);
@@ -878,11 +909,11 @@ void ProgramImpl::make_source() {
     if (d.has_members())
       for (const DeclPtr& m : d.as<ScopeDecl>().members) component(*m, sc);
   };
-  component(*checked_->script.root, *source_node_);
+  component(*image().checked->script.root, *source_node_);
 }
 
 void ProgramImpl::populate() {
-  const ClassDecl& root = *checked_->script.root;
+  const ClassDecl& root = *image().checked->script.root;
   // 8. The database content: source components, the script object and its objects.
   connect_listeners();
   if (attaching_) {  // the content is there already (attach.cpp)
@@ -895,7 +926,7 @@ void ProgramImpl::populate() {
   std::vector<std::pair<const ClassDecl*, SimStateInstance*>> statics;
   std::function<void(const ClassDecl&, Node*)> make = [&](const ClassDecl& c, Node* parent) {
     SimStateInstance& inst =
-        create_node(*class_info_.at(&c), parent, c.kind == DeclKind::Script ? stem_ : c.name);
+        create_node(*image().class_info.at(&c), parent, c.kind == DeclKind::Script ? image().stem : c.name);
     object_ids_[&c] = inst.id();
     statics.emplace_back(&c, &inst);
     for (const DeclPtr& m : c.members)
@@ -903,11 +934,8 @@ void ProgramImpl::populate() {
   };
   make(root, &state_.database());
   root_ = statics.front().second->as<Node>();
-  for (auto& [slot, decl] : object_refs_)
-    consts_[static_cast<std::size_t>(slot)] = static_cast<std::int64_t>(object_ids_.at(decl));
-  for (OuterPlan& p : outer_plans_)
-    if (p.static_decl != nullptr) p.static_id = object_ids_.at(p.static_decl);
-  for (auto& [decl, inst] : statics) setup(*class_info_.at(decl), *inst, nullptr, nullptr, 0);
+  link_objects();
+  for (auto& [decl, inst] : statics) setup(*image().class_info.at(decl), *inst, nullptr, nullptr, 0);
   // What decides the continuation of the run, as database state (attach.cpp).
   exec_ = &state_.create<Executor>();
   exec_->set_name("(executor)");
@@ -958,7 +986,7 @@ void ProgramImpl::setup(const ClassInfo& ci, SimStateInstance& inst, const Val* 
   // Constructors: bases' without arguments, then the class's own (or an object's base's) with them.
   for (const ClassInfo* c : chain) {
     if (c->ctor < 0) continue;
-    const Function& f = *functions_[static_cast<std::size_t>(c->ctor)];
+    const Function& f = *image().functions[static_cast<std::size_t>(c->ctor)];
     if (c == &ci ||
         (c == ci.base && ci.decl->kind == DeclKind::Object && ci.object_ctor < 0 && f.nparams == 0)) {
       if (c == &ci && f.nparams != nargs)
@@ -1037,10 +1065,10 @@ void ProgramImpl::build_net(const ClassInfo& ci, SimStateInstance& inst) {
   }
   // Initialisers of places and transitions with properties.
   for (std::size_t i = 0; i < ci.net->places.size(); ++i)
-    if (auto it = scope_init_.find(ci.net->places[i]); it != scope_init_.end())
+    if (auto it = image().scope_init.find(ci.net->places[i]); it != image().scope_init.end())
       run(it->second, net->places[i]->id(), 0, nullptr, nullptr);
   for (std::size_t i = 0; i < ci.net->transitions.size(); ++i)
-    if (auto it = scope_init_.find(ci.net->transitions[i].decl); it != scope_init_.end())
+    if (auto it = image().scope_init.find(ci.net->transitions[i].decl); it != image().scope_init.end())
       run(it->second, net->transitions[i]->id(), 0, nullptr, nullptr);
   register_net(std::move(net), ci, inst);
 }
@@ -1106,14 +1134,15 @@ Value ProgramImpl::dispatch(const std::weak_ptr<ProgramImpl>& weak, int fi, cons
   if (!other)
     throw Error("no SOML++ program runs the state of " + self.meta().name() + " #" +
                 std::to_string(self.id()) + " (its program was unloaded, or the state was never attached)");
-  for (std::size_t i = 0; i < other->functions_.size(); ++i)
-    if (other->functions_[i]->name == fname) return other->call_from_cpp(static_cast<int>(i), self, args);
+  for (std::size_t i = 0; i < other->image().functions.size(); ++i)
+    if (other->image().functions[i]->name == fname)
+      return other->call_from_cpp(static_cast<int>(i), self, args);
   throw Error("the SOML++ program that runs " + self.meta().name() + " #" + std::to_string(self.id()) +
               " has no function " + fname);
 }
 
 Value ProgramImpl::call_from_cpp(int fi, SimStateInstance& self, std::span<const Value> args) {
-  const Function& f = *functions_[static_cast<std::size_t>(fi)];
+  const Function& f = *image().functions[static_cast<std::size_t>(fi)];
   if (static_cast<int>(args.size()) != f.nparams)
     throw Error("SOML++ function " + f.name + " takes " + std::to_string(f.nparams) + " arguments, " +
                 std::to_string(args.size()) + " given");
@@ -1269,7 +1298,7 @@ std::vector<Place*> Program::places() const {
 }
 
 const MetaInstance* Program::script_class(std::string_view name) const {
-  for (const auto& [decl, ci] : impl_->class_info_)
+  for (const auto& [decl, ci] : impl_->image().class_info)
     if (decl->name == name && decl->kind != DeclKind::Script) return ci->meta;
   return nullptr;
 }
@@ -1287,6 +1316,8 @@ void Program::on_firing(std::function<void(const Firing&)> fn) { impl_->trace_ =
 std::size_t Program::watched_properties() const noexcept { return impl_->deps_map_.size(); }
 std::size_t Program::executor_entries() const noexcept { return impl_->tis_.size(); }
 std::uint64_t Program::condition_tests() const noexcept { return impl_->tests_; }
+std::string Program::disassemble() const { return soml::disassemble(impl_->image()); }
+
 const std::vector<std::string>& Program::condition_errors() const noexcept {
   return impl_->condition_errors_;
 }

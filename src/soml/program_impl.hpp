@@ -1,4 +1,5 @@
-// Internal: the loaded program (linkage table, bytecode, VM, executor). Not installed.
+// Internal: a loaded program — its image (image.hpp: what the compiler made, never changed) and the
+// run-time state of the VM, the net executor, the loader (attach, migrate) and the debugger. Not installed.
 #pragma once
 
 #include <cstdint>
@@ -11,13 +12,16 @@
 #include <unordered_set>
 #include <vector>
 
+#include "dep_table.hpp"
+#include "image.hpp"
+#include "opcodes.hpp"
+#include "vsd/core/config.hpp"
 #include "vsd/core/meta_instance.hpp"
 #include "vsd/core/signal.hpp"
 #include "vsd/core/sim_state.hpp"
 #include "vsd/core/type_builder.hpp"
 #include "vsd/core/value.hpp"
 #include "vsd/core/watch.hpp"
-#include "dep_table.hpp"
 #include "vsd/soml/checker.hpp"
 #include "vsd/soml/net_classes.hpp"
 #include "vsd/soml/runtime.hpp"
@@ -41,152 +45,6 @@ struct VecReg {
   [[nodiscard]] std::size_t size() const noexcept { return v.size() + s.size(); }
 };
 
-// Register kinds of a static type (V: a vector, its elements of kind vector_elem_kind(); X: any other
-// value as a vsd::Value in the fourth parallel array: structs, and vectors of structs and enums).
-enum class RK : std::uint8_t { I, D, S, R, V, X, None };
-
-enum Op : std::uint8_t {
-  OP_NOP,
-  OP_LOADI,  // a = (int16) b
-  OP_LOADK,  // a = consts[b]            (ints and doubles as raw bits)
-  OP_LOADS,  // S[a] = strings[b]
-  OP_MOV,    // a = b
-  OP_MOVS,   // S[a] = S[b]
-  OP_ADDI,
-  OP_SUBI,
-  OP_MULI,
-  OP_DIVI,
-  OP_MODI,
-  OP_ADDD,
-  OP_SUBD,
-  OP_MULD,
-  OP_DIVD,
-  OP_ADDIK,  // a = b + (int16) c
-  OP_MULIK,  // a = b * (int16) c
-  OP_DIVIK,  // a = b / (int16) c   (c not 0 or -1)
-  OP_MODIK,  // a = b % (int16) c   (c not 0 or -1)
-  OP_NEGI,
-  OP_NEGD,
-  OP_NOT,
-  OP_I2D,
-  OP_D2I,
-  OP_LTI,
-  OP_LEI,
-  OP_EQI,
-  OP_NEI,
-  OP_LTD,
-  OP_LED,
-  OP_EQD,
-  OP_NED,
-  OP_LTS,
-  OP_LES,
-  OP_EQS,
-  OP_NES,
-  OP_CONCAT,   // S[a] = S[b] + S[c]
-  OP_TOSTR,    // S[a] = text of b; c: 0 int, 1 double, 2 bool, 3+k enum k
-  OP_STR2B,    // a = !S[b].empty()
-  OP_JMP,      // pc = target
-  OP_JMPF,     // if (!a) pc = target
-  OP_JMPT,     // if (a) pc = target
-  OP_JGEI,     // if (a >= b) pc = target   (fused loop test)
-  OP_JGTI,     // if (a > b) pc = target
-  OP_CALL,     // call functions[b] with frame at a, self in register c; result in a
-  OP_VCALL,    // like CALL, but b is a virtual slot resolved on the class of self
-  OP_RET,      // return register a
-  OP_RET0,     // return nothing
-  OP_RETV,     // return vector register a (a function whose result is a vector)
-  OP_SELF,     // a = instance of scope b levels out (outer plan b)
-  OP_MARK,     // a = mark
-  OP_OBJ,      // a = id of object consts[b]
-  OP_GETP,     // a = property props[c] of instance b
-  OP_SETP,     // property props[c] of instance a = b
-  OP_PLACE,    // a = place node number c of the net instance b (c & kPortPlace: a port net's, of copy b)
-  OP_PCOUNT,   // a = count of place b
-  OP_PPUT,     // place a .put(b)
-  OP_PCLEAR,   // place a .clear()
-  OP_LSIZE,    // a = size of list props[c] of b
-  OP_LGET,     // a = element (id) R[a] of list props[c] of b   (a holds the index on entry)
-  OP_LPUSH,    // list props[c] of a .push(b)
-  OP_NEW,      // a = new classes[b]; arguments from a+1, c of them
-  OP_ISA,      // a = instance b is_a classes[c]
-  OP_AS,       // a = instance b if is_a classes[c] else null
-  OP_MCALL,    // a = MetaMethod methods[b] on instance R[a], arguments from a+1 (count in the method)
-  OP_BUILTIN,  // a = builtin b over registers a.. (c: variant)
-  OP_PRINT,    // print registers a .. a+b-1; kinds from print_kinds[c]
-  OP_NULLCHK,  // error "null" unless a
-  OP_RANGE,    // check that a fits the storage type consts[b] (int properties narrower than int64)
-  OP_FAIL,     // run-time error strings[b]
-  OP_BREAK,    // debugger: patched over a line start; calls the hook, then runs Function::tramp[2 pc]
-  OP_RESUME,   // the second instruction of a trampoline: pc = target (no budget)
-  // Vectors (x: 1 when the elements are strings, else 0; for OP_EQV 0 int, 1 double, 2 string).
-  OP_MOVV,    // V[a] = V[b] (a copy: vectors are values)
-  OP_VCLEAR,  // V[a] = {}
-  OP_VSIZE,   // a = size of V[b]
-  OP_VGET,    // a = V[b][R[c]]            (range-checked)
-  OP_VSET,    // V[a][R[b]] = c            (range-checked)
-  OP_VPUSH,   // V[a].push(b)
-  OP_EQV,     // a = V[b] == V[c]
-  OP_PVSIZE,  // a = size of vector property props[c] of instance b (no copy)
-  OP_PVGET,   // a = element R[a] of vector property props[c] of instance b (no copy; range-checked)
-  OP_FIND,    // a = the node at path S[b] from the database, or null
-  // Values (X registers: structs, vectors of structs and enums; out of line like the vector ones).
-  OP_XDEF,    // X[a] = default value of xtypes[b]
-  OP_MOVX,    // X[a] = X[b] (a copy)
-  OP_XGETF,   // a = field x of struct X[b]          (register kind from the field's type)
-  OP_XSETF,   // field x of struct X[a] = b
-  OP_EQX,     // a = X[b] == X[c]
-  OP_RETX,    // return X register a (a function whose result is a Value)
-  OP_XVSIZE,  // a = size of vector X[b]
-  OP_XVGET,   // a = X[b][R[c]]                     (range-checked)
-  OP_XVSET,   // X[a][R[b]] = c                     (range-checked)
-  OP_XVPUSH,  // X[a].push(b)
-  OP_XOP      // a = StructOp x over b and c (struct_ops.cpp): structs in X, scalars in D, Text into S
-};
-
-// OP_PLACE's operand c with this bit: a place of a port net (index into port_places_), found from the
-// copy's instance.
-inline constexpr std::size_t kPortPlace = 0x8000;
-
-struct Ins {
-  std::uint8_t op;
-  std::uint8_t x;  // spare
-  std::uint16_t a;
-  std::uint16_t b;
-  std::uint16_t c;
-};
-static_assert(sizeof(Ins) == 8);
-
-struct Function {
-  std::string name;  // "Demo.time_to", "cell.go (condition)"
-  std::vector<Ins> code;
-  std::vector<std::uint32_t> lines;  // per instruction: its line as the debugger steps through them
-  // Per instruction: the line and column of the expression or statement it computes (its operator, its
-  // call's '(', its statement), which run-time errors name (file:line:col).
-  struct Pos {
-    std::uint32_t line = 0, column = 0;
-  };
-  std::vector<Pos> positions;
-  std::vector<std::uint32_t> targets;  // jump targets by jump id
-  int nparams = 0;
-  int nregs = 0;
-  const ScopeDecl* scope = nullptr;  // the innermost instance scope (self)
-  std::vector<RK> param_kinds;
-  std::vector<const MetaInstance*> param_classes;  // reference parameters: the class they need
-  RK result = RK::None;
-  Type result_type;
-  bool compiled = false;
-  // For the debugger: parameters and locals by name, each visible in code [from, to).
-  struct Local {
-    std::string name;
-    int slot = 0;
-    Type type;
-    std::uint32_t from = 0, to = 0;
-  };
-  std::vector<Local> locals;
-  std::vector<Ins> original;  // the code before a debugger patched OP_BREAK in (empty: never patched)
-  std::vector<Ins> tramp;     // per instruction i: original[i], OP_RESUME to i + 1 (made with original)
-};
-
 // The debugger's hooks (debugger.cpp). Null when none is attached: the VM then meets no OP_BREAK and
 // the executor tests one pointer per firing.
 class DebugHooks {
@@ -200,74 +58,6 @@ class DebugHooks {
   virtual void on_program_gone() noexcept = 0;
 };
 
-// How to reach the instance `outer` levels out of a function's scope: a fixed object, or parents.
-struct OuterPlan {
-  const ClassDecl* static_decl = nullptr;  // a fixed instance (resolved once objects exist)
-  std::uint64_t static_id = 0;
-  int parents = 0;
-};
-
-enum class PK : std::uint8_t { I64, Bool, Double, String, Int, Enum, Ref, List, Vector, Value, Other };
-
-struct PropSlot {
-  const MetaProperty* prop = nullptr;
-  PK kind = PK::Other;
-};
-
-// One step of a communication arrow's path: a fixed object, or a reference property of the instance
-// reached so far.
-struct PathStep {
-  const ClassDecl* object = nullptr;  // a static object (its id once created)
-  const MetaProperty* prop = nullptr;
-};
-
-struct ArrowInfo {
-  const ArrowDecl* decl = nullptr;
-  int place = -1;              // index into the net's places (-1 for a communication arrow)
-  bool remote = false;         // communication arrow: the place is found through `path`
-  std::vector<PathStep> path;  // from the owner of the transition to the remote instance
-  const PlaceDecl* remote_place = nullptr;
-  std::int64_t weight = 1;
-  bool inhibitor = false;
-  bool object = false;  // the place holds object tokens
-  int cond = -1;        // function index of the arrow condition
-  // An arrow of a substituted sub-net: the substitution transition (index in the net) whose node is the
-  // port net's instance, `this` of its condition and the start of its path; -1: the net's owner.
-  int holder = -1;
-};
-
-struct TransitionInfo {
-  const TransitionDecl* decl = nullptr;
-  int index = 0;  // in the net class
-  std::vector<ArrowInfo> in, out;
-  int mark_in = -1;  // index into in of the object input arrow
-  int cond = -1, action = -1;
-  // Substitution (4.11): a substitution transition is inert (it never fires; its sub-net's places and
-  // transitions are its children); `holder` is the transition whose sub-net this one belongs to.
-  bool inert = false;
-  int holder = -1;
-  // A substitution transition: its port net's places (ports too) -> index in the net (OP_PLACE).
-  std::unordered_map<const Decl*, int> sub_places;
-  // Invocation: the net it invokes and the function that sets the new instance's value parameters.
-  const struct ClassInfo* invoke = nullptr;
-  int invoke_args = -1;
-  // It runs SOML++ code when it fires (action, invocation, output arrow conditions): it fires under a
-  // savepoint, so that an error undoes it whole.
-  bool guarded = false;
-  // The black tokens its output arrows give, summed (at most 2^63-1): a firing without a savepoint first
-  // checks that no place would pass 2^63-1 tokens only when some output place holds more than
-  // 2^63-1 - out_weight.
-  std::int64_t out_weight = 0;
-};
-
-// The net of a class-like declaration (its own places and transitions, bases' first).
-struct NetClass {
-  std::vector<const PlaceDecl*> places;
-  std::vector<TransitionInfo> transitions;
-  std::vector<int> place_holder;  // per place: the substitution transition holding it, -1: the owner
-  bool invocable = false;         // the net of an invocable net (its instances can `finish`)
-};
-
 struct NetInst {
   std::uint64_t owner = 0;
   const NetClass* cls = nullptr;
@@ -277,21 +67,22 @@ struct NetInst {
   bool dead = false;           // its owner, a place or a transition was deleted: it fires no more
 };
 
-struct ClassInfo {
-  const ClassDecl* decl = nullptr;
-  const MetaInstance* meta = nullptr;
-  const ClassInfo* base = nullptr;  // script base
-  int init = -1;                    // property initialisers
-  int ctor = -1;
-  int object_ctor = -1;           // object derived with arguments: the constructor call
-  std::unique_ptr<NetClass> net;  // null when it has no places or transitions (own or inherited)
-  std::unordered_map<const FunctionDecl*, int> vtable;  // root function -> implementation
-  int result_slot = -1;  // invocable net with a result: props_ slot of its `result` property
-  int start_place = -1;  // invocable net: index of its start place
+// What the VM runs of a function (run-time state, one per function of the image): a copy of the image's
+// code, which a debugger patches (OP_BREAK over line starts; the image's code is the original it restores
+// from), and the debugger's trampoline. The VM reads code through Frame::run exactly as it read
+// Function::code before the split: no extra indirection per instruction, one per call or return.
+struct RunCode {
+  const Function* fn;     // the image's function (the VM reaches it from here: no extra load per call)
+  std::vector<Ins> code;  // sized once (frames point into it): only instructions are overwritten
+  // Per instruction i: the image's code[i], then OP_RESUME to i + 1 (made when first patched; kept after,
+  // as a frame may still run in it).
+  std::vector<Ins> tramp;
+  bool patched = false;  // code differs from the image's (a debugger patched it, not restored yet)
 };
 
 struct Frame {
   const Function* fn;
+  RunCode* run;  // the code it runs (ProgramImpl::run_ of fn)
   const Ins* pc;
   std::uint32_t base;
   std::uint64_t self;
@@ -301,7 +92,7 @@ struct Frame {
 // The index of the instruction a frame last started (its call, or where it stopped), also when the
 // frame runs in its function's debugger trampoline.
 inline std::size_t pc_index(const Frame& f) noexcept {
-  const Function& fn = *f.fn;
+  const RunCode& fn = *f.run;
   if (!fn.tramp.empty() && f.pc > fn.tramp.data() && f.pc <= fn.tramp.data() + fn.tramp.size())
     return static_cast<std::size_t>(f.pc - fn.tramp.data() - 1) / 2;
   return f.pc > fn.code.data() ? static_cast<std::size_t>(f.pc - fn.code.data()) - 1 : 0;
@@ -320,6 +111,7 @@ class ProgramImpl {
   // load() in two halves: check, define the run-time classes and enums, compile (define); then make the
   // database content (populate). A reload (migrate.cpp) defines, then migrates instead of populating.
   void define(std::string name, std::string text);
+  void define_image(std::string name, std::string text);  // define()'s body: writes build()
   void populate();
   void connect_listeners();
   void make_source();  // the SourceFile node and its SourceComponents
@@ -401,7 +193,8 @@ class ProgramImpl {
   void put_token(Place& p, SimStateInstance* obj, std::int64_t n);
   // "place 'p' would hold more than 2^63-1 tokens": a token count never wraps.
   // (produced by @p arrow, when given: its position ends the message)
-  [[noreturn, gnu::cold]] void too_many_tokens(const Place& p, std::int64_t n, const ArrowDecl* arrow = nullptr);
+  [[noreturn, gnu::cold]] void too_many_tokens(const Place& p, std::int64_t n,
+                                               const ArrowDecl* arrow = nullptr);
   // For a firing without a savepoint: throws (before anything changed) when producing would take a place
   // past 2^63-1 tokens, naming the arrow.
   void check_token_room(NetInst& net, const TransitionInfo& t);
@@ -451,45 +244,37 @@ class ProgramImpl {
   // ---- data ----
   SimState& state_;
   RunOptions opt_;
-  std::unique_ptr<CheckResult> checked_;
-  std::string stem_;
+  // The program image (image.hpp): made by define(), never changed afterwards. define() writes it
+  // through build(), which is valid only while define() runs; everything else reads image().
+  std::shared_ptr<const ProgramImage> image_ = std::make_shared<const ProgramImage>();
+  ProgramImage* build_ = nullptr;
+  [[nodiscard]] const ProgramImage& image() const noexcept { return *image_; }
+  ProgramImage& build() noexcept {
+    VSD_ASSERT(build_ != nullptr, "the program image is written only while define() runs");
+    return *build_;
+  }
+  // Run-time copies of what the VM reads of the image and a run changes (made by define(), linked by
+  // link_objects()): the constants (OP_OBJ slots get the ids of the static objects), the ids of the
+  // outer plans' fixed instances, and each function's code (RunCode: the debugger patches it).
+  std::vector<std::int64_t> consts_;
+  std::vector<std::uint64_t> outer_ids_;
+  std::vector<RunCode> run_;
+  void prepare_run();
+  // Once the static objects exist (object_ids_): their ids into consts_ and outer_ids_.
+  void link_objects();
+
   Node* root_ = nullptr;
   SourceFile* source_node_ = nullptr;
-
-  std::vector<std::unique_ptr<Function>> functions_;
-  std::vector<std::int64_t> consts_;
-  std::vector<std::string> strings_;
-  std::vector<PropSlot> props_;
-  std::vector<const MetaMethod*> methods_;
-  std::vector<const ClassInfo*> classes_;         // by NEW/ISA operand (script classes)
-  std::vector<const MetaInstance*> class_metas_;  // by NEW/ISA operand
-  std::vector<const MetaType*> enum_types_;       // TOSTR of enums
-  std::vector<const MetaType*> range_types_;
-  std::vector<const MetaType*> xtypes_;  // OP_XDEF, OP_XGETF, OP_XSETF operands (value types)
-  std::vector<std::vector<RK>> print_kinds_;
-  std::vector<std::vector<const MetaType*>> print_types_;  // per print: the vector types of V arguments
-  std::vector<OuterPlan> outer_plans_;
-  std::vector<const FunctionDecl*> vslots_;                // virtual slot -> root function
-  std::unordered_map<const FunctionDecl*, int> vslot_of_;  // overridden functions -> virtual slot
-  std::vector<std::vector<RK>> method_kinds_;              // MCALL argument kinds
-  std::vector<RK> method_results_;
-  std::vector<std::pair<int, const ClassDecl*>> object_refs_;  // consts_ slot -> object
-  std::vector<const PlaceDecl*> port_places_;                  // places of port nets named in code
-  // The node of place port_places_[k] in the copy of its port net whose instance is @p copy; 0: none.
+  // The node of place port_places[k] in the copy of its port net whose instance is @p copy; 0: none.
   std::uint64_t port_place_id(std::uint64_t copy, std::size_t k) const;
-  std::unordered_map<const Decl*, int> scope_init_;  // place/transition property initialisers
-
-  std::unordered_map<const ClassDecl*, std::unique_ptr<ClassInfo>> class_info_;
-  std::vector<const ClassDecl*> class_order_;  // bases first
+  std::unordered_map<const ClassDecl*, std::uint64_t> object_ids_;  // top-level objects
+  // The Registry's classes and enums of the image's declarations, by declaration and by class (the
+  // loader's, not the compiler's: emptied when they are undefined — a refused load, a reload — so that
+  // no lookup matches a class at a recycled address).
   std::unordered_map<const EnumDecl*, const MetaType*> enums_;
-  std::unordered_map<const PropertyDecl*, int> prop_slot_;  // decl -> props_ index
-  std::unordered_map<const MetaProperty*, int> meta_prop_slot_;
-  std::unordered_map<const FunctionDecl*, int> function_index_;
   std::unordered_map<const Decl*, const MetaInstance*> scope_meta_;  // place/transition classes too
-  std::unordered_map<const ClassDecl*, std::uint64_t> object_ids_;   // top-level objects
   std::unordered_map<const MetaInstance*, const ClassInfo*> by_meta_;
   std::unordered_map<const Decl*, SourceComponent*> components_;
-  std::vector<std::pair<int, const TransitionDecl*>> when_fns_, action_fns_;
 
   // VM state
   std::vector<Val> regs_;
@@ -520,7 +305,6 @@ class ProgramImpl {
   [[noreturn, gnu::cold, gnu::noinline]] void memory_exhausted(std::size_t bytes);
   int entry_depth_ = 0;
   std::vector<std::pair<std::uint64_t, const MetaProperty*>>* deps_ = nullptr;
-  std::vector<int> vslot_default_;  // virtual slot -> function of the root declaration
   std::string stack_text(std::size_t from) const;
 
   // executor state
@@ -592,7 +376,7 @@ class ProgramImpl {
   }
   void fire(std::uint32_t ti);
   bool fire_chosen(const Transition& node);  // Program::fire
-  void fire_body(std::uint32_t ti);  // fire() without the savepoint
+  void fire_body(std::uint32_t ti);          // fire() without the savepoint
   // Undoes a failed firing: the SimState back to @p sp, nets killed since killed_[killed] revived.
   void roll_back(const SimState::Savepoint& sp, std::size_t killed, const std::string& why);
   // A net whose nodes a rolled-back firing deleted and re-created: registered again from its nodes.

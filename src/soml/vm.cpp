@@ -191,8 +191,8 @@ std::string ProgramImpl::stack_text(std::size_t from) const {
     const Frame& f = frames_[i];
     const std::size_t at = pc_index(f);
     const Function::Pos pos = at < f.fn->positions.size() ? f.fn->positions[at] : Function::Pos{};
-    s += "\n  at " + f.fn->name + " (" + checked_->source->name() + ":" + std::to_string(pos.line) + ":" +
-         std::to_string(pos.column) + ")";
+    s += "\n  at " + f.fn->name + " (" + image().checked->source->name() + ":" + std::to_string(pos.line) +
+         ":" + std::to_string(pos.column) + ")";
   }
   return s;
 }
@@ -218,7 +218,9 @@ static std::size_t value_bytes(const MetaType& t, const void* addr) {
   if (t.kind() == TypeKind::Vector && t.element() != nullptr) n += t.vector_size(addr) * t.element()->size();
   return n;
 }
-static std::size_t heap_bytes(const Value& v) { return v.type() != nullptr ? value_bytes(*v.type(), v.data()) : 0; }
+static std::size_t heap_bytes(const Value& v) {
+  return v.type() != nullptr ? value_bytes(*v.type(), v.data()) : 0;
+}
 // The heap bytes of the register a value of type @p t goes to (to_registers): none for numbers.
 static std::size_t register_bytes(const MetaType& t, const std::string& s, const VecReg& v, const Value& x) {
   switch (t.kind()) {
@@ -247,13 +249,14 @@ void ProgramImpl::int_overflow(std::int64_t a, const char* op, std::int64_t b) {
        " does not fit an int (64 bits)");
 }
 void ProgramImpl::int_overflow(const char* what, std::int64_t a) {
-  fail(std::string("integer overflow: ") + what + "(" + std::to_string(a) + ") does not fit an int (64 bits)");
+  fail(std::string("integer overflow: ") + what + "(" + std::to_string(a) +
+       ") does not fit an int (64 bits)");
 }
 
 Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* args,
                      const std::string* sargs, std::string* sresult, const VecReg* vargs, VecReg* vresult,
                      const Value* xargs, Value* xresult) {
-  const Function& f = *functions_[static_cast<std::size_t>(fi)];
+  const Function& f = *image().functions[static_cast<std::size_t>(fi)];
   const std::size_t entry = frames_.size();
   if (entry == 0) {
     budget_ = opt_.instruction_budget == 0 ? 1 : opt_.instruction_budget;
@@ -280,7 +283,8 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
     else if (f.param_kinds[static_cast<std::size_t>(i)] == RK::X)
       xregs_[base + static_cast<std::size_t>(i)] = xargs != nullptr ? xargs[i] : Value{};
   }
-  frames_.push_back(Frame{&f, f.code.data(), base, self, mark});
+  RunCode& rc = run_[static_cast<std::size_t>(fi)];
+  frames_.push_back(Frame{&f, &rc, rc.code.data(), base, self, mark});
   top_ = base + static_cast<std::uint32_t>(f.nregs);
   try {
     Val v = exec(entry);
@@ -306,8 +310,8 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
 [[gnu::noinline]] std::uint64_t ProgramImpl::new_instance(const Ins in, const Frame& frame) {
   const Val* R = regs_.data() + frame.base;
   const std::string* S = sregs_.data() + frame.base;
-  const ClassInfo* ci = classes_[in.b];
-  const MetaInstance& cls = ci != nullptr ? *ci->meta : *class_metas_[in.b];
+  const ClassInfo* ci = image().classes[in.b];
+  const MetaInstance& cls = ci != nullptr ? *ci->meta : *image().class_metas[in.b];
   charge(cls.size() + kInstanceBytes);
   const std::size_t before = state_.size() + 1;
   auto rest = [&] {
@@ -318,7 +322,8 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
     rest();
     return id;
   }
-  const Function* ctor = ci->ctor >= 0 ? functions_[static_cast<std::size_t>(ci->ctor)].get() : nullptr;
+  const Function* ctor =
+      ci->ctor >= 0 ? image().functions[static_cast<std::size_t>(ci->ctor)].get() : nullptr;
   if (in.c > 8) fail("more than 8 constructor arguments");
   std::string sargs[8];
   VecReg vargs[8];
@@ -466,13 +471,13 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
     case OP_PVGET: {
       const std::uint64_t id = R[in.b].id;
       SimStateInstance& o = obj(id);
-      const MetaProperty& p = *props_[in.c].prop;
+      const MetaProperty& p = *image().props[in.c].prop;
       if (!o.meta().is_a(p.owner())) {
         fail("instance of " + o.meta().name() + " has no property '" + p.name() + "'");
       }
       if (deps_ != nullptr) deps_->emplace_back(id, &p);
       const void* addr = p.address(o);
-      const bool value = props_[in.c].kind == PK::Value;  // a vector of structs or enums
+      const bool value = image().props[in.c].kind == PK::Value;  // a vector of structs or enums
       const std::size_t n = value ? p.type().vector_size(addr) : vector_size(p.type(), addr);
       if (in.op == OP_PVSIZE) {
         R[in.a].i = static_cast<std::int64_t>(n);
@@ -612,7 +617,7 @@ static void from_registers(const MetaType& t, void* addr, const Val& v, const st
   switch (in.op) {
     case OP_XDEF: {
       const std::size_t before = heap_bytes(X[in.a]);
-      X[in.a] = Value(*xtypes_[in.b]);
+      X[in.a] = Value(*image().xtypes[in.b]);
       grew(before, heap_bytes(X[in.a]));
       break;
     }
@@ -681,11 +686,12 @@ static void from_registers(const MetaType& t, void* addr, const Val& v, const st
 
 Val ProgramImpl::exec(std::size_t entry) {
   Frame* fr = &frames_.back();
-  const Ins* code = fr->fn->code.data();
+  const Ins* code = fr->run->code.data();
   const Ins* pc = fr->pc;
   Val* R = regs_.data() + fr->base;
   std::string* S = sregs_.data() + fr->base;
   const std::int64_t* K = consts_.data();
+  const ProgramImage& img = image();  // immutable: read once
   const std::size_t max_frames = static_cast<std::size_t>(opt_.max_depth);
 
 #define VSD_SAVE() (fr->pc = pc)
@@ -742,8 +748,8 @@ Val ProgramImpl::exec(std::size_t entry) {
         R[in.a].i = K[in.b];
         break;
       case OP_LOADS:
-        string_room(S[in.a], strings_[in.b].size());
-        S[in.a] = strings_[in.b];
+        string_room(S[in.a], img.strings[in.b].size());
+        S[in.a] = img.strings[in.b];
         break;
       case OP_MOV:
         R[in.a] = R[in.b];
@@ -881,7 +887,7 @@ Val ProgramImpl::exec(std::size_t entry) {
         } else if (in.c == 2) {
           S[in.a] = R[in.b].i != 0 ? "true" : "false";
         } else {
-          const MetaType& t = *enum_types_[in.c - 3u];
+          const MetaType& t = *img.enum_types[in.c - 3u];
           const std::string_view n = t.enum_name(R[in.b].i);
           S[in.a] = n.empty() ? std::to_string(R[in.b].i) : std::string(n);
         }
@@ -917,17 +923,18 @@ Val ProgramImpl::exec(std::size_t entry) {
         const std::uint64_t self = R[in.c].id;
         int fi = in.b;
         if (in.op == OP_VCALL) {
-          fi = vslot_default_[in.b];
+          fi = img.vslot_default[in.b];
           const SimStateInstance& o = obj(self);
           auto ci = by_meta_.find(&o.meta());
           if (ci != by_meta_.end()) {
-            auto v = ci->second->vtable.find(vslots_[in.b]);
+            auto v = ci->second->vtable.find(img.vslots[in.b]);
             if (v != ci->second->vtable.end()) fi = v->second;
           }
         } else if (self == 0) {
           fail("null reference");
         }
-        const Function& callee = *functions_[static_cast<std::size_t>(fi)];
+        RunCode& rc = run_[static_cast<std::size_t>(fi)];
+        const Function& callee = *rc.fn;
         if (frames_.size() >= max_frames)
           fail("call depth limit (" + std::to_string(opt_.max_depth) + ") reached calling " + callee.name);
         if (--budget_ == 0)
@@ -942,9 +949,9 @@ Val ProgramImpl::exec(std::size_t entry) {
           xregs_.resize(regs_.size());
         }
         const std::uint64_t mark = fr->mark;
-        frames_.push_back(Frame{&callee, callee.code.data(), nb, self, mark});
+        frames_.push_back(Frame{&callee, &rc, rc.code.data(), nb, self, mark});
         fr = &frames_.back();
-        code = callee.code.data();
+        code = rc.code.data();
         pc = code;
         top_ = nb + static_cast<std::uint32_t>(callee.nregs);
         VSD_REFRESH();
@@ -967,16 +974,16 @@ Val ProgramImpl::exec(std::size_t entry) {
         frames_.pop_back();
         if (frames_.size() == entry) return v;
         fr = &frames_.back();
-        code = fr->fn->code.data();
+        code = fr->run->code.data();
         pc = fr->pc;
         top_ = fr->base + static_cast<std::uint32_t>(fr->fn->nregs);
         VSD_REFRESH();
         break;
       }
       case OP_SELF: {
-        const OuterPlan& p = outer_plans_[in.b];
+        const OuterPlan& p = img.outer_plans[in.b];
         if (p.static_decl != nullptr) {
-          R[in.a].id = p.static_id;
+          R[in.a].id = outer_ids_[in.b];
         } else {
           std::uint64_t id = fr->self;
           for (int k = 0; k < p.parents; ++k) {
@@ -1001,7 +1008,7 @@ Val ProgramImpl::exec(std::size_t entry) {
       case OP_GETP: {
         const std::uint64_t id = R[in.b].id;
         SimStateInstance& o = obj(id);
-        const PropSlot& ps = props_[in.c];
+        const PropSlot& ps = img.props[in.c];
         if (!o.meta().is_a(ps.prop->owner())) {
           VSD_SAVE();
           fail("instance of " + o.meta().name() + " has no property '" + ps.prop->name() + "'");
@@ -1061,7 +1068,7 @@ Val ProgramImpl::exec(std::size_t entry) {
       case OP_SETP: {
         VSD_SAVE();
         SimStateInstance& o = obj(R[in.a].id);
-        const PropSlot& ps = props_[in.c];
+        const PropSlot& ps = img.props[in.c];
         const MetaProperty& p = *ps.prop;
         if (!o.meta().is_a(p.owner()))
           fail("instance of " + o.meta().name() + " has no property '" + p.name() + "'");
@@ -1200,7 +1207,7 @@ Val ProgramImpl::exec(std::size_t entry) {
         VSD_SAVE();
         const std::uint64_t id = R[in.op == OP_LPUSH ? in.a : in.b].id;
         SimStateInstance& o = obj(id);
-        const MetaProperty& p = *props_[in.c].prop;
+        const MetaProperty& p = *img.props[in.c].prop;
         if (!o.meta().is_a(p.owner()))
           fail("instance of " + o.meta().name() + " has no property '" + p.name() + "'");
         const auto& list = *static_cast<const RefListBase*>(p.address(o));
@@ -1233,7 +1240,7 @@ Val ProgramImpl::exec(std::size_t entry) {
       case OP_AS: {
         const std::uint64_t id = R[in.b].id;
         const SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
-        const bool yes = o != nullptr && o->meta().is_a(*class_metas_[in.c]);
+        const bool yes = o != nullptr && o->meta().is_a(*img.class_metas[in.c]);
         if (in.op == OP_ISA)
           R[in.a].i = yes ? 1 : 0;
         else
@@ -1246,8 +1253,8 @@ Val ProgramImpl::exec(std::size_t entry) {
         // What a C++ method reads is invisible here: a condition that calls one watches every property
         // of the instance (a null property: see on_change).
         if (deps_ != nullptr) deps_->emplace_back(o.id(), nullptr);
-        const MetaMethod& m = *methods_[in.b];
-        const auto& kinds = method_kinds_[in.b];
+        const MetaMethod& m = *img.methods[in.b];
+        const auto& kinds = img.method_kinds[in.b];
         std::vector<Value> args;
         args.reserve(kinds.size());
         for (std::size_t i = 0; i < kinds.size(); ++i) {
@@ -1281,7 +1288,7 @@ Val ProgramImpl::exec(std::size_t entry) {
         }
         Value r = o.meta().call(o, m.name(), args);
         VSD_REFRESH();
-        switch (method_results_[in.b]) {
+        switch (img.method_results[in.b]) {
           case RK::I:
             if (r.is<bool>())
               R[in.a].i = r.as<bool>() ? 1 : 0;
@@ -1369,7 +1376,7 @@ Val ProgramImpl::exec(std::size_t entry) {
       }
       case OP_PRINT: {
         std::ostream& out = opt_.out != nullptr ? *opt_.out : std::cout;
-        const auto& kinds = print_kinds_[in.c];
+        const auto& kinds = img.print_kinds[in.c];
         std::string line;
         for (int i = 0; i < in.b; ++i) {
           switch (kinds[static_cast<std::size_t>(i)]) {
@@ -1383,8 +1390,8 @@ Val ProgramImpl::exec(std::size_t entry) {
               line += S[in.a + i];
               break;
             case RK::V:
-              line +=
-                  vector_text(*print_types_[in.c][static_cast<std::size_t>(i)], vregs_[fr->base + in.a + i]);
+              line += vector_text(*img.print_types[in.c][static_cast<std::size_t>(i)],
+                                  vregs_[fr->base + in.a + i]);
               break;
             case RK::X: {
               const Value& x = xregs_[fr->base + in.a + i];
@@ -1407,7 +1414,7 @@ Val ProgramImpl::exec(std::size_t entry) {
       }
       case OP_FAIL:
         VSD_SAVE();
-        fail(strings_[in.b]);
+        fail(img.strings[in.b]);
       case OP_BREAK: {
         // Only a debugger patches this in (a line start or a breakpoint). After its hook, the original
         // instruction runs from the function's trampoline (original, then OP_RESUME back here), so the
@@ -1416,7 +1423,7 @@ Val ProgramImpl::exec(std::size_t entry) {
         const auto at = static_cast<std::size_t>(pc - 1 - code);
         if (debug_ != nullptr) debug_->on_break(*fr->fn, at);
         VSD_REFRESH();
-        pc = fr->fn->tramp.data() + 2 * at;
+        pc = fr->run->tramp.data() + 2 * at;
         break;
       }
       case OP_RESUME:

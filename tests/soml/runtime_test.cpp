@@ -544,4 +544,26 @@ TEST(RuntimeScripts, EveryCleanGoldenScriptLoadsOrIsRefusedWithAPosition) {
   std::cout << "golden scripts: " << loaded << " loaded and ran, " << refused << " refused\n";
 }
 
+TEST_F(Runtime, DisassemblyNamesFunctionsOpcodesOperandsAndLines) {
+  Program& p = load(R"(int fib(int n) {
+  if (n < 2) return n;
+  return fib(n - 1) + fib(n - 2);
+}
+object cell {
+  string label = "a\nb";
+  double big = 12345678.5;
+}
+)");
+  const std::string d = p.disassemble();
+  EXPECT_THAT(d, ::testing::HasSubstr("function f0 fib ("));
+  EXPECT_THAT(d, ::testing::HasSubstr("params 1, registers 7, result int"));
+  EXPECT_THAT(d, ::testing::HasSubstr("local r0 n: int [0, "));
+  EXPECT_THAT(d, ::testing::ContainsRegex("  0  LOADI +r2, #2 +; 2:11"));
+  EXPECT_THAT(d, ::testing::ContainsRegex("CALL +r3, f0, r2 +; 3:13  fib"));
+  EXPECT_THAT(d, ::testing::ContainsRegex("JMPF +r1, -> 5"));
+  EXPECT_THAT(d, ::testing::HasSubstr("s1 = \"a\\nb\""));  // strings quoted, control characters escaped
+  EXPECT_THAT(d, ::testing::HasSubstr("\nconstants\n"));
+  EXPECT_THAT(d, ::testing::HasSubstr(".label"));  // a property operand names the property
+}
+
 }  // namespace

@@ -29,6 +29,7 @@ constexpr std::string_view usage =
     "       vsd-soml run FILE [--steps N] [--trace] [--seed S]\n"
     "       vsd-soml debug FILE [--break FILE:LINE]... [--break-transition NAME]... [--seed S] [--steps N]\n"
     "       vsd-soml convert IN OUT\n"
+    "       vsd-soml disasm FILE\n"
     "       vsd-soml --help\n"
     "\n"
     "run      Loads the SOML++ script FILE into a database and fires its transitions: N firings, or until\n"
@@ -68,6 +69,13 @@ constexpr std::string_view usage =
     "         anything else: SOML++). PNML ids that are not SOML++ identifiers are renamed (a note on\n"
     "         stderr; the original id stays in a comment). OUT is written atomically: a write that fails\n"
     "         leaves the old file whole; OUT \"-\" writes to stdout.\n"
+    "\n"
+    "disasm   Loads the SOML++ script FILE as run does (without firing) and prints its bytecode: per\n"
+    "         function its name, FILE:LINE, parameters, registers and locals (slot, name, type, the\n"
+    "         instructions where visible), then each instruction: index, opcode, operands (r register,\n"
+    "         # immediate, k constant, s string, p property, f function, c class, m method, -> target) and\n"
+    "         the line:column it computes, with what an operand names; then the constants and strings.\n"
+    "         Errors in the script are printed with file:line:col.\n"
     "\n"
     "FILE and IN may be \"-\" (standard input; a net in XML is taken as PNML) or a pipe, except for debug,\n"
     "which reads its commands there. vsd-soml knows vsd's own classes (Node, the scene, robotics and\n"
@@ -241,16 +249,37 @@ int analyze(std::span<const std::string_view> args, std::ostream& out, std::ostr
   return exit_ok;
 }
 
+// vsd-soml disasm FILE: the bytecode of a loaded script (Program::disassemble).
+int disasm(std::span<const std::string_view> args, std::ostream& out, std::ostream& err) {
+  const Arguments a(args, {});
+  a.expect_positional(1, 1, "one FILE");
+  const std::string_view path = a.positional()[0];
+  const std::string file = path == "-" ? "<stdin>" : std::string(path);
+  const std::string text = as_text(read_input(path));
+  Workspace ws;
+  auto& soml = ws.env().use<vsd::soml::Module>();
+  try {
+    out << soml.load(ws.state(), file, text).disassemble();
+  } catch (const vsd::Error& e) {
+    out.flush();
+    const std::string m = printable_lines(e.what());
+    err << m << (m.ends_with("\n") ? "" : "\n");
+    return exit_failure;
+  }
+  return exit_ok;
+}
+
 }  // namespace
 
 int run(std::span<const std::string_view> args, std::istream& in, std::ostream& out, std::ostream& err) {
   return tool::run(tool, args, out, err, [&in](std::span<const std::string_view> a, std::ostream& o, std::ostream& e) {
-    if (a.empty()) throw UsageError("no command (run, debug, analyze or convert)");
+    if (a.empty()) throw UsageError("no command (run, debug, analyze, convert or disasm)");
     const auto rest = a.subspan(1);
     if (a[0] == "analyze") return analyze(rest, o, e);
     if (a[0] == "run") return run_script(rest, o, e);
     if (a[0] == "debug") return debug_command(rest, in, o, e);
     if (a[0] == "convert") return convert(rest, o, e);
+    if (a[0] == "disasm") return disasm(rest, o, e);
     throw UsageError("unknown command '" + printable(a[0]) + "'");
   });
 }

@@ -177,6 +177,12 @@ class Program {
   /// @brief Run-time errors of conditions so far (a failing condition counts as not enabled).
   [[nodiscard]] const std::vector<std::string>& condition_errors() const noexcept;
 
+  /// @brief The bytecode this program runs, as text (`vsd-soml disasm`; docs/soml.md, "Disassembly"): per
+  /// function its name, file:line, parameters, registers, locals and each instruction with its index,
+  /// opcode name, operands and line:column; then the constants and strings. As compiled: debugger
+  /// patches are not shown, constants naming objects show 0 (their ids are linked at run time).
+  [[nodiscard]] std::string disassemble() const;
+
   /// @brief The implementation (for the Module and the tools).
   [[nodiscard]] ProgramImpl& impl() noexcept { return *impl_; }
 
