@@ -9,7 +9,8 @@
 #                                   and workcell.png with gnuplot, into build/examples/workcell)
 #   bash scripts/demo.sh --tour     the core-only tour (examples/demo); further arguments go to it
 # It installs only what it runs (scripts/install-deps.sh, groups): the work cell needs the core, vsd::scene
-# (urdfdom, assimp), vsd::collision (FCL, libccd) and vsd::physics (ODE); the tour the core only. gnuplot
+# (urdfdom, assimp), vsd::collision (FCL, libccd) and vsd::physics (ODE); the tour the core only. With
+# --serve [PORT] (either cell, docs/web.md) it adds the `web` group and builds the page (vsd_web_assets). gnuplot
 # (for the one-robot cell's PNG) is not installed: that cell writes its CSV without it. The tests are not
 # configured.
 # Environment: BUILD_DIR (default build), VSD_SKIP_DEPS=1 to skip the dependency check.
@@ -18,8 +19,12 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
 BUILD_DIR="${BUILD_DIR:-build}"
 
+serve=0
+for a in "$@"; do [[ "$a" == "--serve" ]] && serve=1; done
 if [[ "${1:-}" == "--tour" ]]; then
   bash scripts/install-deps.sh core
+elif [[ $serve -eq 1 ]]; then   # the cell in the browser: vsd::web and its page (npm) too
+  bash scripts/install-deps.sh core scene collision physics web
 else
   bash scripts/install-deps.sh core scene collision physics
 fi
@@ -39,6 +44,9 @@ fi
 # (The target list is read whole first: `grep -q` would stop reading early, and under pipefail the
 # writer's SIGPIPE would count as "not found".)
 targets="$(cmake --build "$BUILD_DIR" --target help)"
+if [[ $serve -eq 1 ]] && grep -q '\bvsd_web_assets\b' <<<"$targets"; then
+  cmake --build "$BUILD_DIR" --target vsd_web_assets
+fi
 if [[ "${1:-}" == "--one-robot" ]] && grep -q '\bvsd_workcell\b' <<<"$targets"; then
   shift
   cmake --build "$BUILD_DIR" --target vsd_workcell --parallel 2
