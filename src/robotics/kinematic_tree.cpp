@@ -128,6 +128,15 @@ const std::vector<KinematicJoint*>& Tracker::followers_of(const KinematicJoint& 
   return it == followers.end() ? none : it->second;
 }
 
+// Whether @p node is part of some kinematic tree: it or one of its ancestors holds a KinematicTree. Only
+// such nodes are in a compiled model; a part on a conveyor, a gripper pad or a marker can move or gain
+// extensions without any model having to be compiled again.
+bool in_a_tree(const vsd::Node& node) {
+  for (const vsd::Node* n = &node; n != nullptr; n = n->parent())
+    if (n->find_extension<KinematicTree>() != nullptr) return true;
+  return false;
+}
+
 void Tracker::joint_changed(KinematicJoint& j, const MetaProperty& p) {
   if (from_frame) return;  // the values follow the link's frame: nothing to derive from them
   if (depth > 64) return;  // a mimic cycle (compile() rejects it); do not recurse without end
@@ -138,7 +147,10 @@ void Tracker::joint_changed(KinematicJoint& j, const MetaProperty& p) {
   } leave{depth};
   const bool position = &p == &KinematicJoint::vsd_prop_position();
   const bool value = position || &p == &KinematicJoint::vsd_prop_position2();
-  if (!value) ++version;
+  if (!value) {  // a limit, an axis, a mimic...: part of the model of the tree the joint is in, if any
+    const auto* owner = j.owner() != nullptr ? j.owner()->as<vsd::Node>() : nullptr;
+    if (owner != nullptr && in_a_tree(*owner)) ++version;
+  }
   if (&p == &KinematicJoint::vsd_prop_mimic() || &p == &KinematicJoint::vsd_prop_mimic_multiplier() ||
       &p == &KinematicJoint::vsd_prop_mimic_offset()) {
     sync_mimic(j);  // never dropped: the follower takes its master's value at once
@@ -164,10 +176,10 @@ void Tracker::joint_changed(KinematicJoint& j, const MetaProperty& p) {
 void Tracker::node_changed(scene::Node3D& node, const MetaProperty& p) {
   KinematicJoint* j = node.find_extension<KinematicJoint>();
   if (&p == &vsd::NamedModelInstance::vsd_prop_extensions()) {
-    ++version;
+    if (in_a_tree(node)) ++version;  // a joint or a tree attached or removed inside a tree
     if (j != nullptr) sync_owner_frame(*j);
   } else if (j == nullptr) {
-    ++version;  // the frame of a node without a joint is part of the model
+    if (in_a_tree(node)) ++version;  // the frame of a fixed link is part of the model
   } else if (syncing == 0) {
     follow_frame(node, *j);  // someone else moved a jointed link: its values follow
   }

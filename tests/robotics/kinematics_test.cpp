@@ -133,6 +133,34 @@ TEST(Kinematics, RecompilesOnlyOnTopologyChanges) {
   EXPECT_THROW(r.tree->set_positions(std::vector<double>{1, 2}), vsd::Error);
 }
 
+TEST(Kinematics, NodesOutsideEveryTreeDoNotRecompileIt) {
+  Robot r("ur5_robot.urdf");
+  vsd::SimState& s = r.env.main_state();
+  (void)r.tree->model();
+  // A part moving beside the robot, gaining and losing an extension: no model depends on it.
+  auto& part = s.create<scene::Node3D>();
+  s.database().add_child(part);  // any reparenting counts (the old parent is not known any more)
+  (void)r.tree->model();
+  const std::uint64_t before = topology_version(s);
+  const std::uint64_t compiled = r.tree->compilations();
+  for (int i = 0; i < 10; ++i) part.set_frame(Eigen::Isometry3d(Eigen::Translation3d(0.01 * i, 0, 0)));
+  auto& joint = s.create<KinematicJoint>();
+  part.add_extension(joint);
+  part.remove_extension(joint);
+  (void)r.tree->model();
+  EXPECT_EQ(topology_version(s), before);
+  EXPECT_EQ(r.tree->compilations(), compiled);
+  // A fixed link inside the tree is part of the model: moving it compiles it again.
+  auto& camera = s.create<scene::Link>();
+  r.link("tool0").add_child(camera);  // a new node in the tree (reparented: a new version)
+  (void)r.tree->model();
+  const std::uint64_t with_camera = r.tree->compilations();
+  camera.set_frame(Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.1)));
+  EXPECT_GT(topology_version(s), before);
+  (void)r.tree->model();
+  EXPECT_EQ(r.tree->compilations(), with_camera + 1);
+}
+
 TEST(Kinematics, UniversalAndDhJointsInTheDatabase) {
   Environment env;
   env.use<Module>();
