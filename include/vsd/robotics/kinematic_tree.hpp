@@ -39,7 +39,10 @@ class KinematicTree : public vsd::Extension {
   [[nodiscard]] std::vector<KinematicJoint*> joints() const;
   /// @brief The joint named @p name below the base, or nullptr.
   [[nodiscard]] KinematicJoint* find_joint(std::string_view name) const;
-  /// @brief The compiled model of the whole tree; recompiled only after a topology change.
+  /// @brief The compiled model of the whole tree; recompiled only after a topology change (a change of
+  /// anything inside the tree but joint values: a limit, a fixed link's frame, a link added or removed).
+  /// The reference stays valid until the next such change: an IkSolver made from it must not be kept
+  /// across one (make it again, as the two-robot work cell does before each solve).
   /// @throws vsd::Error when not attached to a Node3D or when compile() throws.
   [[nodiscard]] const Model& model() const;
   /// @brief How often model() compiled (for tests and diagnostics).
