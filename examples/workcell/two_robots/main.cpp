@@ -4,6 +4,10 @@
 //   vsd_two_robot_cell [--seed N] [--parts N] [--csv FILE] [--quiet] [--step S] [--physics-step S]
 //                      [--time-limit S] [--urdf IIWA14.URDF] [--meta meta_control.soml]
 //                      [--robots multi_robot_control.soml] [--serve [PORT]]
+//                      [--processes 1|2] [--role controller|ui --domain N] [--no-commands]
+//
+// --processes 2 (with vsd::dist built) runs the cell as a controller process and a ui process that
+// replicates it and sends operator commands (docs/workcell.md, "Two processes"); --role runs one of them.
 //
 // --serve (with vsd::web built) shows the cell in the browser while it runs in real time and after, until
 // Ctrl-C (docs/web.md): 127.0.0.1:PORT, 8080 by default, 0 for a free port.
