@@ -149,6 +149,33 @@ class ZoneSensor : public Node3D {
   VSD_PROPERTY(std::string, by, "")    // "robot_a", "robot_b", "robot_a and robot_b" or ""
 };
 
+/// The operator's commands (docs/workcell.md, "Two processes"): properties that a user interface writes —
+/// in the two-process run the ui owns this node — and the plant reacts to at the start of its sensor step.
+class Operator : public vsd::Node {
+  VSD_INSTANCE(Operator, vsd::Node)
+  VSD_PROPERTY(bool, pause_a, false)                           // robot_a's controller holds while true
+  VSD_PROPERTY(bool, pause_b, false)                           // robot_b's
+  VSD_PROPERTY(std::int64_t, injections, 0)                    // raised by one per part to inject ...
+  VSD_PROPERTY(std::int64_t, inject_kind, 1)                   // ... of this kind (1 or 2)
+  VSD_PROPERTY(std::int64_t, moves, 0)                         // raised by one per move of ...
+  VSD_PROPERTY(vsd::SharedRef<vsd::Node>, move_part, nullptr)  // ... this part (lying still) ...
+  VSD_PROPERTY(double, move_dx, 0.0)                           // ... by (dx, dy), at most 2 cm
+  VSD_PROPERTY(double, move_dy, 0.0)
+  VSD_PROPERTY(bool, ready, false)  // the ui has joined (the two-process controller waits for it)
+  // The ui's digest of its replica's vsd::io binary save; not Savable, so that it is not in the saves
+  // it describes.
+  VSD_PROPERTY(std::string, replica_digest, "", vsd::Editable | vsd::Distributed)
+};
+
+/// What the plant tells the operator: its reply to the last command, and the end of the run.
+class Session : public vsd::Node {
+  VSD_INSTANCE(Session, vsd::Node)
+  VSD_PROPERTY(std::int64_t, replies, 0)
+  VSD_PROPERTY(std::string, reply, "")
+  VSD_PROPERTY(bool, finished, false)
+  VSD_PROPERTY(std::string, verdict, "")  // the controller's comparison of the replica with its state
+};
+
 /// A robot's interface to the nets: σ properties, γ methods (as the one-robot cell's Robot, with joint
 /// space motions: a Cartesian goal is solved by IK once and cached, the controller plans a trapezoidal
 /// joint trajectory to it, rail included).
@@ -171,6 +198,7 @@ class Robot : public vsd::Node {
   std::uint64_t step = 0;
   std::uint64_t commanded_in_step = 0;
   double moving_time = 0;
+  bool paused = false;  // by the operator: the controller holds (mode Idle) until resumed
   std::map<std::array<long, 3>, std::vector<double>> solutions;  // goal in the base frame (µm) -> joints
 
   /// γ: moves the pad's contact face to @p height above @p where's origin, the tool pointing down.
@@ -255,7 +283,7 @@ class Robot : public vsd::Node {
  private:
   void command(const std::vector<double>& q) {
     controller->set_target(q);
-    controller->set_mode(vsd::robotics::ControlMode::Position);
+    controller->set_mode(paused ? vsd::robotics::ControlMode::Idle : vsd::robotics::ControlMode::Position);
     set_arrived(false);
     commanded_in_step = step;
   }
@@ -273,6 +301,8 @@ class CellModule : public vsd::Module {
     r.add<Station>();
     r.add<ZoneSensor>();
     r.add<Robot>();
+    r.add<Operator>();
+    r.add<Session>();
   }
 };
 
@@ -359,6 +389,12 @@ CellReport run_cell(const CellOptions& o) {
   auto& orders = s.create<Orders>();
   orders.set_name("orders");
   s.database().add_child(orders);
+  auto& op = s.create<Operator>();
+  op.set_name("operator");
+  s.database().add_child(op);
+  auto& session = s.create<Session>();
+  session.set_name("session");
+  s.database().add_child(session);
   double now = 0;
   orders.log = tl;
   orders.clock = &now;
@@ -460,7 +496,12 @@ CellReport run_cell(const CellOptions& o) {
                                          &kit.geometry(GeometryKind::Box, {0.06, 0.06, 0.06})};
   std::vector<Part*> belt;    // on the belt, front first (no rigid body: the belt carries them)
   std::vector<Part*> placed;  // with a rigid body, somewhere in the room
-  int spawned = 0;
+  int spawned = 0;         // parts made (named part1, part2, ...)
+  int random_spawned = 0;  // of them, the seed's arrivals (o.parts in all)
+  std::vector<std::int64_t> injected;  // kinds the operator asked for, not on the belt yet
+  int parts_injected = 0;
+  std::int64_t injections_seen = 0, moves_seen = 0;
+  auto parts_wanted = [&] { return o.parts + parts_injected; };
   bool in_zone[2] = {false, false};  // this step's zone sensor
   double next_arrival = 0.5;
   CellReport report;
@@ -472,10 +513,54 @@ CellReport run_cell(const CellOptions& o) {
         now = info.time;
         conveyor.set_time(info.time);
         const double dt = o.step;
+        // The operator's commands: the plant's reaction to the properties of `operator` (written by a ui,
+        // through vsd::dist in the two-process run). Each is answered on `session`.
+        auto reply = [&](const std::string& text) {
+          if (tl) *tl << "t=" << Orders::fmt(now) << " s  operator: " << text << '\n';
+          session.set_reply(text);
+          session.set_replies(session.replies() + 1);
+        };
+        for (int i = 0; i < 2; ++i) {
+          Robot* r = robots[i];
+          const bool pause = i == 0 ? op.pause_a() : op.pause_b();
+          if (pause == r->paused) continue;
+          r->paused = pause;
+          if (pause)
+            r->controller->set_mode(vsd::robotics::ControlMode::Idle);  // holds where it is
+          else if (!r->controller->done())
+            r->controller->set_mode(vsd::robotics::ControlMode::Position);  // replans from here
+          reply((pause ? "paused " : "resumed ") + r->name());
+        }
+        for (; injections_seen < op.injections(); ++injections_seen) {
+          if (op.inject_kind() != 1 && op.inject_kind() != 2) {
+            reply("refused to inject a part of kind " + std::to_string(op.inject_kind()) + ": kinds are 1 and 2");
+            continue;
+          }
+          injected.push_back(op.inject_kind());
+          ++parts_injected;
+          reply("injects a part of kind " + std::to_string(op.inject_kind()));
+        }
+        if (moves_seen < op.moves()) {
+          moves_seen = op.moves();
+          auto* p = dynamic_cast<Part*>(op.move_part().get());
+          const Eigen::Vector3d d(op.move_dx(), op.move_dy(), 0);
+          if (p == nullptr) {
+            reply("refused a move: move_part is not a part");
+          } else if (!(d.norm() <= 0.02)) {
+            reply("refused to move " + p->name() + ": at most 2 cm at a time");
+          } else if (!p->resting() || p->find_extension<vsd::physics::RigidBody>() == nullptr) {
+            reply("refused to move " + p->name() + ": only a part lying still can be moved");
+          } else {
+            Eigen::Isometry3d f = p->frame();
+            f.translation() += d;
+            p->set_frame(f);  // physics teleports its body (velocities kept: zero, it lies still)
+            reply("moved " + p->name() + " by (" + Orders::fmt(d.x()) + ", " + Orders::fmt(d.y()) + ") m");
+          }
+        }
         for (Robot* r : robots) {
           r->step = info.step;
           r->set_time(info.time);
-          if (!r->controller->done() && report.parts_handled < o.parts)
+          if (!r->controller->done() && !r->paused && report.parts_handled < parts_wanted())
             r->moving_time += dt;  // until the last part
           if (!r->arrived() && info.step > r->commanded_in_step && r->controller->done()) {
             r->set_arrived(true);
@@ -506,17 +591,22 @@ CellReport run_cell(const CellOptions& o) {
           if (tl) *tl << "t=" << Orders::fmt(now) << " s  ZONE VIOLATION: both arms in the shared zone\n";
         }
         // The belt: a new part at the start when its gap has passed (and there is room).
-        if (spawned < o.parts && info.time >= next_arrival &&
-            (belt.empty() || belt.back()->belt_y > belt_start + belt_gap)) {
+        const bool belt_room = belt.empty() || belt.back()->belt_y > belt_start + belt_gap;
+        if (belt_room && (!injected.empty() || (random_spawned < o.parts && info.time >= next_arrival))) {
           auto& p = s.create<Part>();
-          const int kind = random.uniform() < 0.5 ? 1 : 2;
+          const bool inject = !injected.empty();
+          const auto kind = inject ? injected.front() : random.uniform() < 0.5 ? 1 : 2;
+          if (inject)
+            injected.erase(injected.begin());
+          else
+            ++random_spawned;
           p.set_kind(kind);
           p.set_height(kind == 1 ? 0.04 : 0.06);
           p.belt_y = belt_start;
           kit.hull(p, "part" + std::to_string(++spawned), *part_shape[kind - 1],
                    at(pick_xy.x(), belt_start, table_top + p.height() / 2), room);
           belt.push_back(&p);
-          next_arrival = info.time + 2.0 + 4.0 * random.uniform();
+          if (!inject) next_arrival = info.time + 2.0 + 4.0 * random.uniform();
           if (tl)
             *tl << "t=" << Orders::fmt(now) << " s  conveyor: " << p.name() << " (kind " << kind
                 << ") comes in\n";
@@ -585,7 +675,7 @@ CellReport run_cell(const CellOptions& o) {
             ++report.parts_handled;
             if (tl)
               *tl << "t=" << Orders::fmt(now) << " s  part handled: " << p->name() << " ("
-                  << report.parts_handled << " of " << o.parts << ")\n";
+                  << report.parts_handled << " of " << parts_wanted() << ")\n";
           }
         }
       },
@@ -636,7 +726,7 @@ CellReport run_cell(const CellOptions& o) {
   std::vector<double> step_times;  // s of wall time per env.step()
   if (o.on_built) o.on_built(env);
   for (;;) {
-    if (report.parts_handled == o.parts) {
+    if (report.parts_handled == parts_wanted()) {
       if (drained_at < 0) drained_at = env.time();
       const bool still = robots[0]->controller->done() && robots[1]->controller->done() &&
                          robots[0]->arrived() && robots[1]->arrived() && !mrc.enabled_any() &&
@@ -671,8 +761,11 @@ CellReport run_cell(const CellOptions& o) {
     const bool belt_moves =
         std::any_of(belt.begin(), belt.end(), [&](Part* p) { return p->belt_y != belt_y_before[p]; });
     const bool more_to_come =
-        spawned < o.parts && (belt.empty() || belt.back()->belt_y > belt_start + belt_gap);
-    const bool moving = report.parts_handled == o.parts || belt_moves || more_to_come ||
+        (random_spawned < o.parts || !injected.empty()) &&
+        (belt.empty() || belt.back()->belt_y > belt_start + belt_gap);
+    // A robot the operator paused is waiting for the operator, not deadlocked.
+    const bool moving = report.parts_handled == parts_wanted() || belt_moves || more_to_come ||
+                        robots[0]->paused || robots[1]->paused ||
                         !robots[0]->controller->done() || !robots[1]->controller->done() ||
                         std::any_of(placed.begin(), placed.end(),
                                     [](Part* p) { return !p->resting() || p->stage() == on_destination; });
@@ -696,6 +789,7 @@ CellReport run_cell(const CellOptions& o) {
     report.step_p99 = quantile(0.99);
   }
   report.time = drained_at >= 0 ? drained_at : env.time();
+  report.parts_injected = parts_injected;
   report.steps = env.scheduler().steps();
   report.parts_per_hour = report.time > 0 ? report.parts_handled * 3600.0 / report.time : 0;
   for (int i = 0; i < 2; ++i)
@@ -718,6 +812,28 @@ CellReport run_cell(const CellOptions& o) {
   return report;
 }
 
+void define_net_classes(vsd::Environment& env, const CellOptions& o) {
+  auto& soml = env.use<vsd::soml::Module>();
+  vsd::SimState& s = env.create_state("net classes");
+  auto add = [&](vsd::Node& parent, vsd::Node& n, const char* name) -> vsd::Node& {
+    n.set_name(name);
+    parent.add_child(n);
+    return n;
+  };
+  vsd::Node& cell = add(s.database(), s.create<vsd::scene::Scene>(), "cell");
+  add(cell, s.create<Conveyor>(), "conveyor");
+  add(cell, s.create<Station>(), "station");
+  add(cell, s.create<ZoneSensor>(), "zone");
+  for (const char* n : {"dest_a", "dest_b", "gate_a", "gate_b"}) add(cell, s.create<Node3D>(), n);
+  add(s.database(), s.create<Orders>(), "orders");
+  add(s.database(), s.create<Robot>(), "robot_a");
+  add(s.database(), s.create<Robot>(), "robot_b");
+  static std::ostringstream discard;  // the programs never run here: nothing is printed
+  vsd::soml::RunOptions run;
+  run.out = &discard;
+  for (const std::string* f : {&o.robot_script, &o.meta_script}) soml.load(s, *f, read_text(*f), run);
+}
+
 void print_summary(std::ostream& out, const CellReport& r) {
   char line[160];
   auto put = [&](const char* fmt, auto... v) {
@@ -727,6 +843,7 @@ void print_summary(std::ostream& out, const CellReport& r) {
   put("simulated: %.1f s in %llu steps", r.time, static_cast<unsigned long long>(r.steps));
   put("parts arrived: %d", r.parts_arrived);
   put("parts handled: %d", r.parts_handled);
+  if (r.parts_injected > 0) put("parts injected by the operator: %d", r.parts_injected);
   put("hand-overs: %d", r.handovers);
   put("parts/hour: %.1f", r.parts_per_hour);
   put("zone violations: %d", r.zone_violations);

@@ -46,6 +46,7 @@ struct CellOptions {
 struct CellReport {
   int parts_arrived = 0;
   int parts_handled = 0;  ///< resting on their destination, taken away by the outfeed
+  int parts_injected = 0;  ///< by the operator (`operator.injections`), on top of CellOptions::parts
   int handovers = 0;      ///< parts that went through the hand-over station
   double time = 0;        ///< s simulated
   double parts_per_hour = 0;
@@ -68,6 +69,12 @@ struct CellReport {
 /// Adds the modules the cell uses to @p env — robotics, physics, collision (with the given update period),
 /// the cell's own classes (Robot, Part, Orders, Conveyor, Station), SOML++ — so that its scripts check.
 void add_cell_modules(vsd::Environment& env, double collision_period = 0.01);
+
+/// Defines the run-time classes of the two scripts in @p env's Registry without running them: loads them
+/// into a state of their own ("net classes", not stepped) next to stand-ins of the nodes they look up. A
+/// process that replicates the cell (the ui of docs/workcell.md, "Two processes") needs the classes
+/// before the first snapshot arrives: run-time class definitions do not travel (docs/dist.md).
+void define_net_classes(vsd::Environment& env, const CellOptions& options);
 
 /// Builds the cell and runs it. @throws vsd::Error on bad options, unreadable files or a plant fault.
 CellReport run_cell(const CellOptions& options);

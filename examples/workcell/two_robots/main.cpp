@@ -4,6 +4,10 @@
 //   vsd_two_robot_cell [--seed N] [--parts N] [--csv FILE] [--quiet] [--step S] [--physics-step S]
 //                      [--time-limit S] [--urdf IIWA14.URDF] [--meta meta_control.soml]
 //                      [--robots multi_robot_control.soml] [--serve [PORT]]
+//                      [--processes 1|2] [--role controller|ui --domain N] [--no-commands]
+//
+// --processes 2 (with vsd::dist built) runs the cell as a controller process and a ui process that
+// replicates it and sends operator commands (docs/workcell.md, "Two processes"); --role runs one of them.
 //
 // --serve (with vsd::web built) shows the cell in the browser while it runs in real time and after, until
 // Ctrl-C (docs/web.md): 127.0.0.1:PORT, 8080 by default, 0 for a free port.
@@ -17,6 +21,11 @@
 
 #include "cell.hpp"
 #include "serve_option.hpp"
+#ifdef VSD_WORKCELL_DIST
+#include <unistd.h>
+
+#include "two_process.hpp"
+#endif
 #include "vsd/core/error.hpp"
 #ifdef VSD_WORKCELL_WEB
 #include <memory>
@@ -38,7 +47,19 @@ int main(int argc, char** argv) {
       args.emplace_back(argv[i]);
   }
   int serve_port = -1;
+#ifdef VSD_WORKCELL_DIST
+  vsd_workcell::ProcessOptions processes;
+#endif
   try {
+#ifdef VSD_WORKCELL_DIST
+    vsd_workcell::take_process_options(args, processes);
+    if (serve_port >= 0 && (processes.processes == 2 || !processes.role.empty()))
+      throw vsd::Error("--serve runs the cell in one process: it does not go with --processes 2 or --role");
+#else
+    for (const std::string& a : args)
+      if (a == "--processes" || a == "--role" || a == "--domain" || a == "--no-commands")
+        throw vsd::Error(a + " needs vsd::dist, which this build left out (see the configure messages)");
+#endif
     if (std::string error; !vsd_example::take_serve_option(args, serve_port, error)) throw vsd::Error(error);
 #ifndef VSD_WORKCELL_WEB
     if (serve_port >= 0) throw vsd::Error("--serve needs vsd::web, which this build left out (see the configure messages)");
@@ -48,7 +69,7 @@ int main(int argc, char** argv) {
     std::cerr << "vsd_two_robot_cell: " << e.what()
               << "\nusage: vsd_two_robot_cell [--seed N] [--parts N] [--csv FILE] [--quiet] [--step S] "
                  "[--physics-step S] [--time-limit S] [--urdf FILE] [--meta FILE] [--robots FILE] "
-                 "[--serve [PORT]]\n";
+                 "[--serve [PORT]] [--processes 1|2] [--role controller|ui --domain N] [--no-commands]\n";
     return 2;
   }
   if (!quiet) o.timeline = &std::cout;
@@ -64,10 +85,29 @@ int main(int argc, char** argv) {
   }
 #endif
   try {
-    const auto r = vsd_workcell::run_cell(o);
+    bool replica_ok = true;
+    vsd_workcell::CellReport r;
+#ifdef VSD_WORKCELL_DIST
+    if (processes.role == "ui") {
+      std::cout.setf(std::ios::unitbuf);
+      return vsd_workcell::run_ui(o, processes.domain, processes.commands, std::cout);
+    }
+    if (processes.processes == 2 || processes.role == "controller") {
+      // With --processes 2 the ui is this program again (/proc/self/exe: argv[0] need not be a path).
+      const std::uint32_t domain = processes.has_domain ? processes.domain : 100 + ::getpid() % 100;
+      const auto two = vsd_workcell::run_controller(o, domain, processes.processes == 2 ? "/proc/self/exe" : "",
+                                                    processes.commands, std::cout);
+      r = two.cell;
+      replica_ok = two.replica_equal && (two.ui_exit == 0 || processes.processes == 1);
+    } else {
+      r = vsd_workcell::run_cell(o);
+    }
+#else
+    r = vsd_workcell::run_cell(o);
+#endif
     vsd_workcell::print_summary(std::cout, r);
-    const bool ok = r.parts_handled == o.parts && r.zone_violations == 0 && r.deadlocks == 0 &&
-                    r.condition_errors.empty() && !r.timed_out;
+    const bool ok = r.parts_handled == o.parts + r.parts_injected && r.zone_violations == 0 &&
+                    r.deadlocks == 0 && r.condition_errors.empty() && !r.timed_out && replica_ok;
     std::cout << "check: " << (ok ? "every part handled, the zone exclusive, no deadlock" : "FAILED") << '\n';
     return ok ? 0 : 1;
   } catch (const std::exception& e) {
