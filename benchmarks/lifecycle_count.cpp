@@ -4,12 +4,15 @@
 //   vsd_lifecycle_count create N     N x (create + destroy) of the built-in Robot
 //   vsd_lifecycle_count runtime N    the same with the run-time twin RtRobot
 //   vsd_lifecycle_count emit N K     N emits of a void(int) signal with K listeners
+//   vsd_lifecycle_count record N K   N recorded sets (a frame and a double, alternating) taken as
+//                                    bundles of K sets (K >= 1), the way a stepped state records
 //   vsd_lifecycle_count load N [build-only]
 //                                    builds and saves a model of N instances (binary), then loads it
 //                                    (not with build-only)
 //
 // Instructions per operation = (count for N - count for 0) / N, and per loaded instance
 // (count of "load N" - count of "load N build-only") / N; benchmarks/README.md shows how.
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -17,12 +20,20 @@
 #include <vector>
 
 #include "fixture.hpp"
+#include "vsd/core/meta_type_eigen.hpp"
 #include "vsd/io.hpp"
+
+/// What a moving body's recording writes most: its frame, and a scalar beside it.
+class Framed : public vsd::Node {
+  VSD_INSTANCE(Framed, vsd::Node)
+  VSD_PROPERTY(Eigen::Isometry3d, frame, Eigen::Isometry3d::Identity())
+  VSD_PROPERTY(double, speed, 0.0)
+};
 
 namespace {
 
 int usage() {
-  std::fprintf(stderr, "usage: vsd_lifecycle_count create|runtime|load N, or emit N K\n");
+  std::fprintf(stderr, "usage: vsd_lifecycle_count create|runtime|load N, or emit|record N K\n");
   return 2;
 }
 
@@ -66,6 +77,23 @@ int main(int argc, char** argv) {
       sig.emit(static_cast<int>(i));
       benchmark::ClobberMemory();
     }
+  } else if (mode == "record" && argc > 3) {
+    const long k = std::max(1L, std::atol(argv[3]));
+    Framed& f = st.create<Framed>();
+    st.start_recording();
+    std::size_t ops = 0;
+    Eigen::Isometry3d x = Eigen::Isometry3d::Identity();
+    for (long i = 0; i < n; ++i) {
+      if (i % 2 == 0) {
+        x.translation().x() = bench::value(static_cast<std::size_t>(i));
+        f.set_frame(x);
+      } else {
+        f.set_speed(bench::value(static_cast<std::size_t>(i)));
+      }
+      if ((i + 1) % k == 0) ops += st.take_recording().size();
+    }
+    ops += st.stop_recording().size();
+    if (ops != static_cast<std::size_t>(n)) return std::fprintf(stderr, "sets missing\n"), 1;
   } else if (mode == "load") {
     std::vector<std::uint8_t> bytes;
     {

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -60,6 +61,10 @@ struct Inspected {
     vsd::web::Options o;
     o.port = 0;
     if (mode == 2) o.timeline_bytes = 0;
+    // For instruction counts: under callgrind a run is some 50 times slower, so a push rate in wall time
+    // pushes 50 times as often per step. VSD_BENCH_PUSH_RATE (batches per second, e.g. 1e-6) takes the
+    // pushes out of the steps' count; a batch's cost is counted apart (benchmarks/README.md).
+    if (const char* rate = std::getenv("VSD_BENCH_PUSH_RATE")) o.push_rate = std::strtod(rate, nullptr);
     server = std::make_unique<vsd::web::Server>(env, s, o);
     server->start();
     page = std::make_unique<StreamReader>(*server, [](std::string_view) {});

@@ -62,8 +62,44 @@ void write_lifecycle(std::vector<std::uint8_t>& out, Transaction::Op op, const S
   }
 }
 
+namespace {
+std::uint8_t* put_varint(std::uint8_t* d, std::uint64_t v) noexcept {  // ByteWriter::varint's encoding
+  while (v >= 0x80) {
+    *d++ = static_cast<std::uint8_t>(v | 0x80);
+    v >>= 7;
+  }
+  *d++ = static_cast<std::uint8_t>(v);
+  return d;
+}
+
+std::uint8_t* put_framed_fixed(std::uint8_t* d, const TypeOps& ops, const void* value) noexcept {
+  const auto n = static_cast<std::uint32_t>(ops.fixed_bytes);
+  std::memcpy(d, &n, 4);
+  ops.write_fixed(value, d + 4);
+  return d + 4 + n;
+}
+}  // namespace
+
+// The hot path of a recording SimState: one set per setter call. Values of a fixed binary size (numbers,
+// frames, ...) are framed in one step into space grown once; the bytes are those of the general path below.
 void write_set(std::vector<std::uint8_t>& out, const SimStateInstance& inst, const MetaProperty& p,
                const void* old_value, const void* new_value) {
+  const TypeOps& ops = p.type().ops();
+  if (ops.write_fixed != nullptr) {
+    constexpr std::size_t max_varint = 10;
+    const std::string_view name = p.name();
+    const std::size_t at = out.size();
+    out.resize(at + 1 + 2 * max_varint + name.size() + 2 * (4 + ops.fixed_bytes));
+    std::uint8_t* d = out.data() + at;
+    *d++ = static_cast<std::uint8_t>(Transaction::Op::Set);
+    d = put_varint(d, inst.id());
+    d = put_varint(d, name.size());
+    std::memcpy(d, name.data(), name.size());
+    d = put_framed_fixed(d + name.size(), ops, old_value);
+    d = put_framed_fixed(d, ops, new_value);
+    out.resize(static_cast<std::size_t>(d - out.data()));
+    return;
+  }
   ByteWriter w(out);
   w.u8(static_cast<std::uint8_t>(Transaction::Op::Set));
   w.varint(inst.id());

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -774,6 +775,53 @@ TEST(MetaTypeBytes, ScalarsRoundTrip) {
   EXPECT_TRUE(std::signbit(binary_round_trip(-0.0)));
   EXPECT_TRUE(std::isnan(binary_round_trip(nan)));
   EXPECT_EQ(binary_round_trip(-inf), -inf);
+}
+
+// Recording frames a value with TypeOps::write_fixed where the type has one: it must write exactly what
+// write_bytes writes (else a recorded bundle would not read back), and exist only where every value has
+// the same size.
+template <class T>
+void expect_fixed_form(const T& v) {
+  const vsd::TypeOps& ops = vsd::meta_type<T>().ops();
+  ASSERT_NE(ops.write_fixed, nullptr) << vsd::meta_type<T>().name();
+  const std::vector<std::uint8_t> general = bytes_of(v);
+  ASSERT_EQ(ops.fixed_bytes, general.size()) << vsd::meta_type<T>().name();
+  std::vector<std::uint8_t> fixed(ops.fixed_bytes + 8, 0xAB);  // the tail shows a write past the size
+  ops.write_fixed(&v, fixed.data());
+  EXPECT_TRUE(std::all_of(fixed.end() - 8, fixed.end(), [](std::uint8_t b) { return b == 0xAB; }));
+  fixed.resize(ops.fixed_bytes);
+  EXPECT_EQ(fixed, general) << vsd::meta_type<T>().name();
+}
+
+TEST(MetaTypeBytes, FixedFormIsTheGeneralFormForEveryFixedSizeType) {
+  expect_fixed_form(true);
+  expect_fixed_form(false);
+  expect_fixed_form(std::int8_t{-7});
+  expect_fixed_form(std::int16_t{-300});
+  expect_fixed_form(std::int32_t{0x01020304});
+  expect_fixed_form(std::numeric_limits<std::int64_t>::min());
+  expect_fixed_form(std::uint8_t{200});
+  expect_fixed_form(std::uint16_t{65535});
+  expect_fixed_form(std::uint32_t{0xDEADBEEF});
+  expect_fixed_form(std::numeric_limits<std::uint64_t>::max());
+  expect_fixed_form(0.1f);
+  expect_fixed_form(-0.0);
+  expect_fixed_form(nan);
+  expect_fixed_form(MtColor::Blue);
+  expect_fixed_form(MtLevel::High);
+  expect_fixed_form(MtAccess::Read | MtAccess::Exec);
+  expect_fixed_form(Eigen::Vector2d(1, -2));
+  expect_fixed_form(Eigen::Vector3d(1, 2, 3e-300));
+  expect_fixed_form(Eigen::Vector4d(1, 2, 3, 4));
+  expect_fixed_form(Eigen::Quaterniond(0.5, -0.5, 0.5, 0.5));
+  Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
+  f.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  f.translation() = Eigen::Vector3d(4, -5, 6);
+  expect_fixed_form(f);
+  // Values whose size varies have none.
+  EXPECT_EQ(vsd::meta_type<std::string>().ops().write_fixed, nullptr);
+  EXPECT_EQ(vsd::meta_type<std::vector<double>>().ops().write_fixed, nullptr);
+  EXPECT_EQ(vsd::meta_type<std::vector<Eigen::Vector3d>>().ops().fixed_bytes, 0u);
 }
 
 TEST(MetaTypeBytes, EncodingSizes) {

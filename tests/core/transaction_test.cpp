@@ -7,6 +7,8 @@
 #include <thread>
 
 #include "test_classes.hpp"
+#include "vsd/core/bytes.hpp"
+#include "vsd/core/detail/tx_codec.hpp"
 
 using testing::HasSubstr;
 using vsd_test::TRobot;
@@ -40,6 +42,63 @@ TEST_F(TransactionTest, RecordsEveryKindOfChange) {
                               ".children[0]\nerase #" + ic + " from #" + ir + ".children[0]\ndelete #" + ic +
                               " Node\n");
   EXPECT_EQ(t.size(), 7u);
+}
+
+// A set of a fixed-size value (numbers, frames) is framed by a fast path; its bytes must be those of the
+// general encoding, which the variable-size values (strings, vectors) still take.
+TEST_F(TransactionTest, RecordedSetsHaveTheGeneralEncodingOnEveryPath) {
+  auto& r = source.create<TRobot>();
+  Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
+  f.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0, 1, 1).normalized()).toRotationMatrix();
+  f.translation() = Eigen::Vector3d(1, -2, 3);
+  source.start_recording();
+  r.set_frame(f);
+  r.set_speed(-0.0);
+  r.set_axes(7);
+  r.set_joints({1, 2});
+  const vsd::Transaction t = source.stop_recording();
+
+  const auto bytes = [](const auto& v) {
+    std::vector<std::uint8_t> out;
+    vsd::ByteWriter w(out);
+    vsd::meta_type<std::decay_t<decltype(v)>>().write_bytes(&v, w);
+    return out;
+  };
+  std::vector<std::uint8_t> expected;
+  vsd::detail::write_tx_header(expected);
+  vsd::detail::write_set(expected, r.id(), "frame", bytes(Eigen::Isometry3d(Eigen::Isometry3d::Identity())),
+                         bytes(f));
+  vsd::detail::write_set(expected, r.id(), "speed", bytes(1.0), bytes(-0.0));
+  vsd::detail::write_set(expected, r.id(), "axes", bytes(6), bytes(7));
+  vsd::detail::write_set(expected, r.id(), "joints", bytes(std::vector<double>{}), bytes(std::vector<double>{1, 2}));
+  EXPECT_EQ(t.bytes(), expected);
+
+  // And the frame comes back exactly, both ways.
+  replica.copy_from(source);
+  replica.apply(t.inverted());
+  auto& twin = static_cast<TRobot&>(*replica.find(r.id()));
+  EXPECT_TRUE(twin.frame().isApprox(Eigen::Isometry3d::Identity(), 0.0));
+  replica.apply(t);
+  EXPECT_EQ(twin.frame().matrix(), f.matrix());
+}
+
+// A stepped state takes a bundle a step: the buffer keeps room for the next one, and bundles of any size in
+// any order come out whole.
+TEST_F(TransactionTest, BundlesOfChangingSizeComeOutWhole) {
+  auto& r = source.create<TRobot>();
+  replica.copy_from(source);
+  source.start_recording();
+  for (const int n : {1, 1000, 3, 0, 5000, 2}) {
+    for (int i = 0; i < n; ++i) {
+      r.set_speed(static_cast<double>(n + i) + 0.5);  // never the value it has
+      if (i % 7 == 0) r.set_joints({static_cast<double>(n), static_cast<double>(i)});  // always new
+    }
+    const vsd::Transaction t = source.take_recording();
+    EXPECT_EQ(t.size(), static_cast<std::size_t>(n + (n + 6) / 7));
+    replica.apply(t);
+    expect_equal(source, replica);
+  }
+  EXPECT_TRUE(source.stop_recording().empty());
 }
 
 TEST_F(TransactionTest, ReplicaAppliesToEquality) {

@@ -13,6 +13,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -85,6 +86,11 @@ struct TypeOps {
   void (*bind)(const MetaType&, void* obj, SimStateInstance* holder, const MetaProperty* prop) = nullptr;
   /// For Vector types: element access.
   const VectorOps* vector = nullptr;
+  /// For types whose binary form always has one size (numbers, bools, enums, Eigen vectors, quaternions and
+  /// frames): that size, and a writer of exactly what write_bytes writes into raw memory. Recording frames a
+  /// set's old and new value with it in one step (transaction.cpp); 0 and null for the other types.
+  std::size_t fixed_bytes = 0;
+  void (*write_fixed)(const void* obj, std::uint8_t* out) noexcept = nullptr;
 };
 
 /// @brief Describes a value type. See the file comment.
@@ -382,6 +388,27 @@ struct VectorAccess<std::vector<E, A>> {
   static constexpr const VectorOps* ops = &table;
 };
 
+/// The binary form of T when every value has the same size (TypeOps::fixed_bytes): here numbers, bools
+/// and enums, whose bytes_out is their memory; meta_type_eigen.hpp adds the Eigen types. `write` must put
+/// exactly the bytes of bytes_out<T> (tests/core/meta_type_test.cpp compares them for every built-in type).
+template <class T, class = void>
+struct FixedBytes {
+  static constexpr std::size_t size = 0;
+  static constexpr void (*write)(const void*, std::uint8_t*) noexcept = nullptr;
+};
+template <class T>
+struct FixedBytes<T, std::enable_if_t<std::is_arithmetic_v<T> || std::is_enum_v<T>>> {
+  static constexpr std::size_t size = sizeof(T);
+  static void write(const void* obj, std::uint8_t* out) noexcept {
+    if constexpr (std::is_same_v<T, bool>) {
+      static_assert(sizeof(bool) == 1);
+      *out = *static_cast<const bool*>(obj) ? 1 : 0;  // the value, whatever the object representation
+    } else {
+      std::memcpy(out, obj, sizeof(T));  // little-endian hosts only, as ByteWriter::fixed
+    }
+  }
+};
+
 /// The ops table of a C++ type T, made from the generic operations above.
 template <class T>
 struct ValueOps {
@@ -416,7 +443,8 @@ struct ValueOps {
   }
   static constexpr TypeOps table{&construct,  &copy_construct, &move_construct,     &destroy,   &assign,
                                  &equal,      &hash,           &write_text,         &read_text, &write_bytes,
-                                 &read_bytes, nullptr,         VectorAccess<T>::ops};
+                                 &read_bytes, nullptr,         VectorAccess<T>::ops, FixedBytes<T>::size,
+                                 FixedBytes<T>::write};
 };
 
 /// Makes the MetaType of a C++ type with ValueOps<T>.

@@ -39,6 +39,33 @@ template <>
 struct DefaultValue<Eigen::Isometry3d> {
   static Eigen::Isometry3d make() { return Eigen::Isometry3d::Identity(); }
 };
+// The fixed binary forms (TypeOps::fixed_bytes) of what bytes_out writes: a vector's coefficients in order,
+// a quaternion's fields w, x, y, z, a frame's translation then its linear part column by column.
+template <int N>
+struct FixedBytes<Eigen::Matrix<double, N, 1>> {
+  static constexpr std::size_t size = N * sizeof(double);
+  static void write(const void* obj, std::uint8_t* out) noexcept {
+    std::memcpy(out, static_cast<const Eigen::Matrix<double, N, 1>*>(obj)->data(), size);
+  }
+};
+template <>
+struct FixedBytes<Eigen::Quaterniond> {
+  static constexpr std::size_t size = 4 * sizeof(double);
+  static void write(const void* obj, std::uint8_t* out) noexcept {
+    const auto& q = *static_cast<const Eigen::Quaterniond*>(obj);
+    const double wxyz[4] = {q.w(), q.x(), q.y(), q.z()};
+    std::memcpy(out, wxyz, size);
+  }
+};
+template <>
+struct FixedBytes<Eigen::Isometry3d> {
+  static constexpr std::size_t size = 12 * sizeof(double);
+  static void write(const void* obj, std::uint8_t* out) noexcept {
+    const double* m = static_cast<const Eigen::Isometry3d*>(obj)->matrix().data();  // 4x4, column-major
+    std::memcpy(out, m + 12, 3 * sizeof(double));                                   // translation
+    for (int c = 0; c < 3; ++c) std::memcpy(out + (3 + 3 * c) * sizeof(double), m + 4 * c, 3 * sizeof(double));
+  }
+};
 }  // namespace detail
 
 namespace detail {
