@@ -2,7 +2,10 @@
 // with vsd::web; the option is parsed either way, so that a build without it can say so).
 #pragma once
 
+#include <chrono>
 #include <cstddef>
+#include <functional>
+#include <thread>
 #include <string>
 #include <vector>
 
@@ -29,6 +32,21 @@ inline bool take_serve_option(std::vector<std::string>& args, int& port, std::st
     --i;
   }
   return true;
+}
+
+/// A before-step hook that keeps a run to real time without a server (the controller of two processes
+/// whose ui serves the page): it sleeps until the wall clock has caught up with the simulated time.
+template <class Environment>
+std::function<bool(Environment&)> real_time_pacer() {
+  return [start = std::chrono::steady_clock::time_point{}, t0 = 0.0](Environment& env) mutable {
+    if (start == std::chrono::steady_clock::time_point{}) {
+      start = std::chrono::steady_clock::now();
+      t0 = env.time();
+    }
+    std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                              std::chrono::duration<double>(env.time() - t0)));
+    return true;
+  };
 }
 
 }  // namespace vsd_example

@@ -3,18 +3,21 @@
 //
 //   vsd_two_robot_cell [--seed N] [--parts N] [--csv FILE] [--quiet] [--step S] [--physics-step S]
 //                      [--time-limit S] [--urdf IIWA14.URDF] [--meta meta_control.soml]
-//                      [--robots multi_robot_control.soml] [--serve [PORT]]
+//                      [--robots multi_robot_control.soml] [--serve [PORT] [--no-linger]]
 //                      [--processes 1|2] [--role controller|ui --domain N] [--no-commands]
 //
 // --processes 2 (with vsd::dist built) runs the cell as a controller process and a ui process that
 // replicates it and sends operator commands (docs/workcell.md, "Two processes"); --role runs one of them.
 //
 // --serve (with vsd::web built) shows the cell in the browser while it runs in real time and after, until
-// Ctrl-C (docs/web.md): 127.0.0.1:PORT, 8080 by default, 0 for a free port.
+// Ctrl-C (docs/web.md): 127.0.0.1:PORT, 8080 by default, 0 for a free port; --no-linger ends with the run.
+// With two processes the ui serves its replica (--processes 2 --serve, or --role ui --serve) and the
+// controller keeps to real time; --role controller does not take --serve.
 //
 // Prints a timeline (σ events, γ commands, token moves, parts handled; --quiet leaves it out), then the
 // summary. Exit code 0 when every part was handled with no zone violation, no deadlock and no condition
 // error; 1 otherwise; 2 for bad options.
+#include <algorithm>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -47,20 +50,28 @@ int main(int argc, char** argv) {
       args.emplace_back(argv[i]);
   }
   int serve_port = -1;
+  bool linger = true;  // with --serve: stay on the page after the run until Ctrl-C
 #ifdef VSD_WORKCELL_DIST
   vsd_workcell::ProcessOptions processes;
 #endif
   try {
 #ifdef VSD_WORKCELL_DIST
     vsd_workcell::take_process_options(args, processes);
-    if (serve_port >= 0 && (processes.processes == 2 || !processes.role.empty()))
-      throw vsd::Error("--serve runs the cell in one process: it does not go with --processes 2 or --role");
 #else
     for (const std::string& a : args)
       if (a == "--processes" || a == "--role" || a == "--domain" || a == "--no-commands")
         throw vsd::Error(a + " needs vsd::dist, which this build left out (see the configure messages)");
 #endif
     if (std::string error; !vsd_example::take_serve_option(args, serve_port, error)) throw vsd::Error(error);
+    if (const auto it = std::find(args.begin(), args.end(), "--no-linger"); it != args.end()) {
+      if (serve_port < 0) throw vsd::Error("--no-linger goes with --serve");
+      linger = false;
+      args.erase(it);
+    }
+#ifdef VSD_WORKCELL_DIST
+    if (serve_port >= 0 && processes.role == "controller")
+      throw vsd::Error("--serve: the ui serves the cell (its replica); give --serve to the ui process");
+#endif
 #ifndef VSD_WORKCELL_WEB
     if (serve_port >= 0) throw vsd::Error("--serve needs vsd::web, which this build left out (see the configure messages)");
 #endif
@@ -69,20 +80,47 @@ int main(int argc, char** argv) {
     std::cerr << "vsd_two_robot_cell: " << e.what()
               << "\nusage: vsd_two_robot_cell [--seed N] [--parts N] [--csv FILE] [--quiet] [--step S] "
                  "[--physics-step S] [--time-limit S] [--urdf FILE] [--meta FILE] [--robots FILE] "
-                 "[--serve [PORT]] [--processes 1|2] [--role controller|ui --domain N] [--no-commands]\n";
+                 "[--serve [PORT] [--no-linger]] [--processes 1|2] [--role controller|ui --domain N] [--no-commands]\n";
     return 2;
   }
   if (!quiet) o.timeline = &std::cout;
+#ifdef VSD_WORKCELL_DIST
+  const bool one_process = processes.processes == 1 && processes.role.empty();
+#else
+  const bool one_process = true;
+#endif
+  (void)one_process;
 #ifdef VSD_WORKCELL_WEB
   std::unique_ptr<vsd_example::LiveView> view;
-  if (serve_port >= 0) {
+  if (serve_port >= 0 && one_process) {
     o.on_built = [&](vsd::Environment& env) { view = std::make_unique<vsd_example::LiveView>(env, env.main_state(), serve_port); };
     o.before_step = [&](vsd::Environment& env) { return view->pace(env); };
     o.on_finished = [&](vsd::Environment&, bool completed) {
-      if (completed) view->linger();
+      if (completed && linger) view->linger();
       view.reset();  // the server goes before the cell's Environment
     };
   }
+#endif
+#ifdef VSD_WORKCELL_DIST
+  // Two processes with --serve: the ui serves its replica, and the controller keeps to real time so that
+  // the page shows the cell moving (the ui's page cannot pause the controller: it edits the operator node).
+  std::vector<std::string> ui_args;
+  vsd_workcell::UiHooks ui_hooks;
+  if (serve_port >= 0 && processes.processes == 2) {
+    ui_args = {"--serve", std::to_string(serve_port), "--no-linger"};
+    o.before_step = vsd_example::real_time_pacer<vsd::Environment>();
+  }
+#ifdef VSD_WORKCELL_WEB
+  if (serve_port >= 0 && processes.role == "ui") {
+    ui_hooks.joined = [&](vsd::Environment& env, vsd::SimState& replica) {
+      view = std::make_unique<vsd_example::LiveView>(env, replica, serve_port);
+    };
+    ui_hooks.finished = [&](vsd::Environment&, bool equal) {
+      if (equal && linger) view->linger();
+      view.reset();
+    };
+  }
+#endif
 #endif
   try {
     bool replica_ok = true;
@@ -90,13 +128,13 @@ int main(int argc, char** argv) {
 #ifdef VSD_WORKCELL_DIST
     if (processes.role == "ui") {
       std::cout.setf(std::ios::unitbuf);
-      return vsd_workcell::run_ui(o, processes.domain, processes.commands, std::cout);
+      return vsd_workcell::run_ui(o, processes.domain, processes.commands, std::cout, ui_hooks);
     }
     if (processes.processes == 2 || processes.role == "controller") {
       // With --processes 2 the ui is this program again (/proc/self/exe: argv[0] need not be a path).
       const std::uint32_t domain = processes.has_domain ? processes.domain : 100 + ::getpid() % 100;
       const auto two = vsd_workcell::run_controller(o, domain, processes.processes == 2 ? "/proc/self/exe" : "",
-                                                    processes.commands, std::cout);
+                                                    processes.commands, std::cout, ui_args);
       r = two.cell;
       replica_ok = two.replica_equal && (two.ui_exit == 0 || processes.processes == 1);
     } else {

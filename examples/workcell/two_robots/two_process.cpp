@@ -112,7 +112,7 @@ void take_process_options(std::vector<std::string>& args, ProcessOptions& p) {
 }
 
 TwoProcessReport run_controller(const CellOptions& options, std::uint32_t domain, const std::string& ui_program,
-                                bool ui_commands, std::ostream& out) {
+                                bool ui_commands, std::ostream& out, const std::vector<std::string>& ui_args) {
   TwoProcessReport result;
   Child child;
   if (!ui_program.empty()) {
@@ -120,6 +120,7 @@ TwoProcessReport run_controller(const CellOptions& options, std::uint32_t domain
                                   "--urdf", options.urdf, "--meta", options.meta_script,
                                   "--robots", options.robot_script};
     if (!ui_commands) args.emplace_back("--no-commands");
+    args.insert(args.end(), ui_args.begin(), ui_args.end());
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
@@ -172,7 +173,7 @@ TwoProcessReport run_controller(const CellOptions& options, std::uint32_t domain
   return result;
 }
 
-int run_ui(const CellOptions& o, std::uint32_t domain, bool commands, std::ostream& out) {
+int run_ui(const CellOptions& o, std::uint32_t domain, bool commands, std::ostream& out, const UiHooks& hooks) {
   vsd::Environment env(2);  // a site of its own
   add_cell_modules(env);
   define_net_classes(env, o);
@@ -188,6 +189,16 @@ int run_ui(const CellOptions& o, std::uint32_t domain, bool commands, std::ostre
   auto set = [](vsd::Node& n, const char* prop, const auto& v) { n.meta().property(prop).set(n, v); };
   p.claim(op);  // the operator's commands are the ui's: nobody else may write them
   out << "ui: joined domain " << domain << ", owns the operator's commands\n";
+  // Whatever the hook attaches lets go before the Environment goes, also when the run throws.
+  struct Finish {
+    const UiHooks& hooks;
+    vsd::Environment& env;
+    bool equal = false;
+    ~Finish() {
+      if (hooks.finished) hooks.finished(env, equal);
+    }
+  } finish{hooks, env};
+  if (hooks.joined) hooks.joined(env, s);
   if (commands) {
     set(op, "inject_kind", std::int64_t{2});
     set(op, "injections", std::int64_t{1});
@@ -230,7 +241,8 @@ int run_ui(const CellOptions& o, std::uint32_t domain, bool commands, std::ostre
     throw vsd::Error("the controller did not compare the replica within 30 s");
   const std::string verdict = session.meta().property("verdict").get<std::string>(session);
   out << "ui: the controller finds the replica " << verdict << '\n';
-  return verdict == "equal" ? 0 : 1;
+  finish.equal = verdict == "equal";
+  return finish.equal ? 0 : 1;
 }
 
 }  // namespace vsd_workcell

@@ -6,11 +6,13 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <string>
 #include <vector>
 
 #include "cell.hpp"
+#include "vsd/core/sim_state.hpp"
 
 namespace vsd_workcell {
 
@@ -40,15 +42,24 @@ struct TwoProcessReport {
 /// the end for its digest. With @p ui_program not empty it starts that program as
 /// `--role ui --domain D` (with the scripts and URDF of @p o) and waits for it to exit.
 /// @throws vsd::Error when the ui does not join or does not answer, and what run_cell() throws.
+/// @p ui_args are added to the ui's command line (e.g. `--serve 0 --no-linger`).
 TwoProcessReport run_controller(const CellOptions& o, std::uint32_t domain, const std::string& ui_program,
-                                bool ui_commands, std::ostream& out);
+                                bool ui_commands, std::ostream& out, const std::vector<std::string>& ui_args = {});
+
+/// What the ui lets its caller do with the replica (e.g. serve it in the browser).
+struct UiHooks {
+  /// The replica has its first copy of the controller's state; the ui steps it until the end.
+  std::function<void(vsd::Environment&, vsd::SimState& replica)> joined;
+  /// The controller has compared the replica (@p equal). Whatever `joined` attached must let go here.
+  std::function<void(vsd::Environment&, bool equal)> finished;
+};
 
 /// The ui: joins @p domain, follows the cell until the controller says it has finished, sends the
 /// operator commands of the demo when @p commands (inject a part of kind 2 at once, pause robot_b at
 /// t = 2 s and resume it at t = 6 s, move the first part that lies at the conveyor's sensor by 1 cm),
 /// prints what it does and sees on @p out. @return 0 when the controller found the replica equal.
 /// @throws vsd::Error when the controller does not answer.
-int run_ui(const CellOptions& o, std::uint32_t domain, bool commands, std::ostream& out);
+int run_ui(const CellOptions& o, std::uint32_t domain, bool commands, std::ostream& out, const UiHooks& hooks = {});
 
 /// "N bytes, fnv1a XXXXXXXXXXXXXXXX": what the two processes compare.
 std::string digest(const std::vector<std::uint8_t>& bytes);
