@@ -1,6 +1,7 @@
 // SOML++ runtime benchmarks: the bytecode VM side by side with Lua 5.4 (embedded in this binary), LuaJIT
-// 2.1 (loaded at run time, luajit_peer.hpp) and hand-written C++ on the same functions, transition firings per second, re-testing after one property change, and checking and
-// loading a large script. Command and figures: benchmarks/README.md, section "SOML++ runtime".
+// 2.1 (loaded at run time, luajit_peer.hpp) and hand-written C++ on the same functions, transition firings
+// per second, re-testing after one property change, and checking and loading a large script. Command and
+// figures: benchmarks/README.md, section "SOML++ runtime".
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Geometry>
@@ -125,9 +126,9 @@ void run_workload(benchmark::State& state, Engine& engine, const Workload& w) {
     if (r != w.want) state.SkipWithError("wrong result");
     benchmark::DoNotOptimize(r);
   }
-  if (w.calls > 0) state.counters["calls"] = benchmark::Counter(w.calls, benchmark::Counter::kIsIterationInvariantRate);
+  if (w.calls > 0)
+    state.counters["calls"] = benchmark::Counter(w.calls, benchmark::Counter::kIsIterationInvariantRate);
 }
-
 
 struct SomlEngine : Soml {
   SomlEngine() : Soml(kFunctions) {}

@@ -75,7 +75,7 @@ namespace vsd::soml {
   X(JEQIK, "rit")                                                                                            \
   X(JNEIK, "rit")                                                                                            \
   /* The step and test of `for (...; i < n; i++)` at the loop's bottom: a = a + 1 (checked), then if         \
-     (a < b) pc = target (backward: one unit of the budget). K: b is an int16 constant. */                 \
+     (a < b) pc = target (backward: one unit of the budget). K: b is an int16 constant. */                   \
   X(LOOPLT, "rrt")                                                                                           \
   X(LOOPLE, "rrt")                                                                                           \
   X(LOOPLTK, "rit")                                                                                          \

@@ -716,24 +716,24 @@ Val ProgramImpl::exec(std::size_t entry) {
     }                                      \
     R[in.a].i = v_;                        \
   } while (0)
-#define VSD_IMM(field) std::int64_t{static_cast<std::int16_t>(field)}
+#define VSD_IMM(field) static_cast<std::int64_t>(static_cast<std::int16_t>(field))
 // The bottom of a counting loop (OP_LOOPLT and kin): the counter's checked increment, then the test and,
 // when it holds, the backward jump, which costs one unit of the budget like OP_JMP's.
-#define VSD_LOOP(cmp, bound)                                     \
-  do {                                                           \
-    std::int64_t v_;                                             \
+#define VSD_LOOP(cmp, bound)                                      \
+  do {                                                            \
+    std::int64_t v_;                                              \
     if (__builtin_add_overflow(R[in.a].i, 1, &v_)) [[unlikely]] { \
-      VSD_SAVE();                                                \
-      int_overflow(R[in.a].i, "+", 1);                           \
-    }                                                            \
-    R[in.a].i = v_;                                              \
-    if (v_ cmp(bound)) {                                         \
-      if (--budget_ == 0) [[unlikely]] {                         \
-        VSD_SAVE();                                              \
-        loop_budget_exhausted();                                 \
-      }                                                          \
-      pc = VSD_TARGET(in);                                       \
-    }                                                            \
+      VSD_SAVE();                                                 \
+      int_overflow(R[in.a].i, "+", 1);                            \
+    }                                                             \
+    R[in.a].i = v_;                                               \
+    if (v_ cmp(bound)) {                                          \
+      if (--budget_ == 0) [[unlikely]] {                          \
+        VSD_SAVE();                                               \
+        loop_budget_exhausted();                                  \
+      }                                                           \
+      pc = VSD_TARGET(in);                                        \
+    }                                                             \
   } while (0)
 
   auto obj = [&](std::uint64_t id) -> SimStateInstance& {

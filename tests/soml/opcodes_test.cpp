@@ -17,10 +17,10 @@
 
 namespace {
 
+using soml_test::error_of;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using vsd::soml::Program;
-using soml_test::error_of;
 
 struct Opcodes : soml_test::ScriptTest {
   Program* p = nullptr;
@@ -54,10 +54,11 @@ int big(int a) { if (a < 40000) return 1; return 0; }
 int count_down(int n) { int k = 0; while (n > 0) { n -= 1; k += 1; } return k; }
 )");
   const std::string d = p->disassemble();
-  for (const char* op : {"JGEI ", "JGTI ", "JLEI ", "JLTI ", "JNEI ", "JEQI ", "JGEIK", "JGTIK", "JLEIK", "JLTIK",
-                         "JNEIK", "JEQIK"})
+  for (const char* op : {"JGEI ", "JGTI ", "JLEI ", "JLTI ", "JNEI ", "JEQI ", "JGEIK", "JGTIK", "JLEIK",
+                         "JLTIK", "JNEIK", "JEQIK"})
     EXPECT_THAT(d, HasSubstr(op)) << "the condition fused into " << op;
-  const std::vector<std::int64_t> values = {kMin, -40000, -32768, -32767, -4, -3, -2, 0, 6, 7, 8, 32767, 32768, kMax};
+  const std::vector<std::int64_t> values = {kMin, -40000, -32768, -32767, -4,    -3,    -2,
+                                            0,    6,      7,      8,      32767, 32768, kMax};
   for (std::int64_t a : values) {
     for (std::int64_t b : values) {
       EXPECT_EQ(call("lt", {I(a), I(b)}), a < b ? 1 : 0) << a << " < " << b;
@@ -156,9 +157,10 @@ int sum(int from, int n) {
             "SOML++ run-time error: integer overflow: 9223372036854775807 + 1 does not fit an int (64 bits)\n"
             "  at upto (loop.soml:3:31)");
   // The sum in the body (ADDI straight into the local) overflows at its `+=`.
-  EXPECT_EQ(error("sum", {I(kMax - 3), I(kMax)}),
-            "SOML++ run-time error: integer overflow: 9223372036854775804 + 9223372036854775805 does not fit an "
-            "int (64 bits)\n  at sum (loop.soml:8:36)");
+  EXPECT_EQ(
+      error("sum", {I(kMax - 3), I(kMax)}),
+      "SOML++ run-time error: integer overflow: 9223372036854775804 + 9223372036854775805 does not fit an "
+      "int (64 bits)\n  at sum (loop.soml:8:36)");
 }
 
 // The fused loop's backward jump costs one unit of the budget, as OP_JMP's did: a loop of N iterations
@@ -235,7 +237,8 @@ int self_add(int a) { a += a; return a; }
   EXPECT_THAT(error("quot", {I(1), I(0)}), HasSubstr("division by zero"));
   EXPECT_THAT(error("rem", {I(1), I(0)}), HasSubstr("division by zero"));
   EXPECT_THAT(error("quot", {I(kMin), I(-1)}), HasSubstr("integer overflow: -9223372036854775808 / -1"));
-  EXPECT_THAT(error("self_add", {I(kMax)}), HasSubstr("9223372036854775807 + 9223372036854775807 does not fit"));
+  EXPECT_THAT(error("self_add", {I(kMax)}),
+              HasSubstr("9223372036854775807 + 9223372036854775807 does not fit"));
 }
 
 // Breakpoints patch OP_BREAK over line starts, and the patched instruction runs from the function's
@@ -274,7 +277,8 @@ TEST_F(FusedLoopDebugger, LineBreakpointsInsideAFusedLoopStopEveryIteration) {
   d.break_at_line(3);
   seen.clear();
   EXPECT_EQ(p->root().call("sum", {I(3)}).as<std::int64_t>(), 3);
-  EXPECT_THAT(seen, ElementsAre("3", "3", "3", "3")) << "the loop's start, then its step after each iteration";
+  EXPECT_THAT(seen, ElementsAre("3", "3", "3", "3"))
+      << "the loop's start, then its step after each iteration";
 }
 
 TEST_F(FusedLoopDebugger, SteppingWalksTheFusedLoop) {
