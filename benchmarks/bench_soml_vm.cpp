@@ -1,6 +1,7 @@
-// SOML++ runtime benchmarks: the bytecode VM side by side with Lua 5.4 (embedded in this binary) on the
-// same functions, transition firings per second, re-testing after one property change, and checking and
-// loading a large script. Command and figures: benchmarks/README.md, section "SOML++ runtime".
+// SOML++ runtime benchmarks: the bytecode VM side by side with Lua 5.4 (embedded in this binary), LuaJIT
+// 2.1 (loaded at run time, luajit_peer.hpp) and hand-written C++ on the same functions, transition firings
+// per second, re-testing after one property change, and checking and loading a large script. Command and
+// figures: benchmarks/README.md, section "SOML++ runtime".
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Geometry>
@@ -13,6 +14,10 @@
 #include "vsd/core.hpp"
 #include "vsd/soml.hpp"
 
+#if VSD_BENCH_HAVE_LUAJIT
+#include "luajit_peer.hpp"
+#endif
+
 #if VSD_BENCH_HAVE_LUA
 extern "C" {
 #include <lauxlib.h>
@@ -22,15 +27,6 @@ extern "C" {
 #endif
 
 namespace {
-
-constexpr const char* kFunctions = R"(
-int fib(int n) { if (n < 2) return n; return fib(n - 1) + fib(n - 2); }
-int loop(int n) {
-  int s = 0;
-  for (int i = 0; i < n; i++) { s = s + i * 3 % 7; }
-  return s;
-}
-)";
 
 struct Soml {
   vsd::Registry reg;
@@ -43,25 +39,33 @@ struct Soml {
   }
 };
 
-void BM_SomlFib27(benchmark::State& state) {
-  Soml s(kFunctions);
-  const vsd::Value arg(std::int64_t{27});
-  for (auto _ : state) benchmark::DoNotOptimize(s.program->root().call("fib", {arg}).as<std::int64_t>());
-  state.counters["calls"] =
-      benchmark::Counter(832039.0 + 514228.0 - 1.0, benchmark::Counter::kIsIterationInvariantRate);
+// ---- fib(27), the plain counting loop and the arithmetic loop, five ways side by side (issue 25) -------
+// BM_<engine><workload>: engines Soml (the bytecode VM), Lua (5.4, linked), LuaJit (2.1, JIT on) and
+// LuaJitInterp (the same with jit.off(): its interpreter), both loaded through luajit_peer.hpp, and Cpp
+// (hand-written C++). Every engine's result is checked against the known value before timing and after
+// every iteration (a wrong result marks the benchmark failed); the input comes in at run time.
+constexpr const char* kFunctions = R"(
+int fib(int n) { if (n < 2) return n; return fib(n - 1) + fib(n - 2); }
+int count_loop(int n) {
+  int s = 0;
+  for (int i = 0; i < n; i++) s += i;
+  return s;
 }
-BENCHMARK(BM_SomlFib27)->Unit(benchmark::kMillisecond);
-
-void BM_SomlLoop1e7(benchmark::State& state) {
-  Soml s(kFunctions);
-  const vsd::Value arg(std::int64_t{10'000'000});
-  for (auto _ : state) benchmark::DoNotOptimize(s.program->root().call("loop", {arg}).as<std::int64_t>());
+int loop(int n) {
+  int s = 0;
+  for (int i = 0; i < n; i++) { s = s + i * 3 % 7; }
+  return s;
 }
-BENCHMARK(BM_SomlLoop1e7)->Unit(benchmark::kMillisecond);
+)";
 
-#if VSD_BENCH_HAVE_LUA
+// The same functions in Lua 5.1 / 5.4 (both run it: integers in 5.4, doubles in LuaJIT, exact here).
 constexpr const char* kLua = R"(
 function fib(n) if n < 2 then return n end return fib(n - 1) + fib(n - 2) end
+function count_loop(n)
+  local s = 0
+  for i = 0, n - 1 do s = s + i end
+  return s
+end
 function loop(n)
   local s = 0
   for i = 0, n - 1 do s = s + i * 3 % 7 end
@@ -69,14 +73,89 @@ function loop(n)
 end
 )";
 
-struct Lua {
+// The C++ twins. The loops pass the sum through an empty asm statement each iteration: the add stays one
+// scalar add per iteration, as in the scripts (no closed form, no vector instructions, which no checked
+// 64-bit arithmetic of SOML++ could have either); fib's argument is opaque at the call.
+template <class T>
+inline void keep_scalar(T& x) {
+  asm("" : "+r"(x));
+}
+[[gnu::noinline]] std::int64_t cpp_fib(std::int64_t n) { return n < 2 ? n : cpp_fib(n - 1) + cpp_fib(n - 2); }
+[[gnu::noinline]] std::int64_t cpp_count_loop(std::int64_t n) {
+  std::int64_t s = 0;
+  for (std::int64_t i = 0; i < n; i++) {
+    s += i;
+    keep_scalar(s);
+  }
+  return s;
+}
+[[gnu::noinline]] std::int64_t cpp_loop(std::int64_t n) {
+  std::int64_t s = 0;
+  for (std::int64_t i = 0; i < n; i++) {
+    s = s + i * 3 % 7;
+    keep_scalar(s);
+  }
+  return s;
+}
+
+struct Workload {
+  const char* name;  // in the benchmark's name
+  const char* fn;    // in the scripts
+  std::int64_t n;
+  std::int64_t want;
+  std::int64_t (*cpp)(std::int64_t);
+  double calls;  // function calls per run (fib), 0 for a loop
+};
+// fib(27) = 196418 makes 2 fib(28) - 1 = 635621 calls; the counting loop sums 0 .. 10^7-1; i * 3 % 7 runs
+// through 0 3 6 2 5 1 4 (21 per 7), 10^7 = 7 * 1428571 + 3, so the sum is 1428571 * 21 + 0 + 3 + 6.
+const Workload kWorkloads[] = {
+    {"Fib27", "fib", 27, 196418, cpp_fib, 2.0 * 317811.0 - 1.0},
+    {"CountLoop1e7", "count_loop", 10'000'000, 49'999'995'000'000, cpp_count_loop, 0},
+    {"Loop1e7", "loop", 10'000'000, 30'000'000, cpp_loop, 0},
+};
+
+// Times engine.call(fn, n), checked against the known value.
+template <class Engine>
+void run_workload(benchmark::State& state, Engine& engine, const Workload& w) {
+  if (engine.call(w.fn, w.n) != w.want) {
+    state.SkipWithError("wrong result before timing");
+    return;
+  }
+  for (auto _ : state) {
+    const std::int64_t r = engine.call(w.fn, w.n);
+    if (r != w.want) state.SkipWithError("wrong result");
+    benchmark::DoNotOptimize(r);
+  }
+  if (w.calls > 0)
+    state.counters["calls"] = benchmark::Counter(w.calls, benchmark::Counter::kIsIterationInvariantRate);
+}
+
+struct SomlEngine : Soml {
+  SomlEngine() : Soml(kFunctions) {}
+  std::int64_t call(const char* fn, std::int64_t n) {
+    return program->root().call(fn, {vsd::Value(n)}).as<std::int64_t>();
+  }
+};
+
+struct CppEngine {
+  const Workload* w;
+  std::int64_t call(const char* /*fn*/, std::int64_t n) {
+    benchmark::DoNotOptimize(n);  // opaque: the compiler cannot compute the result ahead
+    return w->cpp(n);
+  }
+};
+
+#if VSD_BENCH_HAVE_LUA
+struct LuaEngine {
   lua_State* L = luaL_newstate();
-  Lua() {
+  LuaEngine() {
     luaL_openlibs(L);
     if (luaL_dostring(L, kLua) != LUA_OK) throw std::runtime_error(lua_tostring(L, -1));
   }
-  ~Lua() { lua_close(L); }
-  lua_Integer call(const char* fn, lua_Integer n) {
+  ~LuaEngine() { lua_close(L); }
+  LuaEngine(const LuaEngine&) = delete;
+  LuaEngine& operator=(const LuaEngine&) = delete;
+  std::int64_t call(const char* fn, std::int64_t n) {
     lua_getglobal(L, fn);
     lua_pushinteger(L, n);
     lua_call(L, 1, 1);
@@ -85,21 +164,39 @@ struct Lua {
     return r;
   }
 };
-
-void BM_LuaFib27(benchmark::State& state) {
-  Lua lua;
-  for (auto _ : state) benchmark::DoNotOptimize(lua.call("fib", 27));
-  state.counters["calls"] =
-      benchmark::Counter(832039.0 + 514228.0 - 1.0, benchmark::Counter::kIsIterationInvariantRate);
-}
-BENCHMARK(BM_LuaFib27)->Unit(benchmark::kMillisecond);
-
-void BM_LuaLoop1e7(benchmark::State& state) {
-  Lua lua;
-  for (auto _ : state) benchmark::DoNotOptimize(lua.call("loop", 10'000'000));
-}
-BENCHMARK(BM_LuaLoop1e7)->Unit(benchmark::kMillisecond);
 #endif
+
+// Registered per workload, the engines next to each other in the output.
+const bool kRegistered = [] {
+  for (const Workload& w : kWorkloads) {
+    const std::string name = w.name;
+    benchmark::RegisterBenchmark(("BM_Soml" + name).c_str(), [&w](benchmark::State& s) {
+      SomlEngine e;
+      run_workload(s, e, w);
+    })->Unit(benchmark::kMillisecond);
+#if VSD_BENCH_HAVE_LUA
+    benchmark::RegisterBenchmark(("BM_Lua" + name).c_str(), [&w](benchmark::State& s) {
+      LuaEngine e;
+      run_workload(s, e, w);
+    })->Unit(benchmark::kMillisecond);
+#endif
+#if VSD_BENCH_HAVE_LUAJIT
+    for (const bool jit : {true, false}) {
+      benchmark::RegisterBenchmark(((jit ? "BM_LuaJit" : "BM_LuaJitInterp") + name).c_str(),
+                                   [&w, jit](benchmark::State& s) {
+                                     bench::LuaJit e(kLua, jit);
+                                     run_workload(s, e, w);
+                                   })
+          ->Unit(benchmark::kMillisecond);
+    }
+#endif
+    benchmark::RegisterBenchmark(("BM_Cpp" + name).c_str(), [&w](benchmark::State& s) {
+      CppEngine e{&w};
+      run_workload(s, e, w);
+    })->Unit(benchmark::kMillisecond);
+  }
+  return true;
+}();
 
 // 10^6 frame-times-point products `p = t * p` (docs/soml.md 4.14: one XOP instruction calling Eigen),
 // beside Lua with the 3-vector and the frame written by hand (tables, a rotation matrix and a

@@ -20,7 +20,7 @@
 #               packaging tests' builds reuse the Release tree's objects), Chromium (the inspector's
 #               page is tested in headless Chromium; playwright-core comes from npm)
 #   benchmarks  Google Benchmark and the peers the benchmarks compare with: RTTR, Qt 5, Boost.Signals2,
-#               libsigc++ 3, Lua 5.4, MuJoCo 2.2, DART 6 (its URDF loader and ODE collision detector)
+#               libsigc++ 3, Lua 5.4, LuaJIT 2.1, MuJoCo 2.2, DART 6 (its URDF loader and ODE collision detector)
 #   fuzzing     clang and libFuzzer's runtime
 # A module whose packages are missing is skipped at configure time with a message, not the build; on a
 # system without apt, install the same libraries with its package manager (README.md lists them per
@@ -38,7 +38,7 @@ GROUP[collision]="libfcl-dev libccd-dev"
 GROUP[physics]="libode-dev pkg-config"
 GROUP[web]="libcpp-httplib-dev pkg-config @npm"
 GROUP[tests]="libgtest-dev libgmock-dev liborocos-kdl-dev gnuplot-nox python3 ccache chromium"
-GROUP[benchmarks]="libbenchmark-dev librttr-dev qtbase5-dev libboost-dev libsigc++-3.0-dev liblua5.4-dev libmujoco-dev libdart-dev libdart-utils-urdf-dev libdart-collision-ode-dev"
+GROUP[benchmarks]="libbenchmark-dev librttr-dev qtbase5-dev libboost-dev libsigc++-3.0-dev liblua5.4-dev libluajit-5.1-dev libmujoco-dev libdart-dev libdart-utils-urdf-dev libdart-collision-ode-dev"
 GROUP[fuzzing]="clang libclang-rt-14-dev"
 MODULES="analysis scene dist collision physics web"
 ALL="core $MODULES tests benchmarks fuzzing"

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <tuple>
 
@@ -1008,7 +1009,12 @@ class Compiler {
     Type result = target.type;
     if (result.kind == K::Int && rt.kind == K::Double) result = Type::of(K::Double);
     if (target.type.kind == K::String) result = Type::of(K::String);
-    int v = arith(op, cur, target.type, r, rt, result, target.loc);
+    // A local int or double whose result has its own kind: computed straight into its register (`s += i`
+    // is one ADDI; the instruction writes only after its checks, so an error leaves the local as it was).
+    const bool in_place = target.kind == ExprKind::Name && target.as<NameExpr>().binding.kind == BK::Local &&
+                          (result.kind == K::Int || result.kind == K::Double) &&
+                          result.kind == target.type.kind;
+    int v = arith(op, cur, target.type, r, rt, result, target.loc, in_place ? cur : -1);
     if (result.kind == K::Double && target.type.kind == K::Int) {
       const int t = temp();
       emit(OP_D2I, t, v);
@@ -1068,19 +1074,24 @@ class Compiler {
     switch (b.kind) {
       case BK::Function: {
         const auto& fd = b.decl->as<FunctionDecl>();
-        int self;
+        auto v = P.build().vslot_of.find(&fd);
+        const bool virt = v != P.build().vslot_of.end();
+        // A plain call of a function of this scope runs on this frame's self: OP_CALLS, no SELF.
+        const bool same_self = callee.kind != ExprKind::Member && b.outer == 0 && !virt;
+        int self = -1;
         if (callee.kind == ExprKind::Member)
           self = expr(*callee.as<MemberExpr>().object);
-        else
+        else if (!same_self)
           self = self_at(b.outer, callee.loc);
         std::vector<Type> want;
         for (const Param& p : fd.params) want.push_back(p.type);
         const int base = args_at(e.args, want);
         if (base == top_) temp();  // the result register
         at(e.loc);
-        auto v = P.build().vslot_of.find(&fd);
-        if (v != P.build().vslot_of.end())
+        if (virt)
           emit(OP_VCALL, base, v->second, self);
+        else if (same_self)
+          emit(OP_CALLS, base, P.build().function_index.at(&fd));
         else
           emit(OP_CALL, base, P.build().function_index.at(&fd), self);
         top_ = base + 1;
@@ -1393,8 +1404,7 @@ class Compiler {
       }
       case StmtKind::If: {
         const auto& i = s.as<IfStmt>();
-        const int c = expr(*i.cond);
-        const std::size_t jf = emit_jump(OP_JMPF, c);
+        const std::size_t jf = cond_jump(*i.cond);
         top_ = save;
         stmt(*i.then_stmt);
         if (i.else_stmt) {
@@ -1423,6 +1433,10 @@ class Compiler {
       case StmtKind::For: {
         const auto& f = s.as<ForStmt>();
         if (f.init) stmt(*f.init);
+        if (const int i = counted_slot(f); i >= 0) {
+          counted_for(f, i, save);
+          break;
+        }
         const std::size_t top = here();
         std::size_t jf = static_cast<std::size_t>(-1);
         if (f.cond) jf = cond_jump(*f.cond);
@@ -1471,7 +1485,11 @@ class Compiler {
       }
       case StmtKind::Return: {
         const auto& r = s.as<ReturnStmt>();
-        if (r.value) {
+        if (r.value && (F.result == RK::I || F.result == RK::D || F.result == RK::R) &&
+            r.value->kind == ExprKind::Name && r.value->as<NameExpr>().binding.kind == BK::Local &&
+            r.value->type.kind == F.result_type.kind) {
+          emit(OP_RET, r.value->as<NameExpr>().binding.slot);  // a local of the result's kind: no copy
+        } else if (r.value) {
           const int v = temp();
           expr_to(*r.value, v, F.result_type);
           emit(F.result == RK::V ? OP_RETV : F.result == RK::X ? OP_RETX : OP_RET, v);
@@ -1552,20 +1570,107 @@ class Compiler {
     emit(OP_RET0);
   }
 
-  // Jump when the condition is false; `i < n` and `i <= n` on ints fuse into one instruction.
+  // Jump when the condition is false. A comparison of two ints fuses into one compare-and-jump
+  // instruction (JGEI ..., against a small constant JGEIK ...): the condition's value is never stored.
   std::size_t cond_jump(const Expr& c) {
     at(c.loc);
     if (c.kind == ExprKind::Binary) {
       const auto& b = c.as<BinaryExpr>();
-      if ((b.op == TokenKind::Less || b.op == TokenKind::LessEqual) && b.lhs->type.kind == K::Int &&
-          b.rhs->type.kind == K::Int) {
+      Op reg = OP_NOP, imm = OP_NOP;  // jump when the comparison is false
+      switch (b.op) {
+        case TokenKind::Less:
+          reg = OP_JGEI, imm = OP_JGEIK;
+          break;
+        case TokenKind::LessEqual:
+          reg = OP_JGTI, imm = OP_JGTIK;
+          break;
+        case TokenKind::Greater:
+          reg = OP_JLEI, imm = OP_JLEIK;
+          break;
+        case TokenKind::GreaterEqual:
+          reg = OP_JLTI, imm = OP_JLTIK;
+          break;
+        case TokenKind::EqualEqual:
+          reg = OP_JNEI, imm = OP_JNEIK;
+          break;
+        case TokenKind::BangEqual:
+          reg = OP_JEQI, imm = OP_JEQIK;
+          break;
+        default:
+          break;
+      }
+      if (reg != OP_NOP && b.lhs->type.kind == K::Int && b.rhs->type.kind == K::Int) {
+        const Here at_node(*this, b.loc);
         const int l = expr(*b.lhs);
+        if (const auto k = small_literal(*b.rhs)) return emit_jump(imm, l, static_cast<std::uint16_t>(*k));
         const int r = expr(*b.rhs);
-        return emit_jump(b.op == TokenKind::Less ? OP_JGEI : OP_JGTI, l, r);
+        return emit_jump(reg, l, r);
       }
     }
     const int r = expr(c);
     return emit_jump(OP_JMPF, r);
+  }
+
+  // An int literal, or a negated one (`-3`), that fits an int16 immediate; or nothing.
+  static std::optional<std::int16_t> small_literal(const Expr& e) {
+    const bool neg = e.kind == ExprKind::Unary && e.as<UnaryExpr>().op == TokenKind::Minus;
+    const Expr& lit = neg ? *e.as<UnaryExpr>().operand : e;
+    if (lit.kind != ExprKind::Int) return std::nullopt;
+    const std::int64_t v = lit.as<LiteralExpr>().int_value;
+    if (v < -32768 || v > 32768) return std::nullopt;  // (the literal 2^63 and beyond never reach here)
+    const std::int64_t k = neg ? -v : v;
+    if (k < -32768 || k > 32767) return std::nullopt;
+    return static_cast<std::int16_t>(k);
+  }
+
+  // The local int a `for` loop counts up by one (`for (...; i < n; i++)`, `++i` or `i += 1`, the bound
+  // a local int or a small constant): its step and test fuse into one instruction at the loop's bottom
+  // (OP_LOOPLT and kin). -1 for any other loop.
+  static int counted_slot(const ForStmt& f) {
+    if (!f.cond || !f.step || f.cond->kind != ExprKind::Binary) return -1;
+    const auto& c = f.cond->as<BinaryExpr>();
+    if (c.op != TokenKind::Less && c.op != TokenKind::LessEqual) return -1;
+    auto local_int = [](const Expr& e) {
+      return e.kind == ExprKind::Name && e.as<NameExpr>().binding.kind == BK::Local && e.type.kind == K::Int
+                 ? e.as<NameExpr>().binding.slot
+                 : -1;
+    };
+    const int i = local_int(*c.lhs);
+    if (i < 0 || (local_int(*c.rhs) < 0 && !small_literal(*c.rhs))) return -1;
+    const Expr& st = *f.step;
+    if (st.kind == ExprKind::Unary || st.kind == ExprKind::Postfix) {
+      const auto& u = st.as<UnaryExpr>();
+      return u.op == TokenKind::PlusPlus && local_int(*u.operand) == i ? i : -1;
+    }
+    if (st.kind == ExprKind::Assign) {
+      const auto& a = st.as<BinaryExpr>();
+      const auto k = small_literal(*a.rhs);
+      return a.op == TokenKind::PlusEqual && k && *k == 1 && local_int(*a.lhs) == i ? i : -1;
+    }
+    return -1;
+  }
+
+  // `for (init; i < n; i++) body` as: the test once at the top (jump out when false), the body, then
+  // OP_LOOPLT i, n -> body (step, test and backward jump in one instruction, at the step's position and
+  // line: its overflow and budget errors name the step as before).
+  void counted_for(const ForStmt& f, int i, int save) {
+    const std::size_t jf = cond_jump(*f.cond);
+    top_ = save;
+    const std::size_t body = here();
+    loops_.emplace_back();
+    stmt(*f.body);
+    const std::size_t cont = here();
+    at(f.step->loc);
+    const auto& c = f.cond->as<BinaryExpr>();
+    const bool le = c.op == TokenKind::LessEqual;
+    std::size_t back;
+    if (const auto k = small_literal(*c.rhs))
+      back = emit_jump(le ? OP_LOOPLEK : OP_LOOPLTK, i, static_cast<std::uint16_t>(*k));
+    else
+      back = emit_jump(le ? OP_LOOPLE : OP_LOOPLT, i, c.rhs->as<NameExpr>().binding.slot);
+    patch(back, body);
+    patch(jf, here());
+    close_loop(cont, here());
   }
 
   void close_loop(std::size_t cont, std::size_t end) {

@@ -79,7 +79,7 @@ std::string_view trim(std::string_view s) {
 }
 
 bool is_jump(std::uint8_t op) {
-  return op == OP_JMP || op == OP_JMPF || op == OP_JMPT || op == OP_JGEI || op == OP_JGTI;
+  return op != OP_RESUME && op_jumps(op);  // OP_RESUME only ever runs from a trampoline
 }
 
 }  // namespace

@@ -63,8 +63,26 @@ namespace vsd::soml {
   X(JMPT, "r-t")   /* if (a) pc = target */                                                                  \
   X(JGEI, "rrt")   /* if (a >= b) pc = target   (fused loop test) */                                         \
   X(JGTI, "rrt")   /* if (a > b) pc = target */                                                              \
+  X(JLTI, "rrt")   /* if (a < b) pc = target */                                                              \
+  X(JLEI, "rrt")   /* if (a <= b) pc = target */                                                             \
+  X(JEQI, "rrt")   /* if (a == b) pc = target */                                                             \
+  X(JNEI, "rrt")   /* if (a != b) pc = target */                                                             \
+  /* The same against a constant: if (a op (int16) b) pc = target (an `if` or loop test `n < 2`). */         \
+  X(JGEIK, "rit")                                                                                            \
+  X(JGTIK, "rit")                                                                                            \
+  X(JLTIK, "rit")                                                                                            \
+  X(JLEIK, "rit")                                                                                            \
+  X(JEQIK, "rit")                                                                                            \
+  X(JNEIK, "rit")                                                                                            \
+  /* The step and test of `for (...; i < n; i++)` at the loop's bottom: a = a + 1 (checked), then if         \
+     (a < b) pc = target (backward: one unit of the budget). K: b is an int16 constant. */                   \
+  X(LOOPLT, "rrt")                                                                                           \
+  X(LOOPLE, "rrt")                                                                                           \
+  X(LOOPLTK, "rit")                                                                                          \
+  X(LOOPLEK, "rit")                                                                                          \
   X(CALL, "rfr")   /* call functions[b] with frame at a, self in register c; result in a */                  \
   X(VCALL, "rvr")  /* like CALL, but b is a virtual slot resolved on the class of self */                    \
+  X(CALLS, "rf-")  /* like CALL, on this frame's self (a function of the same scope: no SELF) */             \
   X(RET, "r--")    /* return register a */                                                                   \
   X(RET0, "---")   /* return nothing */                                                                      \
   X(RETV, "r--")   /* return vector register a (a function whose result is a vector) */                      \
@@ -142,6 +160,9 @@ static_assert(kOpCount <= 256, "opcodes are one byte");
 /// The name and operand shape of opcode @p op; an opcode past the table reads as "?" (never met in code
 /// the compiler made).
 constexpr OpInfo op_info(std::uint8_t op) noexcept { return op < kOpCount ? kOps[op] : OpInfo{"?", "---"}; }
+
+/// Whether opcode @p op may jump: its operand c (with x for the high bits) is a target.
+constexpr bool op_jumps(std::uint8_t op) noexcept { return op_info(op).shape[2] == 't'; }
 
 // OP_PLACE's operand c with this bit: a place of a port net (index into port_places_), found from the
 // copy's instance.

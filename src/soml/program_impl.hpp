@@ -185,6 +185,8 @@ class ProgramImpl {
   // "integer overflow: a op b does not fit an int (64 bits)", and "what(a)" for unary operations.
   [[noreturn, gnu::cold, gnu::noinline]] void int_overflow(std::int64_t a, const char* op, std::int64_t b);
   [[noreturn, gnu::cold, gnu::noinline]] void int_overflow(const char* what, std::int64_t a);
+  // "instruction budget exhausted (...): an endless loop?" (a backward jump found the budget spent).
+  [[noreturn, gnu::cold, gnu::noinline]] void loop_budget_exhausted();
 
   // ---- executor ----
   std::uint64_t step(std::uint64_t n);  // step_loop, then sync_state (also on an error)

@@ -253,6 +253,11 @@ void ProgramImpl::int_overflow(const char* what, std::int64_t a) {
        ") does not fit an int (64 bits)");
 }
 
+void ProgramImpl::loop_budget_exhausted() {
+  fail("instruction budget exhausted (" + std::to_string(opt_.instruction_budget) +
+       " jumps and calls): an endless loop?");
+}
+
 Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* args,
                      const std::string* sargs, std::string* sresult, const VecReg* vargs, VecReg* vresult,
                      const Value* xargs, Value* xresult) {
@@ -711,6 +716,25 @@ Val ProgramImpl::exec(std::size_t entry) {
     }                                      \
     R[in.a].i = v_;                        \
   } while (0)
+#define VSD_IMM(field) static_cast<std::int64_t>(static_cast<std::int16_t>(field))
+// The bottom of a counting loop (OP_LOOPLT and kin): the counter's checked increment, then the test and,
+// when it holds, the backward jump, which costs one unit of the budget like OP_JMP's.
+#define VSD_LOOP(cmp, bound)                                      \
+  do {                                                            \
+    std::int64_t v_;                                              \
+    if (__builtin_add_overflow(R[in.a].i, 1, &v_)) [[unlikely]] { \
+      VSD_SAVE();                                                 \
+      int_overflow(R[in.a].i, "+", 1);                            \
+    }                                                             \
+    R[in.a].i = v_;                                               \
+    if (v_ cmp(bound)) {                                          \
+      if (--budget_ == 0) [[unlikely]] {                          \
+        VSD_SAVE();                                               \
+        loop_budget_exhausted();                                  \
+      }                                                           \
+      pc = VSD_TARGET(in);                                        \
+    }                                                             \
+  } while (0)
 
   auto obj = [&](std::uint64_t id) -> SimStateInstance& {
     SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
@@ -897,10 +921,9 @@ Val ProgramImpl::exec(std::size_t entry) {
         break;
       case OP_JMP: {
         const Ins* t = VSD_TARGET(in);
-        if (t < pc && --budget_ == 0) {
+        if (t < pc && --budget_ == 0) [[unlikely]] {
           VSD_SAVE();
-          fail("instruction budget exhausted (" + std::to_string(opt_.instruction_budget) +
-               " jumps and calls): an endless loop?");
+          loop_budget_exhausted();
         }
         pc = t;
         break;
@@ -917,10 +940,53 @@ Val ProgramImpl::exec(std::size_t entry) {
       case OP_JGTI:
         if (R[in.a].i > R[in.b].i) pc = VSD_TARGET(in);
         break;
+      case OP_JLTI:
+        if (R[in.a].i < R[in.b].i) pc = VSD_TARGET(in);
+        break;
+      case OP_JLEI:
+        if (R[in.a].i <= R[in.b].i) pc = VSD_TARGET(in);
+        break;
+      case OP_JEQI:
+        if (R[in.a].i == R[in.b].i) pc = VSD_TARGET(in);
+        break;
+      case OP_JNEI:
+        if (R[in.a].i != R[in.b].i) pc = VSD_TARGET(in);
+        break;
+      case OP_JGEIK:
+        if (R[in.a].i >= VSD_IMM(in.b)) pc = VSD_TARGET(in);
+        break;
+      case OP_JGTIK:
+        if (R[in.a].i > VSD_IMM(in.b)) pc = VSD_TARGET(in);
+        break;
+      case OP_JLTIK:
+        if (R[in.a].i < VSD_IMM(in.b)) pc = VSD_TARGET(in);
+        break;
+      case OP_JLEIK:
+        if (R[in.a].i <= VSD_IMM(in.b)) pc = VSD_TARGET(in);
+        break;
+      case OP_JEQIK:
+        if (R[in.a].i == VSD_IMM(in.b)) pc = VSD_TARGET(in);
+        break;
+      case OP_JNEIK:
+        if (R[in.a].i != VSD_IMM(in.b)) pc = VSD_TARGET(in);
+        break;
+      case OP_LOOPLT:
+        VSD_LOOP(<, R[in.b].i);
+        break;
+      case OP_LOOPLE:
+        VSD_LOOP(<=, R[in.b].i);
+        break;
+      case OP_LOOPLTK:
+        VSD_LOOP(<, VSD_IMM(in.b));
+        break;
+      case OP_LOOPLEK:
+        VSD_LOOP(<=, VSD_IMM(in.b));
+        break;
       case OP_CALL:
+      case OP_CALLS:
       case OP_VCALL: {
         VSD_SAVE();
-        const std::uint64_t self = R[in.c].id;
+        const std::uint64_t self = in.op == OP_CALLS ? fr->self : R[in.c].id;
         int fi = in.b;
         if (in.op == OP_VCALL) {
           fi = img.vslot_default[in.b];
@@ -1473,6 +1539,8 @@ Val ProgramImpl::exec(std::size_t entry) {
 #undef VSD_TARGET
 #undef VSD_REFRESH
 #undef VSD_CHECKED
+#undef VSD_IMM
+#undef VSD_LOOP
 }
 
 }  // namespace vsd::soml

@@ -556,11 +556,13 @@ object cell {
 )");
   const std::string d = p.disassemble();
   EXPECT_THAT(d, ::testing::HasSubstr("function f0 fib ("));
-  EXPECT_THAT(d, ::testing::HasSubstr("params 1, registers 7, result int"));
+  EXPECT_THAT(d, ::testing::HasSubstr("params 1, registers 5, result int"));
   EXPECT_THAT(d, ::testing::HasSubstr("local r0 n: int [0, "));
-  EXPECT_THAT(d, ::testing::ContainsRegex("  0  LOADI +r2, #2 +; 2:11"));
-  EXPECT_THAT(d, ::testing::ContainsRegex("CALL +r3, f0, r2 +; 3:13  fib"));
-  EXPECT_THAT(d, ::testing::ContainsRegex("JMPF +r1, -> 5"));
+  // `if (n < 2)` is one compare-with-constant-and-jump, `return n` returns the local's register, and
+  // the recursive calls run on the frame's own self (no SELF).
+  EXPECT_THAT(d, ::testing::ContainsRegex("  0  JGEIK +r0, #2, -> 2 +; 2:9"));
+  EXPECT_THAT(d, ::testing::ContainsRegex("  1  RET +r0 +; 2:14"));
+  EXPECT_THAT(d, ::testing::ContainsRegex("CALLS +r2, f0 +; 3:13  fib"));
   EXPECT_THAT(d, ::testing::HasSubstr("s1 = \"a\\nb\""));  // strings quoted, control characters escaped
   EXPECT_THAT(d, ::testing::HasSubstr("\nconstants\n"));
   EXPECT_THAT(d, ::testing::HasSubstr(".label"));  // a property operand names the property
