@@ -1,7 +1,7 @@
 // The paper's work cell (section 4.2): two 8-axis robots under "Meta Control" and "Multi Robot Control",
 // both SOML++ nets, in one process (cell.hpp says what it is).
 //
-//   vsd_two_robot_cell [--seed N] [--parts N] [--csv FILE] [--quiet] [--step S] [--physics-step S]
+//   vsd_two_robot_cell [--seed N] [--parts N] [--kinds 1|2] [--csv FILE] [--png FILE] [--quiet] [--step S] [--physics-step S]
 //                      [--time-limit S] [--urdf IIWA14.URDF] [--meta meta_control.soml]
 //                      [--robots multi_robot_control.soml] [--serve [PORT]]
 //                      [--processes 1|2] [--role controller|ui --domain N] [--no-commands]
@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
     vsd_workcell::parse_options(args, o);
   } catch (const std::exception& e) {
     std::cerr << "vsd_two_robot_cell: " << e.what()
-              << "\nusage: vsd_two_robot_cell [--seed N] [--parts N] [--csv FILE] [--quiet] [--step S] "
+              << "\nusage: vsd_two_robot_cell [--seed N] [--parts N] [--kinds 1|2] [--csv FILE] [--png FILE] [--quiet] [--step S] "
                  "[--physics-step S] [--time-limit S] [--urdf FILE] [--meta FILE] [--robots FILE] "
                  "[--serve [PORT]] [--processes 1|2] [--role controller|ui --domain N] [--no-commands]\n";
     return 2;
@@ -107,7 +107,7 @@ int main(int argc, char** argv) {
 #endif
     vsd_workcell::print_summary(std::cout, r);
     const bool ok = r.parts_handled == o.parts + r.parts_injected && r.zone_violations == 0 &&
-                    r.deadlocks == 0 && r.condition_errors.empty() && !r.timed_out && replica_ok;
+                    r.deadlocks == 0 && r.condition_errors.empty() && !r.timed_out && replica_ok && r.png_error.empty();
     std::cout << "check: " << (ok ? "every part handled, the zone exclusive, no deadlock" : "FAILED") << '\n';
     return ok ? 0 : 1;
   } catch (const std::exception& e) {
