@@ -6,6 +6,8 @@
 //                      [--robots multi_robot_control.soml] [--serve [PORT]]
 //                      [--processes 1|2] [--role controller|ui --domain N] [--no-commands]
 //
+//   vsd_two_robot_cell --net-dot SCRIPT.soml      (the net's picture as Graphviz DOT, made from the script)
+//
 // --processes 2 (with vsd::dist built) runs the cell as a controller process and a ui process that
 // replicates it and sends operator commands (docs/workcell.md, "Two processes"); --role runs one of them.
 //
@@ -20,6 +22,7 @@
 #include <vector>
 
 #include "cell.hpp"
+#include "net_picture.hpp"
 #include "serve_option.hpp"
 #ifdef VSD_WORKCELL_DIST
 #include <unistd.h>
@@ -45,6 +48,16 @@ int main(int argc, char** argv) {
       quiet = true;
     else
       args.emplace_back(argv[i]);
+  }
+  // --net-dot SCRIPT: the net's picture as Graphviz DOT on stdout (scripts/net-pictures.sh), nothing else.
+  if (args.size() == 2 && args[0] == "--net-dot") {
+    try {
+      std::cout << vsd_workcell::net_dot(args[1]);
+      return 0;
+    } catch (const std::exception& e) {
+      std::cerr << "vsd_two_robot_cell: " << e.what() << '\n';
+      return 1;
+    }
   }
   int serve_port = -1;
 #ifdef VSD_WORKCELL_DIST
