@@ -1017,6 +1017,8 @@ void print_summary(std::ostream& out, const CellReport& r) {
       "arrivals %.2f s)",
       r.bound.parts_per_hour, r.bound.limit.c_str(), r.bound.cycle, r.bound.load_a, r.bound.load_b,
       r.bound.load_zone, r.cycle.arrival_gap);
+  put("job cycles: A direct %.2f s, B direct %.2f s, hand-over A %.2f s (zone %.2f s), B %.2f s (zone %.2f s)",
+      r.cycle.direct_a, r.cycle.direct_b, r.cycle.give_a, r.cycle.zone_a, r.cycle.take_b, r.cycle.zone_b);
   put("parts/hour of the bound: %.0f %%", r.bound.parts_per_hour > 0 ? 100 * r.parts_per_hour / r.bound.parts_per_hour : 0.0);
   put("zone violations: %d", r.zone_violations);
   put("deadlocks: %d", r.deadlocks);
