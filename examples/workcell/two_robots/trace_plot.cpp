@@ -28,7 +28,7 @@ void TracePlot::write(const std::string& path) const {
     int top, height;
     double lo, hi;  // m
   };
-  const Panel py{20, 260, -1.6, 1.6}, px{300, 200, -1.0, 1.0};
+  const Panel py{20, 260, -1.6, 1.6}, px{300, 200, -1.4, 1.4};
   const int occ_top = 520, row = 30, height = occ_top + 2 * row + 30;
   vsd_example::Image img(width, height, white);
   const double t_end = samples_.empty() ? 1.0 : std::max(samples_.back().t, 1.0);
