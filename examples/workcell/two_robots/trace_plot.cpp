@@ -14,9 +14,17 @@ void TracePlot::add(const TraceSample& s) {
   if (!samples_.empty()) {
     const TraceSample& last = samples_.back();
     const bool zone_changed = last.a_in_zone != s.a_in_zone || last.b_in_zone != s.b_in_zone;
-    if (!zone_changed && s.t - last.t < 0.02) return;
+    if (!zone_changed && s.t - last.t < interval_) return;
   }
   samples_.push_back(s);
+  if (samples_.size() >= max_samples) {
+    // A long run: keep every other sample and sample half as often from now on. The picture is 1,160
+    // pixels wide; memory stays bounded however long the run.
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < samples_.size(); i += 2) samples_[k++] = samples_[i];
+    samples_.resize(k);
+    interval_ *= 2;
+  }
 }
 
 void TracePlot::write(const std::string& path) const {

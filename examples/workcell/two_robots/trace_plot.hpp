@@ -16,13 +16,14 @@ struct TraceSample {
   bool b_in_zone = false;
 };
 
-/// Collects samples (at most one per 20 ms of simulated time, and every change of the zone's occupancy)
-/// and draws them: three panels over a common time axis (grid lines every 10 s, every 60 s beyond 10
+/// Collects samples (at most one per 20 ms of simulated time, and every change of the zone's occupancy;
+/// fewer in a run so long that it would need more than max_samples) and draws them: three panels over a common time axis (grid lines every 10 s, every 60 s beyond 10
 /// minutes) — the pads' y (the rails' direction; grey lines at the pick points, the station and the
 /// destinations), the pads' x (the shared zone's x range shaded) and the zone's occupancy (A's row, B's
 /// row, both at once in black); robot A red, robot B blue.
 class TracePlot {
  public:
+  static constexpr std::size_t max_samples = 100'000;
   void add(const TraceSample& s);
   std::size_t size() const { return samples_.size(); }
   /// Writes the picture as a PNG (through a temporary file renamed over @p path).
@@ -31,6 +32,7 @@ class TracePlot {
 
  private:
   std::vector<TraceSample> samples_;
+  double interval_ = 0.02;  // s between samples
 };
 
 /// Checks before a run that @p path can be written (creates and removes PATH.tmp), so that a bad

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cell.hpp"
+#include "trace_plot.hpp"
 #include "vsd/core/error.hpp"
 
 namespace {
@@ -154,6 +155,18 @@ TEST(TwoRobotCell, WritesThePictureAndFailsClearlyWhereItCannot) {
   } catch (const vsd::Error& e) {
     EXPECT_EQ(std::string(e.what()), "cannot write /nonexistent-dir/cell.png: No such file or directory");
   }
+}
+
+TEST(TwoRobotCell, ThePicturesSamplesStayBoundedInALongRun) {
+  vsd_workcell::TracePlot plot;
+  vsd_workcell::TraceSample s;
+  for (int i = 0; i < 2'000'000; ++i) {  // 20,000 s at the demo's 10 ms step
+    s.t = i * 0.01;
+    s.a_in_zone = i % 5000 < 300;  // the zone's occupancy changes now and then
+    plot.add(s);
+    ASSERT_LT(plot.size(), vsd_workcell::TracePlot::max_samples);
+  }
+  EXPECT_GT(plot.size(), vsd_workcell::TracePlot::max_samples / 4);
 }
 
 TEST(TwoRobotCell, WritesOneCsvRowPerStep) {
