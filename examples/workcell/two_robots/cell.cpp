@@ -15,7 +15,10 @@
 #include <sstream>
 #include <utility>
 
+#include "cycle_bound.hpp"
 #include "eight_axis_urdf.hpp"
+#include "infeed.hpp"
+#include "trace_plot.hpp"
 #include "scene_kit.hpp"
 #include "vsd/collision.hpp"
 #include "vsd/physics.hpp"
@@ -30,12 +33,15 @@ namespace {
 
 // --- The layout (m, world frame, z up). Robot A's rail runs along y at x = -0.65, robot B's at x = +0.65,
 // each arm facing the other; between them the shared zone, with the hand-over station in its middle.
-// The conveyor ends at `pick`, which only A reaches; `dest_a` only A reaches, `dest_b` only B (each is
-// more than the iiwa14's 0.82 m reach from the other rail).
+// The conveyor has two lanes: lane A ends at `pick` (the node `conveyor`), which only A reaches, lane B at
+// `pick_b` (`conveyor_b`), which only B reaches; `dest_a` only A reaches, `dest_b` only B (each is more than
+// the iiwa14's 0.82 m reach from the other rail). Parts wait at the infeed, between the lanes' starts,
+// until Meta Control diverts them (infeed.hpp).
 constexpr double rail_x = 0.65;
 constexpr double table_top = 0.25;  // every work surface
 constexpr double tool_length = 0.05;
 const Eigen::Vector2d pick_xy{-0.30, -0.75};
+const Eigen::Vector2d pick_b_xy{0.30, -0.75};
 const Eigen::Vector2d dest_a_xy{-0.30, 0.75};
 const Eigen::Vector2d dest_b_xy{0.30, 0.75};
 const Eigen::Vector2d station_xy{0.0, 0.0};
@@ -45,12 +51,14 @@ const Eigen::Vector2d gate_b_xy{0.42, 0.0};
 const Eigen::Vector3d zone_min{-0.15, -0.30, 0.0};
 const Eigen::Vector3d zone_max{0.15, 0.30, 2.0};
 constexpr double arm_sphere = 0.06;    // radius of the spheres that stand for each arm
-constexpr double belt_start = -1.60;   // y where parts come onto the belt (x = pick x)
+constexpr double belt_start = -1.60;   // y where parts come onto a lane (x = its pick x); the infeed's y
 constexpr double belt_speed = 0.25;    // m/s
 constexpr double belt_gap = 0.10;      // m between queued parts' centres
 constexpr double rest_speed = 0.005;   // m/s: slower than this ...
 constexpr double rest_time = 0.2;      // ... for this long is "at rest"
 constexpr double outfeed_delay = 0.3;  // s a delivered part rests on its destination before it goes
+constexpr double arrival_min = 2.0;    // s: the gap between two arrivals is uniform in
+constexpr double arrival_spread = 4.0;  // [arrival_min, arrival_min + arrival_spread]
 
 enum Stage : std::int64_t {
   on_belt = 0,
@@ -91,6 +99,7 @@ class Part : public vsd::scene::Hull {
   double belt_y = 0;       // while on the belt
   double slow_for = 0;     // s below rest_speed
   double resting_for = 0;  // s resting on a destination
+  bool handed_over = false;  // it rested on the station
 };
 
 /// The order board between Meta Control (posts) and Multi Robot Control (takes).
@@ -102,10 +111,10 @@ class Orders : public vsd::Node {
  public:
   std::ostream* log = nullptr;
   double* clock = nullptr;
-  /// γ: posts @p p with @p r (1 direct, 2 hand-over).
+  /// γ: posts @p p with @p r (1: A direct, 2: hand-over from A to B, 3: B direct).
   void post(vsd::SharedRef<vsd::Node> p, std::int64_t r) {
     if (part()) throw vsd::Error("orders.post: the board already holds " + part()->name());
-    if (log) *log << "t=" << fmt(*clock) << " s  γ orders.post(" << p->name() << ", route " << r << ")\n";
+    if (log) *log << "t=" << fmt(*clock) << " s  γ " << name() << ".post(" << p->name() << ", route " << r << ")\n";
     set_route(r);
     set_part(p);
   }
@@ -192,7 +201,7 @@ class Robot : public vsd::Node {
   vsd::scene::SpatialView* view = nullptr;
   Node3D* base = nullptr;
   Node3D* pad = nullptr;
-  Conveyor* conveyor = nullptr;
+  Conveyor* conveyors[2] = {nullptr, nullptr};  // the lanes' stops
   Station* station = nullptr;
   std::ostream* log = nullptr;
   std::uint64_t step = 0;
@@ -223,7 +232,8 @@ class Robot : public vsd::Node {
     b->set_resting(false);
     b->slow_for = 0;
     b->set_stage(held);
-    if (conveyor->at_sensor().get() == b) conveyor->set_at_sensor(nullptr);
+    for (Conveyor* c : conveyors)
+      if (c->at_sensor().get() == b) c->set_at_sensor(nullptr);
     if (station->part().get() == b) station->set_part(nullptr);
     set_holding(part);
   }
@@ -271,6 +281,34 @@ class Robot : public vsd::Node {
     solutions.emplace(key, r.q);
     return r.q;
   }
+  /// The planned duration (s) of the move between two flange positions (solved as move_to solves them),
+  /// with the limits and interpolation the controller plans with.
+  vsd::robotics::JointTrajectory plan(const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+    const std::vector<double> a = solve(from), b = solve(to);
+    std::vector<double> v, acc;
+    for (const vsd::robotics::DofInfo& d : tree->model().layout()) {
+      v.push_back(d.velocity_limit > 0 ? d.velocity_limit : controller->default_velocity());
+      acc.push_back(d.acceleration_limit > 0 ? d.acceleration_limit : controller->default_acceleration());
+    }
+    return vsd::robotics::JointTrajectory::plan(controller->interpolation(), a, b, v, acc);
+  }
+  double move_time(const Eigen::Vector3d& from, const Eigen::Vector3d& to) { return plan(from, to).duration(); }
+  /// The time (s, whole steps) from commanding the descent from @p from towards @p to until the pad's
+  /// face reaches the height @p contact_z (world): where collision reports the touch and the nets grasp.
+  double contact_time(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double contact_z, double step) {
+    const vsd::robotics::JointTrajectory t = plan(from, to);
+    const vsd::robotics::Model& m = tree->model();
+    auto data = m.make_data();
+    const int flange = m.find_body("iiwa_link_ee_kuka");
+    std::vector<double> q(t.size()), qd(t.size());
+    for (int k = 1;; ++k) {
+      const double at_time = k * step;
+      t.sample(at_time, q.data(), qd.data());
+      m.forward(q, data);
+      const double z = (base->world_frame() * m.pose(data, flange).translation).z() - tool_length;
+      if (z <= contact_z + 1e-6 || at_time >= t.duration()) return at_time;
+    }
+  }
   bool reaches(const Eigen::Vector3d& flange_at) {
     try {
       solve(flange_at);
@@ -303,6 +341,7 @@ class CellModule : public vsd::Module {
     r.add<Robot>();
     r.add<Operator>();
     r.add<Session>();
+    r.add<Infeed>();
   }
 };
 
@@ -328,6 +367,7 @@ CellReport run_cell(const CellOptions& o) {
   if (!(o.step > 0) || !(o.physics_step > 0) || o.physics_step > o.step)
     throw vsd::Error("the physics step must be positive and at most the step");
   std::ostream* tl = o.timeline;
+  if (!o.png.empty()) check_writable(o.png);  // before the run, not after it
   const double time_limit = o.time_limit > 0 ? o.time_limit : 60.0 * o.parts;
 
   vsd::Environment env;
@@ -375,20 +415,27 @@ CellReport run_cell(const CellOptions& o) {
              kit.geometry(GeometryKind::Box, {size.x(), size.y(), 0.04}),
              at(xy.x(), xy.y(), table_top - 0.02), room);
   };
-  surface("belt", {pick_xy.x(), (belt_start + pick_xy.y()) / 2}, {0.16, pick_xy.y() - belt_start + 0.2});
+  for (const Eigen::Vector2d& pick : {pick_xy, pick_b_xy})
+    surface(pick.x() < 0 ? "belt" : "belt_b", {pick.x(), (belt_start + pick.y()) / 2},
+            {0.16, pick.y() - belt_start + 0.2});
   surface("station table", station_xy, {0.16, 0.16});
   surface("dest_a table", dest_a_xy, {0.2, 0.2});
   surface("dest_b table", dest_b_xy, {0.2, 0.2});
   auto& conveyor = static_cast<Conveyor&>(marker(s.create<Conveyor>(), "conveyor", pick_xy));
+  auto& conveyor_b = static_cast<Conveyor&>(marker(s.create<Conveyor>(), "conveyor_b", pick_b_xy));
+  auto& infeed = static_cast<Infeed&>(marker(s.create<Infeed>(), "infeed", {0.0, belt_start}));
   auto& station = static_cast<Station&>(marker(s.create<Station>(), "station", station_xy));
   auto& zone = static_cast<ZoneSensor&>(marker(s.create<ZoneSensor>(), "zone", station_xy));
   Node3D& dest_a = marker(s.create<Node3D>(), "dest_a", dest_a_xy);
   Node3D& dest_b = marker(s.create<Node3D>(), "dest_b", dest_b_xy);
   Node3D& gate_a = marker(s.create<Node3D>(), "gate_a", gate_a_xy);
   Node3D& gate_b = marker(s.create<Node3D>(), "gate_b", gate_b_xy);
-  auto& orders = s.create<Orders>();
+  auto& orders = s.create<Orders>();  // robot A's jobs
   orders.set_name("orders");
   s.database().add_child(orders);
+  auto& orders_b = s.create<Orders>();  // robot B's jobs from lane B
+  orders_b.set_name("orders_b");
+  s.database().add_child(orders_b);
   auto& op = s.create<Operator>();
   op.set_name("operator");
   s.database().add_child(op);
@@ -396,8 +443,12 @@ CellReport run_cell(const CellOptions& o) {
   session.set_name("session");
   s.database().add_child(session);
   double now = 0;
-  orders.log = tl;
-  orders.clock = &now;
+  for (Orders* b : {&orders, &orders_b}) {
+    b->log = tl;
+    b->clock = &now;
+  }
+  infeed.log = tl;
+  infeed.clock = &now;
   vsd::scene::SpatialView view(s);
 
   // --- The robots: the 8-axis URDF twice, each base on its rail, facing the zone.
@@ -430,7 +481,8 @@ CellReport run_cell(const CellOptions& o) {
     robot.tree = &tree;
     robot.view = &view;
     robot.base = rep.scene;
-    robot.conveyor = &conveyor;
+    robot.conveyors[0] = &conveyor;
+    robot.conveyors[1] = &conveyor_b;
     robot.station = &station;
     robot.log = tl;
     // Start at the gate, above the work height.
@@ -455,13 +507,65 @@ CellReport run_cell(const CellOptions& o) {
   // Who reaches what (the reason for the hand-over): checked by IK, not assumed.
   for (int i = 0; i < 2; ++i) {
     std::string line;
-    const Node3D* points[] = {&conveyor, &station, &dest_a, &dest_b};
+    const Node3D* points[] = {&conveyor, &conveyor_b, &station, &dest_a, &dest_b};
     for (const Node3D* n : points) {
       const bool r =
           robots[i]->reaches(n->world_frame().translation() + Eigen::Vector3d(0, 0, 0.1 + tool_length));
       line += (line.empty() ? "" : ", ") + n->name() + (r ? " yes" : " no");
     }
     if (tl) *tl << "reach of " << robots[i]->name() << ": " << line << '\n';
+  }
+
+  // --- The analytic bound's motion times (cycle_bound.hpp; docs/workcell.md, "The analytic bound"): the
+  // moves of each job as the nets command them, planned as the controllers plan them, between the pad
+  // heights the nets use (above = 0.12 m travel height, drop = 0.004 m; a small part on route 1, a large
+  // one on routes 2 and 3). The descent is counted to the contact (the part's top), where it stops.
+  CycleParameters cycle;
+  {
+    constexpr double above = 0.12, drop = 0.004;
+    auto pt = [](const Node3D& n, double height) {
+      return Eigen::Vector3d(n.world_frame().translation() + Eigen::Vector3d(0, 0, height + tool_length));
+    };
+    // A sequence of pad positions: the sum of each move's cycle (move_cycle: the step rounding, the
+    // step in which the nets see `arrived`).
+    auto path = [&](Robot& r, std::initializer_list<Eigen::Vector3d> stops) {
+      double t = 0;
+      const Eigen::Vector3d* prev = nullptr;
+      for (const Eigen::Vector3d& x : stops) {
+        if (prev != nullptr) t += move_cycle(r.move_time(*prev, x), o.step);
+        prev = &x;
+      }
+      return t;
+    };
+    const double small = 0.04, large = 0.06;
+    // The part's centre is at half its height above the surface: its top at `h`, the travel height at
+    // h + above (move_to(part, h / 2 + above)), the same as move_to(surface, h + above).
+    Robot& a = *robots[0];
+    Robot& b = *robots[1];
+    // The descent: commanded 1 cm into the part, it ends where the pad touches the part's top.
+    auto descent = [&](Robot& r, const Node3D& n, double h) {
+      return r.contact_time(pt(n, h + above), pt(n, h - 0.01), table_top + h, o.step);
+    };
+    cycle.direct_a = path(a, {pt(dest_a, small + above), pt(conveyor, small + above)}) + descent(a, conveyor, small) +
+                     path(a, {pt(conveyor, small), pt(conveyor, small + above), pt(dest_a, small + above),
+                              pt(dest_a, small + drop), pt(dest_a, small + above)});
+    cycle.direct_b = path(b, {pt(dest_b, large + above), pt(conveyor_b, large + above)}) +
+                     descent(b, conveyor_b, large) +
+                     path(b, {pt(conveyor_b, large), pt(conveyor_b, large + above), pt(dest_b, large + above),
+                              pt(dest_b, large + drop), pt(dest_b, large + above)});
+    // A's half of a hand-over, from its gate (where the last one ended) back to it; the zone is held from
+    // the gate into the station and back to the gate.
+    cycle.zone_a = path(a, {pt(gate_a, large + above), pt(station, large + above), pt(station, large + drop),
+                            pt(station, large + above), pt(gate_a, above)});
+    cycle.give_a = path(a, {pt(gate_a, above), pt(conveyor, large + above)}) + descent(a, conveyor, large) +
+                   path(a, {pt(conveyor, large), pt(conveyor, large + above), pt(gate_a, large + above)}) +
+                   cycle.zone_a;
+    // B's half: from above dest_b into the station (holding the zone), out to its gate, to dest_b.
+    cycle.zone_b = path(b, {pt(dest_b, large + above), pt(station, large + above)}) + descent(b, station, large) +
+                   path(b, {pt(station, large), pt(station, large + above), pt(gate_b, large + above)});
+    cycle.take_b = cycle.zone_b + path(b, {pt(gate_b, large + above), pt(dest_b, large + above),
+                                           pt(dest_b, large + drop), pt(dest_b, large + above)});
+    cycle.arrival_gap = arrival_min + arrival_spread / 2;  // the mean gap
   }
 
   // --- Collision: pad against part contacts (σ touched); distances between the arms on request.
@@ -494,7 +598,15 @@ CellReport run_cell(const CellOptions& o) {
   Random random(o.seed);
   vsd::scene::Geometry* part_shape[2] = {&kit.geometry(GeometryKind::Box, {0.04, 0.04, 0.04}),
                                          &kit.geometry(GeometryKind::Box, {0.06, 0.06, 0.06})};
-  std::vector<Part*> belt;    // on the belt, front first (no rigid body: the belt carries them)
+  // The conveyor's lanes: each a belt of parts, front first (no rigid body: the belt carries them).
+  struct Lane {
+    Conveyor* stop;
+    Eigen::Vector2d pick;
+    std::vector<Part*> belt;
+  };
+  Lane lanes[2] = {{&conveyor, pick_xy, {}}, {&conveyor_b, pick_b_xy, {}}};
+  auto room_at_start = [](const Lane& l) { return l.belt.empty() || l.belt.back()->belt_y > belt_start + belt_gap; };
+  Part* at_infeed = nullptr;  // waiting for Meta Control's divert
   std::vector<Part*> placed;  // with a rigid body, somewhere in the room
   int spawned = 0;         // parts made (named part1, part2, ...)
   int random_spawned = 0;  // of them, the seed's arrivals (o.parts in all)
@@ -505,6 +617,7 @@ CellReport run_cell(const CellOptions& o) {
   bool in_zone[2] = {false, false};  // this step's zone sensor
   double next_arrival = 0.5;
   CellReport report;
+  int handled_by_route[3] = {0, 0, 0};  // routes 1, 2 (hand-over) and 3
 
   // --- The sensors, after control, physics and collision in each step: only changes reach the nets.
   env.scheduler().add_periodic(
@@ -512,6 +625,7 @@ CellReport run_cell(const CellOptions& o) {
       [&](const vsd::StepInfo& info) {
         now = info.time;
         conveyor.set_time(info.time);
+        conveyor_b.set_time(info.time);
         const double dt = o.step;
         // The operator's commands: the plant's reaction to the properties of `operator` (written by a ui,
         // through vsd::dist in the two-process run). Each is answered on `session`.
@@ -590,41 +704,58 @@ CellReport run_cell(const CellOptions& o) {
           ++report.zone_violations;
           if (tl) *tl << "t=" << Orders::fmt(now) << " s  ZONE VIOLATION: both arms in the shared zone\n";
         }
-        // The belt: a new part at the start when its gap has passed (and there is room).
-        const bool belt_room = belt.empty() || belt.back()->belt_y > belt_start + belt_gap;
-        if (belt_room && (!injected.empty() || (random_spawned < o.parts && info.time >= next_arrival))) {
+        // The infeed: the part Meta Control diverted goes onto its lane's start when that has room; a new
+        // part comes to the infeed when its gap has passed and the infeed is empty.
+        if (at_infeed != nullptr && infeed.chosen != 0 && room_at_start(lanes[infeed.chosen - 1])) {
+          Lane& l = lanes[infeed.chosen - 1];
+          at_infeed->belt_y = belt_start;
+          at_infeed->set_frame(at(l.pick.x(), belt_start, table_top + at_infeed->height() / 2));
+          l.belt.push_back(at_infeed);
+          at_infeed = nullptr;
+          infeed.chosen = 0;
+        }
+        if (at_infeed == nullptr && (!injected.empty() || (random_spawned < o.parts && info.time >= next_arrival))) {
           auto& p = s.create<Part>();
           const bool inject = !injected.empty();
-          const auto kind = inject ? injected.front() : random.uniform() < 0.5 ? 1 : 2;
+          // --kinds 1 draws too, so that the arrival times are the seed's either way.
+          const std::int64_t drawn = inject ? injected.front() : random.uniform() < 0.5 ? 1 : 2;
+          const auto kind = inject || o.kinds == 2 ? drawn : 1;
           if (inject)
             injected.erase(injected.begin());
           else
             ++random_spawned;
           p.set_kind(kind);
           p.set_height(kind == 1 ? 0.04 : 0.06);
-          p.belt_y = belt_start;
           kit.hull(p, "part" + std::to_string(++spawned), *part_shape[kind - 1],
-                   at(pick_xy.x(), belt_start, table_top + p.height() / 2), room);
-          belt.push_back(&p);
-          if (!inject) next_arrival = info.time + 2.0 + 4.0 * random.uniform();
+                   at(0.0, belt_start, table_top + p.height() / 2), room);
+          at_infeed = &p;
+          infeed.set_waiting(vsd::SharedRef<vsd::Node>(&p));
+          if (!inject) next_arrival = info.time + arrival_min + arrival_spread * random.uniform();
           if (tl)
             *tl << "t=" << Orders::fmt(now) << " s  conveyor: " << p.name() << " (kind " << kind
                 << ") comes in\n";
         }
-        const bool spot_free =
-            !conveyor.at_sensor() &&
-            std::none_of(placed.begin(), placed.end(), [&](Part* p) { return p->stage() == on_belt; });
-        for (std::size_t k = 0; k < belt.size(); ++k) {
-          const double limit =
-              k == 0 ? (spot_free ? pick_xy.y() : pick_xy.y() - belt_gap) : belt[k - 1]->belt_y - belt_gap;
-          belt[k]->belt_y = std::min(limit, belt[k]->belt_y + belt_speed * dt);
-          belt[k]->set_frame(at(pick_xy.x(), belt[k]->belt_y, table_top + belt[k]->height() / 2));
-        }
-        if (!belt.empty() && spot_free && belt.front()->belt_y >= pick_xy.y() - 1e-9) {
-          Part* p = belt.front();  // at the stop: physics takes it over until the sensor sees it at rest
-          belt.erase(belt.begin());
-          p->add_extension(s.create<vsd::physics::RigidBody>());
-          placed.push_back(p);
+        for (Lane& l : lanes) {
+          const auto at_stop = [&](Part* p) {
+            return p->stage() == on_belt && (p->world_frame().translation().head<2>() - l.pick).norm() < 0.05;
+          };
+          const bool spot_free = !l.stop->at_sensor() && std::none_of(placed.begin(), placed.end(), at_stop);
+          for (std::size_t k = 0; k < l.belt.size(); ++k) {
+            const double limit =
+                k == 0 ? (spot_free ? l.pick.y() : l.pick.y() - belt_gap) : l.belt[k - 1]->belt_y - belt_gap;
+            l.belt[k]->belt_y = std::min(limit, l.belt[k]->belt_y + belt_speed * dt);
+            l.belt[k]->set_frame(at(l.pick.x(), l.belt[k]->belt_y, table_top + l.belt[k]->height() / 2));
+          }
+          if (!l.belt.empty() && spot_free && l.belt.front()->belt_y >= l.pick.y() - 1e-9) {
+            Part* p = l.belt.front();  // at the stop: physics takes it over until the sensor sees it at rest
+            l.belt.erase(l.belt.begin());
+            p->add_extension(s.create<vsd::physics::RigidBody>());
+            placed.push_back(p);
+          }
+          const auto queued = static_cast<std::int64_t>(
+              l.belt.size() + (l.stop->at_sensor() ? 1 : 0) + std::count_if(placed.begin(), placed.end(), at_stop));
+          if (&l == &lanes[0] && queued != infeed.queued_a()) infeed.set_queued_a(queued);
+          if (&l == &lanes[1] && queued != infeed.queued_b()) infeed.set_queued_b(queued);
         }
         // Rest: where a part lies still decides what the sensors report. The parts with a rigid body are
         // those in the room that neither the belt carries nor a robot holds.
@@ -645,16 +776,20 @@ CellReport run_cell(const CellOptions& o) {
             p->set_resting(true);
             const Eigen::Vector2d xy = x.head<2>();
             const char* where = nullptr;
-            if ((xy - pick_xy).norm() < 0.05) {
-              where = "the conveyor's sensor";
+            const Lane* lane = (xy - pick_xy).norm() < 0.05     ? &lanes[0]
+                               : (xy - pick_b_xy).norm() < 0.05 ? &lanes[1]
+                                                                : nullptr;
+            if (lane != nullptr) {
+              where = lane == &lanes[0] ? "the conveyor's sensor" : "the conveyor's sensor on lane B";
               p->set_stage(at_sensor);
-              conveyor.set_at_sensor(vsd::SharedRef<vsd::Node>(p));
-              conveyor.set_last(vsd::SharedRef<vsd::Node>(p));
-              conveyor.set_arrivals(conveyor.arrivals() + 1);
+              lane->stop->set_at_sensor(vsd::SharedRef<vsd::Node>(p));
+              lane->stop->set_last(vsd::SharedRef<vsd::Node>(p));
+              lane->stop->set_arrivals(lane->stop->arrivals() + 1);
               ++report.parts_arrived;
             } else if ((xy - station_xy).norm() < 0.06) {
               where = "the station";
               p->set_stage(on_station);
+              p->handed_over = true;
               station.set_part(vsd::SharedRef<vsd::Node>(p));
               ++report.handovers;
             } else if ((xy - (p->kind() == 1 ? dest_a_xy : dest_b_xy)).norm() < 0.06) {
@@ -673,6 +808,7 @@ CellReport run_cell(const CellOptions& o) {
             outfeed.add_child(*p);
             p->set_stage(delivered);
             ++report.parts_handled;
+            ++handled_by_route[p->kind() == 1 ? 0 : p->handed_over ? 1 : 2];
             if (tl)
               *tl << "t=" << Orders::fmt(now) << " s  part handled: " << p->name() << " ("
                   << report.parts_handled << " of " << parts_wanted() << ")\n";
@@ -724,6 +860,7 @@ CellReport run_cell(const CellOptions& o) {
   // Until every part is handled, then until the robots are back at rest (their nets idle) — at most 20 s.
   double drained_at = -1;
   std::vector<double> step_times;  // s of wall time per env.step()
+  TracePlot plot;
   if (o.on_built) o.on_built(env);
   for (;;) {
     if (report.parts_handled == parts_wanted()) {
@@ -738,7 +875,8 @@ CellReport run_cell(const CellOptions& o) {
       break;
     }
     belt_y_before.clear();
-    for (Part* p : belt) belt_y_before[p] = p->belt_y;
+    for (const Lane& l : lanes)
+      for (Part* p : l.belt) belt_y_before[p] = p->belt_y;
     if (o.before_step && !o.before_step(env)) {
       report.interrupted = true;
       break;
@@ -750,6 +888,17 @@ CellReport run_cell(const CellOptions& o) {
     for (const auto* ha : spheres[0])
       for (const auto* hb : spheres[1]) d = std::min(d, contacts.distance(*ha, *hb).distance);
     report.min_arm_distance = std::min(report.min_arm_distance, d);
+    if (!o.png.empty()) {
+      TraceSample sample;
+      sample.t = env.time();
+      const Eigen::Vector3d pa = robots[0]->pad->world_frame().translation();
+      const Eigen::Vector3d pb = robots[1]->pad->world_frame().translation();
+      std::copy(pa.data(), pa.data() + 3, sample.a);
+      std::copy(pb.data(), pb.data() + 3, sample.b);
+      sample.a_in_zone = in_zone[0];
+      sample.b_in_zone = in_zone[1];
+      plot.add(sample);
+    }
     if (csv.is_open()) {
       const Eigen::Vector3d pa = robots[0]->pad->world_frame().translation();
       const Eigen::Vector3d pb = robots[1]->pad->world_frame().translation();
@@ -758,11 +907,11 @@ CellReport run_cell(const CellOptions& o) {
           << report.parts_handled << '\n';
     }
     // Deadlock: parts left, yet nothing moves and no transition is enabled, for 10 s.
-    const bool belt_moves =
-        std::any_of(belt.begin(), belt.end(), [&](Part* p) { return p->belt_y != belt_y_before[p]; });
+    const bool belt_moves = std::any_of(lanes, lanes + 2, [&](const Lane& l) {
+      return std::any_of(l.belt.begin(), l.belt.end(), [&](Part* p) { return p->belt_y != belt_y_before[p]; });
+    });
     const bool more_to_come =
-        (random_spawned < o.parts || !injected.empty()) &&
-        (belt.empty() || belt.back()->belt_y > belt_start + belt_gap);
+        (random_spawned < o.parts || !injected.empty()) && at_infeed == nullptr;
     // A robot the operator paused is waiting for the operator, not deadlocked.
     const bool moving = report.parts_handled == parts_wanted() || belt_moves || more_to_come ||
                         robots[0]->paused || robots[1]->paused ||
@@ -794,6 +943,14 @@ CellReport run_cell(const CellOptions& o) {
   report.parts_per_hour = report.time > 0 ? report.parts_handled * 3600.0 / report.time : 0;
   for (int i = 0; i < 2; ++i)
     report.utilisation[i] = report.time > 0 ? robots[i]->moving_time / report.time : 0;
+  if (report.parts_handled > 0) {
+    const double n = report.parts_handled;
+    cycle.share_direct_a = handled_by_route[0] / n;
+    cycle.share_handover = handled_by_route[1] / n;
+    cycle.share_direct_b = 1.0 - cycle.share_direct_a - cycle.share_handover;
+  }
+  report.cycle = cycle;
+  report.bound = cycle_bound(cycle);
   report.firings = mrc.firings() + meta.firings();
   report.condition_tests = mrc.condition_tests() + meta.condition_tests();
   for (vsd::soml::Program* p : {&mrc, &meta})
@@ -808,6 +965,13 @@ CellReport run_cell(const CellOptions& o) {
     });
   }
   report.final_marking = marking;
+  if (!o.png.empty()) {
+    try {
+      plot.write(o.png);
+    } catch (const vsd::Error& e) {
+      report.png_error = e.what();  // the run's figures are not lost with the picture
+    }
+  }
   completed = true;
   return report;
 }
@@ -822,10 +986,13 @@ void define_net_classes(vsd::Environment& env, const CellOptions& o) {
   };
   vsd::Node& cell = add(s.database(), s.create<vsd::scene::Scene>(), "cell");
   add(cell, s.create<Conveyor>(), "conveyor");
+  add(cell, s.create<Conveyor>(), "conveyor_b");
+  add(cell, s.create<Infeed>(), "infeed");
   add(cell, s.create<Station>(), "station");
   add(cell, s.create<ZoneSensor>(), "zone");
   for (const char* n : {"dest_a", "dest_b", "gate_a", "gate_b"}) add(cell, s.create<Node3D>(), n);
   add(s.database(), s.create<Orders>(), "orders");
+  add(s.database(), s.create<Orders>(), "orders_b");
   add(s.database(), s.create<Robot>(), "robot_a");
   add(s.database(), s.create<Robot>(), "robot_b");
   static std::ostringstream discard;  // the programs never run here: nothing is printed
@@ -846,6 +1013,13 @@ void print_summary(std::ostream& out, const CellReport& r) {
   if (r.parts_injected > 0) put("parts injected by the operator: %d", r.parts_injected);
   put("hand-overs: %d", r.handovers);
   put("parts/hour: %.1f", r.parts_per_hour);
+  put("parts/hour bound: %.1f (%s; cycle %.2f s per part: robot A %.2f s, robot B %.2f s, zone %.2f s, "
+      "arrivals %.2f s)",
+      r.bound.parts_per_hour, r.bound.limit.c_str(), r.bound.cycle, r.bound.load_a, r.bound.load_b,
+      r.bound.load_zone, r.cycle.arrival_gap);
+  put("job cycles: A direct %.2f s, B direct %.2f s, hand-over A %.2f s (zone %.2f s), B %.2f s (zone %.2f s)",
+      r.cycle.direct_a, r.cycle.direct_b, r.cycle.give_a, r.cycle.zone_a, r.cycle.take_b, r.cycle.zone_b);
+  put("parts/hour of the bound: %.0f %%", r.bound.parts_per_hour > 0 ? 100 * r.parts_per_hour / r.bound.parts_per_hour : 0.0);
   put("zone violations: %d", r.zone_violations);
   put("deadlocks: %d", r.deadlocks);
   put("min arm distance: %.3f m", r.min_arm_distance);
@@ -855,6 +1029,7 @@ void print_summary(std::ostream& out, const CellReport& r) {
   out << "final marking (multi robot control): " << r.final_marking << '\n';
   for (const std::string& e : r.condition_errors) out << "condition error: " << e << '\n';
   put("step time: p50 %.3f ms, p99 %.3f ms (wall, both robots and both nets)", 1e3 * r.step_p50, 1e3 * r.step_p99);
+  if (!r.png_error.empty()) out << "png: " << r.png_error << '\n';
   if (r.timed_out) out << "stopped: time limit reached\n";
   if (r.interrupted) out << "stopped: interrupted\n";
 }
@@ -908,8 +1083,12 @@ void parse_options(const std::vector<std::string>& args, CellOptions& o) {
       o.physics_step = number(i, 1e-4, 0.05);
     else if (a == "--time-limit")
       o.time_limit = number(i, 1, 1e9);
+    else if (a == "--kinds")
+      o.kinds = static_cast<int>(whole(i, 1, 2));
     else if (a == "--csv")
       o.csv = value(i);
+    else if (a == "--png")
+      o.png = value(i);
     else if (a == "--urdf")
       o.urdf = value(i);
     else if (a == "--meta")

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "cycle_bound.hpp"
+
 namespace vsd {
 class Environment;
 }
@@ -28,9 +30,13 @@ struct CellOptions {
   std::string robot_script;          ///< multi_robot_control.soml
   std::uint64_t seed = 1;            ///< part kinds and arrival times; the nets' choices
   int parts = 20;                    ///< run until this many parts are handled
+  /// 2: parts of both kinds (half each, drawn from the seed); 1: only small parts — they all go to robot
+  /// A, B has nothing to do: the one-robot baseline of the benchmark (benchmarks/README.md).
+  int kinds = 2;
   double step = 0.01;                ///< s: the scheduler's base step (control, sensors, checks)
   double physics_step = 0.001;       ///< s: ODE's fixed step inside a scheduler step
   std::string csv;                   ///< when not empty: one row per step (robots, distance, zone)
+  std::string png;                   ///< when not empty: the picture of trace_plot.hpp (checked at the start)
   std::ostream* timeline = nullptr;  ///< when set: σ events, γ commands, token moves, parts handled
   double time_limit = 0;             ///< s of simulated time; 0: 60 s per part
   /// Called once the cell is built, before the first step (the `--serve` inspector attaches here).
@@ -50,6 +56,8 @@ struct CellReport {
   int handovers = 0;      ///< parts that went through the hand-over station
   double time = 0;        ///< s simulated
   double parts_per_hour = 0;
+  CycleParameters cycle;  ///< the cell's motion times and arrival gap, with this run's shares of the routes
+  CycleBound bound;       ///< cycle_bound(cycle): what parts_per_hour is compared with
   std::uint64_t steps = 0;
   int zone_violations = 0;         ///< steps in which both arms were in the shared zone (geometry)
   int deadlocks = 0;               ///< 1 when the cell stopped with parts left and nothing enabled or moving
@@ -59,6 +67,7 @@ struct CellReport {
   std::uint64_t condition_tests = 0;  ///< both nets
   std::vector<std::string> condition_errors;
   std::string final_marking;  ///< Multi Robot Control's places
+  std::string png_error;      ///< why the picture (CellOptions::png) could not be written; empty: it was
   bool timed_out = false;
   bool interrupted = false;  ///< before_step ended the run
   double step_p50 = 0;       ///< s of wall time per step (Environment::step: control, physics, collision,

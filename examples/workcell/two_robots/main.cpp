@@ -1,10 +1,12 @@
 // The paper's work cell (section 4.2): two 8-axis robots under "Meta Control" and "Multi Robot Control",
 // both SOML++ nets, in one process (cell.hpp says what it is).
 //
-//   vsd_two_robot_cell [--seed N] [--parts N] [--csv FILE] [--quiet] [--step S] [--physics-step S]
+//   vsd_two_robot_cell [--seed N] [--parts N] [--kinds 1|2] [--csv FILE] [--png FILE] [--quiet] [--step S] [--physics-step S]
 //                      [--time-limit S] [--urdf IIWA14.URDF] [--meta meta_control.soml]
 //                      [--robots multi_robot_control.soml] [--serve [PORT] [--no-linger]]
 //                      [--processes 1|2] [--role controller|ui --domain N] [--no-commands]
+//
+//   vsd_two_robot_cell --net-dot SCRIPT.soml      (the net's picture as Graphviz DOT, made from the script)
 //
 // --processes 2 (with vsd::dist built) runs the cell as a controller process and a ui process that
 // replicates it and sends operator commands (docs/workcell.md, "Two processes"); --role runs one of them.
@@ -23,6 +25,7 @@
 #include <vector>
 
 #include "cell.hpp"
+#include "net_picture.hpp"
 #include "serve_option.hpp"
 #ifdef VSD_WORKCELL_DIST
 #include <unistd.h>
@@ -48,6 +51,16 @@ int main(int argc, char** argv) {
       quiet = true;
     else
       args.emplace_back(argv[i]);
+  }
+  // --net-dot SCRIPT: the net's picture as Graphviz DOT on stdout (scripts/net-pictures.sh), nothing else.
+  if (args.size() == 2 && args[0] == "--net-dot") {
+    try {
+      std::cout << vsd_workcell::net_dot(args[1]);
+      return 0;
+    } catch (const std::exception& e) {
+      std::cerr << "vsd_two_robot_cell: " << e.what() << '\n';
+      return 1;
+    }
   }
   int serve_port = -1;
   bool linger = true;  // with --serve: stay on the page after the run until Ctrl-C
@@ -78,7 +91,7 @@ int main(int argc, char** argv) {
     vsd_workcell::parse_options(args, o);
   } catch (const std::exception& e) {
     std::cerr << "vsd_two_robot_cell: " << e.what()
-              << "\nusage: vsd_two_robot_cell [--seed N] [--parts N] [--csv FILE] [--quiet] [--step S] "
+              << "\nusage: vsd_two_robot_cell [--seed N] [--parts N] [--kinds 1|2] [--csv FILE] [--png FILE] [--quiet] [--step S] "
                  "[--physics-step S] [--time-limit S] [--urdf FILE] [--meta FILE] [--robots FILE] "
                  "[--serve [PORT] [--no-linger]] [--processes 1|2] [--role controller|ui --domain N] [--no-commands]\n";
     return 2;
@@ -145,7 +158,7 @@ int main(int argc, char** argv) {
 #endif
     vsd_workcell::print_summary(std::cout, r);
     const bool ok = r.parts_handled == o.parts + r.parts_injected && r.zone_violations == 0 &&
-                    r.deadlocks == 0 && r.condition_errors.empty() && !r.timed_out && replica_ok;
+                    r.deadlocks == 0 && r.condition_errors.empty() && !r.timed_out && replica_ok && r.png_error.empty();
     std::cout << "check: " << (ok ? "every part handled, the zone exclusive, no deadlock" : "FAILED") << '\n';
     return ok ? 0 : 1;
   } catch (const std::exception& e) {

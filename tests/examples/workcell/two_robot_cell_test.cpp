@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cell.hpp"
+#include "trace_plot.hpp"
 #include "vsd/core/error.hpp"
 
 namespace {
@@ -61,7 +62,14 @@ TEST_P(SeededCell, EveryPartHandledZoneExclusiveNoDeadlock) {
   constexpr int parts = parts_per_seed;
   const CellReport r = vsd_workcell::run_cell(options(GetParam(), parts));
   expect_clean(r, parts);
-  EXPECT_GT(r.parts_per_hour, 100);
+  // Both robots work (issue 24's goal: >= 1.6 times the one robot's rate, measured in the benchmark),
+  // and the analytic bound holds: the run never beats it, and comes within 15 % of it over 250 parts
+  // (the start — the first part's trip down the belt — and the end are outside the bound's model).
+  EXPECT_GT(r.utilisation[1], 0.5);
+  EXPECT_LE(r.parts_per_hour, r.bound.parts_per_hour * 1.001);
+  if (parts >= 100) {
+    EXPECT_GT(r.parts_per_hour, 0.85 * r.bound.parts_per_hour) << r.bound.limit;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Seeds12, SeededCell, testing::Values(1, 2));
@@ -79,30 +87,86 @@ TEST(TwoRobotCell, Soak) {
 
 TEST(TwoRobotCell, TimelineShowsEventsCommandsTokensAndParts) {
   std::ostringstream out;
-  CellOptions o = options(7, 4);
+  CellOptions o = options(1, 4);  // part1 comes down lane B, part3 is handed over
   o.timeline = &out;
   const CellReport r = vsd_workcell::run_cell(o);
   expect_clean(r, 4);
   const std::string t = out.str();
-  EXPECT_NE(t.find("reach of robot_a: conveyor yes, station yes, dest_a yes, dest_b no"), std::string::npos);
-  EXPECT_NE(t.find("reach of robot_b: conveyor no, station yes, dest_a no, dest_b yes"), std::string::npos);
-  EXPECT_NE(t.find("σ part1 rests on the conveyor's sensor"), std::string::npos);
-  EXPECT_NE(t.find("γ orders.post(part1"), std::string::npos);
+  EXPECT_NE(t.find("reach of robot_a: conveyor yes, conveyor_b no, station yes, dest_a yes, dest_b no"),
+            std::string::npos);
+  EXPECT_NE(t.find("reach of robot_b: conveyor no, conveyor_b yes, station yes, dest_a no, dest_b yes"),
+            std::string::npos);
+  EXPECT_NE(t.find("γ infeed.divert(part1, lane B)"), std::string::npos);
+  EXPECT_NE(t.find("σ part1 rests on the conveyor's sensor on lane B"), std::string::npos);
+  EXPECT_NE(t.find("γ orders_b.post(part1, route 3)"), std::string::npos);
+  EXPECT_NE(t.find("γ infeed.divert(part3, lane A)"), std::string::npos);
+  EXPECT_NE(t.find("γ orders.post(part3, route 2)"), std::string::npos);
+  EXPECT_NE(t.find("A: hand over part3 at the station"), std::string::npos);
   EXPECT_NE(t.find("σ zone occupied by robot_a\n"), std::string::npos);
   EXPECT_NE(t.find("σ zone occupied by robot_b\n"), std::string::npos);
   EXPECT_EQ(t.find("ZONE VIOLATION"), std::string::npos);
-  EXPECT_NE(t.find("γ robot_a.grasp(part1)"), std::string::npos);
+  EXPECT_NE(t.find("γ robot_b.grasp(part1)"), std::string::npos);
+  EXPECT_NE(t.find("token: multi_robot_control b.fetch: b.idle -1, b.approaching +1"), std::string::npos);
   EXPECT_NE(t.find("token: multi_robot_control a.fetch: a.idle -1, a.approaching +1"), std::string::npos);
   EXPECT_NE(t.find("token: multi_robot_control b.enter: b.idle -1, station.full -1, zone.free -1, "
                    "b.zone_approaching +1"),
             std::string::npos);
-  EXPECT_NE(t.find("part handled: part4 (4 of 4)"), std::string::npos);
+  EXPECT_NE(t.find(" (4 of 4)\n"), std::string::npos);
   std::ostringstream summary;
   vsd_workcell::print_summary(summary, r);
   const std::string s = summary.str();
-  for (const char* line : {"parts handled: 4\n", "parts/hour: ", "zone violations: 0\n", "deadlocks: 0\n",
+  for (const char* line : {"parts handled: 4\n", "parts/hour: ", "parts/hour bound: ", "zone violations: 0\n", "deadlocks: 0\n",
                            "min arm distance: ", "utilisation: robot A ", "firings: ", "condition tests: "})
     EXPECT_NE(s.find(line), std::string::npos) << line << " in\n" << s;
+}
+
+TEST(TwoRobotCell, OneKindIsTheOneRobotBaseline) {
+  // --kinds 1: only small parts; all go down lane A to robot A, B has nothing to do. The bound is then
+  // robot A's direct cycle, and the run comes close to it.
+  CellOptions o = options(2, 12);
+  o.kinds = 1;
+  const CellReport r = vsd_workcell::run_cell(o);
+  EXPECT_EQ(r.parts_handled, 12);
+  EXPECT_EQ(r.handovers, 0);
+  EXPECT_EQ(r.utilisation[1], 0.0);
+  EXPECT_EQ(r.bound.limit, "robot A");
+  EXPECT_DOUBLE_EQ(r.bound.cycle, r.cycle.direct_a);
+  EXPECT_LE(r.parts_per_hour, r.bound.parts_per_hour * 1.001);
+  EXPECT_GT(r.parts_per_hour, 0.8 * r.bound.parts_per_hour);
+}
+
+TEST(TwoRobotCell, WritesThePictureAndFailsClearlyWhereItCannot) {
+  const auto dir = std::filesystem::temp_directory_path();
+  const auto path = dir / "vsd_two_robot_cell_test.png";
+  CellOptions o = options(3, 2);
+  o.png = path.string();
+  const CellReport r = vsd_workcell::run_cell(o);
+  EXPECT_TRUE(r.png_error.empty()) << r.png_error;
+  std::ifstream in(path, std::ios::binary);
+  std::string head(8, '\0');
+  in.read(head.data(), 8);
+  EXPECT_EQ(head, std::string("\x89PNG\r\n\x1a\n", 8));
+  std::filesystem::remove(path);
+  // A directory that is not there: the run refuses to start, naming the file and the reason.
+  o.png = "/nonexistent-dir/cell.png";
+  try {
+    vsd_workcell::run_cell(o);
+    ADD_FAILURE() << "no error";
+  } catch (const vsd::Error& e) {
+    EXPECT_EQ(std::string(e.what()), "cannot write /nonexistent-dir/cell.png: No such file or directory");
+  }
+}
+
+TEST(TwoRobotCell, ThePicturesSamplesStayBoundedInALongRun) {
+  vsd_workcell::TracePlot plot;
+  vsd_workcell::TraceSample s;
+  for (int i = 0; i < 2'000'000; ++i) {  // 20,000 s at the demo's 10 ms step
+    s.t = i * 0.01;
+    s.a_in_zone = i % 5000 < 300;  // the zone's occupancy changes now and then
+    plot.add(s);
+    ASSERT_LT(plot.size(), vsd_workcell::TracePlot::max_samples);
+  }
+  EXPECT_GT(plot.size(), vsd_workcell::TracePlot::max_samples / 4);
 }
 
 TEST(TwoRobotCell, WritesOneCsvRowPerStep) {
@@ -159,11 +223,15 @@ TEST(TwoRobotCell, BadOptionsAreClearErrors) {
   EXPECT_EQ(error({"--step", "0.1x"}), "--step: '0.1x' is not a number in [0.0001, 0.05]");
   EXPECT_EQ(error({"--step", "0.01", "--physics-step", "0.02"}), "--physics-step must not exceed --step");
   EXPECT_EQ(error({"--frobnicate"}), "unknown option '--frobnicate'");
+  EXPECT_EQ(error({"--kinds", "3"}), "--kinds: '3' is not a whole number in [1, 2]");
+  EXPECT_EQ(error({"--png"}), "--png: needs a value");
   CellOptions o;
-  vsd_workcell::parse_options({"--seed", "42", "--parts", "12", "--csv", "x.csv"}, o);
+  vsd_workcell::parse_options({"--seed", "42", "--parts", "12", "--csv", "x.csv", "--png", "x.png", "--kinds", "1"}, o);
   EXPECT_EQ(o.seed, 42u);
   EXPECT_EQ(o.parts, 12);
   EXPECT_EQ(o.csv, "x.csv");
+  EXPECT_EQ(o.png, "x.png");
+  EXPECT_EQ(o.kinds, 1);
   // Files that are not there.
   CellOptions missing = options(1, 1);
   missing.robot_script = "/nonexistent/mrc.soml";
