@@ -91,6 +91,7 @@ class Part : public vsd::scene::Hull {
   double belt_y = 0;       // while on the belt
   double slow_for = 0;     // s below rest_speed
   double resting_for = 0;  // s resting on a destination
+  bool slipped = false;    // slipped from a gripper (a fault): resting again is no new arrival or hand-over
 };
 
 /// The order board between Meta Control (posts) and Multi Robot Control (takes).
@@ -185,6 +186,7 @@ class Robot : public vsd::Node {
   VSD_PROPERTY(bool, arrived, true)                          // σ
   VSD_PROPERTY(vsd::SharedRef<vsd::Node>, touched, nullptr)  // σ: collision, pad against a part
   VSD_PROPERTY(vsd::SharedRef<vsd::Node>, holding, nullptr)
+  VSD_PROPERTY(bool, faulted, false)  // σ: its hardware adapters do not deliver (--hardware); it holds
 
  public:
   vsd::robotics::JointController* controller = nullptr;
@@ -198,6 +200,7 @@ class Robot : public vsd::Node {
   std::uint64_t step = 0;
   std::uint64_t commanded_in_step = 0;
   double moving_time = 0;
+  double grasped_at = 0;  // s: the last grasp
   bool paused = false;  // by the operator: the controller holds (mode Idle) until resumed
   std::map<std::array<long, 3>, std::vector<double>> solutions;  // goal in the base frame (µm) -> joints
 
@@ -223,8 +226,10 @@ class Robot : public vsd::Node {
     b->set_resting(false);
     b->slow_for = 0;
     b->set_stage(held);
+    b->slipped = false;
     if (conveyor->at_sensor().get() == b) conveyor->set_at_sensor(nullptr);
     if (station->part().get() == b) station->set_part(nullptr);
+    grasped_at = time();
     set_holding(part);
   }
   /// γ: opens the gripper: the part gets its rigid body back.
@@ -234,6 +239,15 @@ class Robot : public vsd::Node {
     if (log) *log << "t=" << Orders::fmt(time()) << " s  γ " << name() << ".release(" << b->name() << ")\n";
     view->release(*b);
     b->add_extension(b->state().create<vsd::physics::RigidBody>());
+    set_holding(nullptr);
+  }
+  /// A fault, not a command: the gripper loses its part, which gets its rigid body back and falls.
+  void slip() {
+    auto* b = dynamic_cast<Part*>(holding().get());
+    if (b == nullptr) return;
+    view->release(*b);
+    b->add_extension(b->state().create<vsd::physics::RigidBody>());
+    b->slipped = true;
     set_holding(nullptr);
   }
   std::string clock() const { return Orders::fmt(time()); }
@@ -407,6 +421,15 @@ CellReport run_cell(const CellOptions& o) {
   urdf_options.load_meshes = false;
   Robot* robots[2] = {nullptr, nullptr};
   std::vector<vsd::scene::Hull*> spheres[2];
+  // --hardware (hardware.hpp): each robot's joints bound to its adapters once it stands at its gate.
+  std::unique_ptr<CellHardware> hardware;
+  if (o.hardware.enabled) hardware = std::make_unique<CellHardware>(o.hardware);
+  for (const FaultSpec& f : o.faults)
+    if (f.kind == FaultSpec::Kind::ArmSilent && (!hardware || !o.hardware.arm[f.robot].empty()))
+      throw vsd::Error("--fault '" + f.spec + "': needs --hardware with the arm's simulator started here (not " +
+                       (f.robot == 0 ? "--arm-a" : "--arm-b") + ")");
+  FaultMonitor faults(o.faults);
+  faults.timeline = tl;
   const char* arm_links[] = {"iiwa_link_4", "iiwa_link_6"};  // elbow and wrist; the pad stands for the hand
   auto& pad_shape = kit.geometry(GeometryKind::Box, {0.04, 0.04, 0.01});
   auto& sphere_shape = kit.geometry(GeometryKind::Sphere, {}, arm_sphere);
@@ -441,6 +464,7 @@ CellReport run_cell(const CellOptions& o) {
     kit.hull(pad, "pad_" + tag, pad_shape, flange->world_frame() * at(0, 0, tool_length - 0.005), cell_node);
     view.relate(pad, *flange, vsd::scene::SpatialRelation::AttachedTo);
     robot.pad = &pad;
+    if (hardware) hardware->attach(i, *rep.scene, tree);
     spheres[i].push_back(&pad);
     for (const char* link : arm_links) {
       Node3D* l = rep.scene->find_link(link);
@@ -505,6 +529,8 @@ CellReport run_cell(const CellOptions& o) {
   bool in_zone[2] = {false, false};  // this step's zone sensor
   double next_arrival = 0.5;
   CellReport report;
+  bool zone_sensor_down = false;          // a fault: the zone's presence sensor delivers nothing
+  vsd::soml::Place* zone_free = nullptr;  // Multi Robot Control's zone.free (the fault monitor watches it)
 
   // --- The sensors, after control, physics and collision in each step: only changes reach the nets.
   env.scheduler().add_periodic(
@@ -569,6 +595,34 @@ CellReport run_cell(const CellOptions& o) {
           if (!r->controller->fault().empty())
             throw vsd::Error(r->name() + " controller: " + r->controller->fault());
         }
+        // The adapters' state (σ Robot.faulted) and the injected faults (faults.hpp): on and off by time,
+        // the cell's reaction seen through the views, the report lines written by the monitor.
+        if (hardware || !o.faults.empty()) {
+          FaultView views[2];
+          for (int i = 0; i < 2; ++i) {
+            Robot* r = robots[i];
+            views[i].name = r->name();
+            if (hardware) {
+              const auto& b = hardware->binding(i);
+              views[i].adapter_fault = b.fault();
+              views[i].delivering = b.status() == vsd::robotics::BindingStatus::Running;
+              const bool faulted = b.status() == vsd::robotics::BindingStatus::Fault;
+              if (faulted != r->faulted() && tl)
+                *tl << "t=" << Orders::fmt(now) << " s  σ " << r->name()
+                    << (faulted ? " faulted: " + b.fault() : std::string(" delivers again")) << '\n';
+              r->set_faulted(faulted);
+            }
+            if (auto* part = r->holding().get()) views[i].holding = part->name();
+            views[i].grasped_at = r->grasped_at;
+            const Eigen::Vector3d pad = r->pad->world_frame().translation();
+            for (int k = 0; k < 3; ++k) views[i].pad[k] = pad[k];
+          }
+          const FaultActions act = faults.step(now, views, zone_free != nullptr ? static_cast<int>(zone_free->count()) : 1);
+          for (int i = 0; i < 2; ++i)
+            if (hardware) hardware->silence(i, act.silent[i]);
+          zone_sensor_down = act.zone_sensor_down;
+          if (act.slip >= 0) robots[act.slip]->slip();
+        }
         // The zone: an arm is in it when one of its spheres touches the zone's box. Both at once is a
         // violation, counted from this geometry, whatever the nets' markings say.
         for (int i = 0; i < 2; ++i) {
@@ -577,7 +631,9 @@ CellReport run_cell(const CellOptions& o) {
             in_zone[i] =
                 in_zone[i] || sphere_in_box(h->world_frame().translation(), arm_sphere, zone_min, zone_max);
         }
-        const std::string by = in_zone[0] && in_zone[1] ? "robot_a and robot_b"
+        // A zone sensor that is down reads as occupied (fail-safe): no net lets a robot in.
+        const std::string by = zone_sensor_down            ? "unknown (the sensor is down)"
+                               : in_zone[0] && in_zone[1] ? "robot_a and robot_b"
                                : in_zone[0]             ? "robot_a"
                                : in_zone[1]             ? "robot_b"
                                                         : "";
@@ -649,14 +705,16 @@ CellReport run_cell(const CellOptions& o) {
               where = "the conveyor's sensor";
               p->set_stage(at_sensor);
               conveyor.set_at_sensor(vsd::SharedRef<vsd::Node>(p));
-              conveyor.set_last(vsd::SharedRef<vsd::Node>(p));
-              conveyor.set_arrivals(conveyor.arrivals() + 1);
-              ++report.parts_arrived;
+              if (!p->slipped) {  // a part that slipped back is no new arrival (its job goes on)
+                conveyor.set_last(vsd::SharedRef<vsd::Node>(p));
+                conveyor.set_arrivals(conveyor.arrivals() + 1);
+                ++report.parts_arrived;
+              }
             } else if ((xy - station_xy).norm() < 0.06) {
               where = "the station";
               p->set_stage(on_station);
               station.set_part(vsd::SharedRef<vsd::Node>(p));
-              ++report.handovers;
+              if (!p->slipped) ++report.handovers;
             } else if ((xy - (p->kind() == 1 ? dest_a_xy : dest_b_xy)).norm() < 0.06) {
               where = p->kind() == 1 ? "dest_a" : "dest_b";
               p->set_stage(on_destination);
@@ -688,6 +746,10 @@ CellReport run_cell(const CellOptions& o) {
   run.out = tl != nullptr ? tl : &discard;
   vsd::soml::Program& mrc = soml.load(s, o.robot_script, read_text(o.robot_script), run);
   vsd::soml::Program& meta = soml.load(s, o.meta_script, read_text(o.meta_script), run);
+  if (vsd::Node* z = mrc.object("zone"))
+    z->visit([&](vsd::Node& c) {
+      if (auto* pl = dynamic_cast<vsd::soml::Place*>(&c); pl != nullptr && pl->name() == "free") zone_free = pl;
+    });
   for (vsd::soml::Program* p : {&mrc, &meta}) {
     if (tl == nullptr) continue;
     // "token: multi_robot_control a.fetch: a.idle -1, a.approaching +1": net, transition, black tokens moved
@@ -765,7 +827,8 @@ CellReport run_cell(const CellOptions& o) {
         (belt.empty() || belt.back()->belt_y > belt_start + belt_gap);
     // A robot the operator paused is waiting for the operator, not deadlocked.
     const bool moving = report.parts_handled == parts_wanted() || belt_moves || more_to_come ||
-                        robots[0]->paused || robots[1]->paused ||
+                        robots[0]->paused || robots[1]->paused || robots[0]->faulted() ||
+                        robots[1]->faulted() || zone_sensor_down ||
                         !robots[0]->controller->done() || !robots[1]->controller->done() ||
                         std::any_of(placed.begin(), placed.end(),
                                     [](Part* p) { return !p->resting() || p->stage() == on_destination; });
@@ -808,6 +871,10 @@ CellReport run_cell(const CellOptions& o) {
     });
   }
   report.final_marking = marking;
+  faults.finish(env.time());
+  report.faults = faults.records();
+  report.fault_lines = faults.lines();
+  for (int i = 0; hardware && i < 2; ++i) report.hardware.push_back(robots[i]->name() + ": " + hardware->summary(i));
   completed = true;
   return report;
 }
@@ -855,6 +922,13 @@ void print_summary(std::ostream& out, const CellReport& r) {
   out << "final marking (multi robot control): " << r.final_marking << '\n';
   for (const std::string& e : r.condition_errors) out << "condition error: " << e << '\n';
   put("step time: p50 %.3f ms, p99 %.3f ms (wall, both robots and both nets)", 1e3 * r.step_p50, 1e3 * r.step_p99);
+  for (const std::string& h : r.hardware) out << "hardware " << h << '\n';
+  if (!r.faults.empty()) {
+    int recovered = 0;
+    for (const FaultRecord& f : r.faults) recovered += f.recovered >= 0 ? 1 : 0;
+    put("faults injected: %d, recovered: %d", static_cast<int>(r.faults.size()), recovered);
+    for (const std::string& l : r.fault_lines) out << l << '\n';
+  }
   if (r.timed_out) out << "stopped: time limit reached\n";
   if (r.interrupted) out << "stopped: interrupted\n";
 }
@@ -898,6 +972,7 @@ void parse_options(const std::vector<std::string>& args, CellOptions& o) {
   };
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
+    if (take_hardware_option(args, i, o.hardware)) continue;
     if (a == "--seed")
       o.seed = static_cast<std::uint64_t>(whole(i, 0, 1e15));
     else if (a == "--parts")
@@ -916,10 +991,15 @@ void parse_options(const std::vector<std::string>& args, CellOptions& o) {
       o.meta_script = value(i);
     else if (a == "--robots")
       o.robot_script = value(i);
+    else if (a == "--fault")
+      o.faults.push_back(parse_fault(value(i)));
     else
       throw vsd::Error("unknown option '" + a + "'");
   }
   if (o.physics_step > o.step) throw vsd::Error("--physics-step must not exceed --step");
+  for (const std::string& e : {o.hardware.arm[0], o.hardware.arm[1], o.hardware.simulator})
+    if (!e.empty() && !o.hardware.enabled)
+      throw vsd::Error("--arm-a, --arm-b and --simulator go with --hardware");
 }
 
 }  // namespace vsd_workcell
