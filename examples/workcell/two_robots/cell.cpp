@@ -667,9 +667,10 @@ CellReport run_cell(const CellOptions& o) {
             *tl << "t=" << Orders::fmt(now) << " s  conveyor: " << p.name() << " (kind " << kind
                 << ") comes in\n";
         }
-        const bool spot_free =
-            !conveyor.at_sensor() &&
-            std::none_of(placed.begin(), placed.end(), [&](Part* p) { return p->stage() == on_belt; });
+        // The stop is free when no part lies there (one that slipped from a gripper back onto it included).
+        const bool spot_free = !conveyor.at_sensor() && std::none_of(placed.begin(), placed.end(), [&](Part* p) {
+          return p->stage() == on_belt || (p->slipped && (p->world_frame().translation().head<2>() - pick_xy).norm() < 0.1);
+        });
         for (std::size_t k = 0; k < belt.size(); ++k) {
           const double limit =
               k == 0 ? (spot_free ? pick_xy.y() : pick_xy.y() - belt_gap) : belt[k - 1]->belt_y - belt_gap;
@@ -719,7 +720,8 @@ CellReport run_cell(const CellOptions& o) {
               where = p->kind() == 1 ? "dest_a" : "dest_b";
               p->set_stage(on_destination);
             } else {
-              throw vsd::Error(p->name() + " came to rest at a wrong place at t=" + Orders::fmt(now));
+              throw vsd::Error(p->name() + " came to rest at a wrong place (" + Orders::fmt(xy.x()) + ", " +
+                               Orders::fmt(xy.y()) + ") at t=" + Orders::fmt(now));
             }
             if (tl) *tl << "t=" << Orders::fmt(now) << " s  σ " << p->name() << " rests on " << where << '\n';
           } else if (!rest) {

@@ -39,11 +39,12 @@ FaultSpec parse_fault(const std::string& spec) {
   f.spec = spec;
   const auto at = spec.find('@');
   if (at == std::string::npos)
-    throw vsd::Error("--fault '" + spec + "': no '@' (KIND@T+D or slip@partN)");
+    throw vsd::Error("--fault '" + spec + "': no '@' (KIND@T+D, or slip@partN)");
   const std::string kind = spec.substr(0, at);
   const std::string when = spec.substr(at + 1);
-  if (kind == "slip") {
+  if (kind == "slip" || kind == "slip_a" || kind == "slip_b") {
     f.kind = FaultSpec::Kind::Slip;
+    f.robot = kind == "slip" ? -1 : kind == "slip_a" ? 0 : 1;
     const bool ok = when.size() > 4 && when.rfind("part", 0) == 0 &&
                     when.find_first_not_of("0123456789", 4) == std::string::npos && when[4] != '0' &&
                     when.size() <= 13;
@@ -58,7 +59,7 @@ FaultSpec parse_fault(const std::string& spec) {
     f.kind = FaultSpec::Kind::ZoneSensorDrop;
   } else {
     throw vsd::Error("--fault '" + spec + "': unknown fault '" + kind +
-                     "' (arm_a_silent, arm_b_silent, zone_sensor_drop or slip)");
+                     "' (arm_a_silent, arm_b_silent, zone_sensor_drop, slip, slip_a or slip_b)");
   }
   const auto plus = when.find('+');
   if (plus == std::string::npos)
@@ -146,7 +147,7 @@ FaultActions FaultMonitor::step(double t, const FaultView (&robots)[2], int zone
       case FaultSpec::Kind::Slip: {
         if (rec.began < 0) {
           for (int r = 0; r < 2; ++r)
-            if (robots[r].holding == f.part && t - robots[r].grasped_at >= slip_after - 1e-9 && act.slip < 0) {
+            if ((f.robot < 0 || f.robot == r) && robots[r].holding == f.part && t - robots[r].grasped_at >= slip_after - 1e-9 && act.slip < 0) {
               act.slip = r;
               robot_[i] = r;
               rec.began = rec.detected = t;

@@ -4,7 +4,12 @@
 //   arm_a_silent@T+D      robot_a's arm stops answering on the UDP FRI-like link from simulated time T for
 //   arm_b_silent@T+D      D seconds (its vsd_robot_simulator process is stopped; needs --hardware)
 //   zone_sensor_drop@T+D  the shared zone's presence sensor delivers nothing from T for D seconds
-//   slip@partN            partN slips from the gripper of the robot that grasps it first, 0.15 s into the lift
+//   slip@partN            partN slips from the gripper of the robot that grasps it first, as the lift begins
+//   slip_a@partN          ... of robot_a (A's first grasp of it)
+//   slip_b@partN          ... of robot_b (B's first grasp of it: a hand-over part, on the station)
+//
+// A slipped part falls back onto where it was picked from (the conveyor's stop, the station) and the
+// robot's net picks it again (the `slipped` transitions of multi_robot_control.soml).
 //
 // T and D are decimal numbers of seconds with an optional `s` ("12", "12s", "0.5s"); D must be positive.
 #pragma once
@@ -19,7 +24,7 @@ namespace vsd_workcell {
 struct FaultSpec {
   enum class Kind { ArmSilent, ZoneSensorDrop, Slip };
   Kind kind = Kind::ArmSilent;
-  int robot = 0;          ///< ArmSilent: 0 robot_a, 1 robot_b
+  int robot = 0;          ///< ArmSilent, Slip: 0 robot_a, 1 robot_b (Slip: -1 whichever grasps the part first)
   double at = 0;          ///< s of simulated time (ArmSilent, ZoneSensorDrop)
   double duration = 0;    ///< s (ArmSilent, ZoneSensorDrop)
   std::string part;       ///< Slip: the part's name ("part7")
@@ -65,7 +70,7 @@ class FaultMonitor {
  public:
   explicit FaultMonitor(std::vector<FaultSpec> specs);
   /// How long into the lift a part slips (s after its grasp).
-  static constexpr double slip_after = 0.15;
+  static constexpr double slip_after = 0.05;
   /// One step at simulated time @p t; @p zone_free: tokens on Multi Robot Control's zone.free.
   FaultActions step(double t, const FaultView (&robots)[2], int zone_free);
   [[nodiscard]] const std::vector<FaultSpec>& specs() const noexcept { return specs_; }
