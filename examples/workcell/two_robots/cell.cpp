@@ -424,10 +424,7 @@ CellReport run_cell(const CellOptions& o) {
   // --hardware (hardware.hpp): each robot's joints bound to its adapters once it stands at its gate.
   std::unique_ptr<CellHardware> hardware;
   if (o.hardware.enabled) hardware = std::make_unique<CellHardware>(o.hardware);
-  for (const FaultSpec& f : o.faults)
-    if (f.kind == FaultSpec::Kind::ArmSilent && (!hardware || !o.hardware.arm[f.robot].empty()))
-      throw vsd::Error("--fault '" + f.spec + "': needs --hardware with the arm's simulator started here (not " +
-                       (f.robot == 0 ? "--arm-a" : "--arm-b") + ")");
+  check_faults(o.faults, o.hardware);
   FaultMonitor faults(o.faults);
   faults.timeline = tl;
   const char* arm_links[] = {"iiwa_link_4", "iiwa_link_6"};  // elbow and wrist; the pad stands for the hand
@@ -1002,6 +999,7 @@ void parse_options(const std::vector<std::string>& args, CellOptions& o) {
   for (const std::string& e : {o.hardware.arm[0], o.hardware.arm[1], o.hardware.simulator})
     if (!e.empty() && !o.hardware.enabled)
       throw vsd::Error("--arm-a, --arm-b and --simulator go with --hardware");
+  check_faults(o.faults, o.hardware);
 }
 
 }  // namespace vsd_workcell

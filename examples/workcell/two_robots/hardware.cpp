@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "faults.hpp"
 #include "simulator_process.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/robotics.hpp"
@@ -49,6 +50,13 @@ bool take_hardware_option(const std::vector<std::string>& args, std::size_t& i, 
     return false;
   }
   return true;
+}
+
+void check_faults(const std::vector<FaultSpec>& faults, const HardwareOptions& o) {
+  for (const FaultSpec& f : faults)
+    if (f.kind == FaultSpec::Kind::ArmSilent && (!o.enabled || !o.arm[f.robot].empty()))
+      throw vsd::Error("--fault '" + f.spec + "': needs --hardware with the arm's simulator started here (not " +
+                       (f.robot == 0 ? "--arm-a" : "--arm-b") + ")");
 }
 
 CellHardware::CellHardware(HardwareOptions options) : options_(std::move(options)) {

@@ -20,6 +20,8 @@ class KinematicTree;
 
 namespace vsd_workcell {
 
+struct FaultSpec;
+
 /// The `--hardware` options of the cell.
 struct HardwareOptions {
   bool enabled = false;         ///< --hardware: the arms over UDP, the linear axes over the fieldbus
@@ -31,6 +33,10 @@ struct HardwareOptions {
 /// Takes the hardware option at @p args[@p i] (and its value: @p i moves on); false when it is none.
 /// @throws vsd::Error for a missing or malformed value.
 bool take_hardware_option(const std::vector<std::string>& args, std::size_t& i, HardwareOptions& o);
+
+/// @throws vsd::Error when a fault of @p faults needs what @p o does not give: an arm's silence needs
+/// --hardware with that arm's simulator started here (not --arm-a/--arm-b: a process this run can stop).
+void check_faults(const std::vector<FaultSpec>& faults, const HardwareOptions& o);
 
 /// The adapters of both robots: starts the simulator processes (unless an endpoint was given) and binds
 /// each robot's joints to them. Stops the processes it started when it goes.
