@@ -96,12 +96,6 @@ FaultActions FaultMonitor::step(double t, const FaultView (&robots)[2], int zone
     const FaultSpec& f = specs_[i];
     FaultRecord& rec = records_[i];
     const bool on = f.active(t);
-    // While a fault is on and not yet recovered, how far the robots' pads went.
-    const int affected = f.kind == FaultSpec::Kind::ArmSilent ? f.robot : robot_[i];
-    if (affected >= 0 && rec.began >= 0 && rec.recovered < 0) {
-      rec.affected_motion += moved[affected];
-      rec.other_motion += moved[1 - affected];
-    }
     switch (f.kind) {
       case FaultSpec::Kind::ArmSilent: {
         const FaultView& v = robots[f.robot];
@@ -160,6 +154,12 @@ FaultActions FaultMonitor::step(double t, const FaultView (&robots)[2], int zone
         }
         break;
       }
+    }
+    // From the step the cell saw the fault until the step before it recovered: how far the pads went.
+    const int affected = f.kind == FaultSpec::Kind::ArmSilent ? f.robot : robot_[i];
+    if (affected >= 0 && rec.detected >= 0 && rec.recovered < 0) {
+      rec.affected_motion += moved[affected];
+      rec.other_motion += moved[1 - affected];
     }
   }
   return act;

@@ -42,8 +42,10 @@ struct FaultRecord {
   double began = -1;      ///< s: injected (the slip: the part left the gripper); -1: never happened
   double detected = -1;   ///< s: the cell saw it (the arm's binding in Fault, the sensor down, the gripper empty)
   double recovered = -1;  ///< s: the cell resumed (the binding Running again, the sensor back, the part re-grasped)
-  double affected_motion = 0;  ///< m the affected robot's pad moved while detected and not recovered
-  double other_motion = 0;     ///< m the other robot's pad moved meanwhile (it goes on where it can)
+  /// m the affected robot's pad moved from the step the cell saw the fault to the step before it recovered
+  /// (an arm's silence: while its binding held; the step of the recovery is left out — see docs/workcell.md)
+  double affected_motion = 0;
+  double other_motion = 0;  ///< m the other robot's pad moved meanwhile (it goes on where it can)
   int zone_entries = 0;        ///< zone_sensor_drop: times a net took the zone while the sensor was down
 };
 
