@@ -103,9 +103,9 @@ TEST(CellHardware, OptionsAndTheirErrors) {
 
 // An arm that stops answering: that robot holds (its pad does not move), the report says what and when,
 // the other robot goes on, and the cell resumes when the arm answers again.
-class ArmSilent : public testing::TestWithParam<int> {};
+class CellArmSilent : public testing::TestWithParam<int> {};
 
-TEST_P(ArmSilent, HoldsIsReportedAndResumes) {
+TEST_P(CellArmSilent, HoldsIsReportedAndResumes) {
   const int robot = GetParam();
   const std::string spec = std::string(robot == 0 ? "arm_a_silent" : "arm_b_silent") + "@10s+2s";
   auto o = hardware_options(3);
@@ -137,7 +137,7 @@ TEST_P(ArmSilent, HoldsIsReportedAndResumes) {
   EXPECT_NE(r.hardware[robot].find("faults 1, recoveries 1; fieldbus axis"), std::string::npos) << r.hardware[robot];
 }
 
-INSTANTIATE_TEST_SUITE_P(Robots, ArmSilent, testing::Values(0, 1));
+INSTANTIATE_TEST_SUITE_P(EachArm, CellArmSilent, testing::Values(0, 1));
 
 TEST(CellHardware, TheOtherRobotGoesOnWhileBIsSilent) {
   // B silent from 10 s to 14 s: A goes on fetching and placing parts meanwhile (its pad moves).
