@@ -473,6 +473,7 @@ CellReport run_cell(const CellOptions& o) {
     }
     robots[i] = &robot;
   }
+  if (hardware) hardware->connect(o.step);  // both robots Running before the first step
   // Who reaches what (the reason for the hand-over): checked by IK, not assumed.
   for (int i = 0; i < 2; ++i) {
     std::string line;

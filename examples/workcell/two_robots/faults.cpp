@@ -92,6 +92,8 @@ FaultActions FaultMonitor::step(double t, const FaultView (&robots)[2], int zone
   have_pad_ = true;
   const bool zone_taken = zone_free_before_ > 0 && zone_free == 0;
   zone_free_before_ = zone_free;
+  const double last_t = last_t_;  // the last step's time (-1 before the first)
+  last_t_ = t;
   for (std::size_t i = 0; i < specs_.size(); ++i) {
     const FaultSpec& f = specs_[i];
     FaultRecord& rec = records_[i];
@@ -127,7 +129,8 @@ FaultActions FaultMonitor::step(double t, const FaultView (&robots)[2], int zone
           note(i, t, "the shared zone's presence sensor drops out: it reads as occupied (fail-safe), so no "
                      "robot enters the zone; a robot in it finishes and leaves");
         }
-        if (on && zone_taken) {
+        // zone.free as seen now was taken by a firing of the last step, which read the sensor of the last step.
+        if (zone_taken && last_t >= 0 && f.active(last_t)) {
           ++rec.zone_entries;
           note(i, t, "a robot took the zone while its sensor was down");
         }

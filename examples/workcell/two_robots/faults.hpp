@@ -94,6 +94,7 @@ class FaultMonitor {
   double last_pad_[2][3] = {};
   bool have_pad_ = false;
   int zone_free_before_ = -1;
+  double last_t_ = -1;  // the time of the last step()
 };
 
 }  // namespace vsd_workcell

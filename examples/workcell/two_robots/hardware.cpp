@@ -2,11 +2,12 @@
 #include "hardware.hpp"
 
 #include <signal.h>
-#include <unistd.h>
 
-#include <cmath>
+#include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <sstream>
+#include <utility>
 
 #include "faults.hpp"
 #include "simulator_process.hpp"
@@ -38,6 +39,10 @@ bool take_hardware_option(const std::vector<std::string>& args, std::size_t& i, 
         port.find_first_not_of("0123456789") != std::string::npos || port.size() > 5 || std::stoi(port) < 1 ||
         std::stoi(port) > 65535)
       throw vsd::Error(a + ": '" + v + "' is not HOST:PORT (a loopback address and a port 1 to 65535)");
+    const std::string host = v.substr(0, colon);
+    if (host != "localhost" && host.rfind("127.", 0) != 0)
+      throw vsd::Error(a + ": '" + host + "' is not a loopback address (127.x.y.z or localhost): the UDP adapter "
+                       "talks to robots on this machine only");
     o.arm[a == "--arm-a" ? 0 : 1] = v;
   } else if (a == "--hardware-timeout") {
     const std::string& v = value();
@@ -68,10 +73,7 @@ CellHardware::CellHardware(HardwareOptions options) : options_(std::move(options
   }
 }
 
-CellHardware::~CellHardware() {
-  for (int i = 0; i < 2; ++i)
-    if (silent_[i]) silence(i, false);  // a stopped process cannot be reaped by SIGKILL alone on every system
-}
+CellHardware::~CellHardware() = default;  // kills the simulators it started (SIGKILL ends a stopped one too)
 
 std::string CellHardware::summary(int i) const {
   std::string out;
@@ -83,6 +85,24 @@ std::string CellHardware::summary(int i) const {
            std::to_string(st.faults) + ", recoveries " + std::to_string(st.recoveries);
   }
   return out;
+}
+
+void CellHardware::connect(double dt) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(options_.connect_timeout);
+  for (;;) {
+    bool running = true;
+    for (vsd::robotics::HardwareBinding* b : bindings_) {
+      b->cycle(dt);
+      running = running && b->status() == vsd::robotics::BindingStatus::Running;
+    }
+    if (running) return;
+    if (std::chrono::steady_clock::now() > end)
+      for (int i = 0; i < 2; ++i)
+        if (bindings_[i]->status() != vsd::robotics::BindingStatus::Running)
+          throw vsd::Error("--hardware: robot_" + std::string(i == 0 ? "a" : "b") + "'s adapters do not deliver (" +
+                           (bindings_[i]->fault().empty() ? std::string("still connecting") : bindings_[i]->fault()) +
+                           ")");
+  }
 }
 
 bool CellHardware::started(int i) const { return processes_[i] != nullptr; }

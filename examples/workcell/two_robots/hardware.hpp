@@ -28,6 +28,7 @@ struct HardwareOptions {
   std::string simulator;        ///< --simulator PATH: vsd_robot_simulator (default: next to the program)
   std::string arm[2];           ///< --arm-a / --arm-b HOST:PORT: a simulator already running, not started here
   double timeout = 0.02;        ///< --hardware-timeout S: how long one cycle waits for the arm's answer
+  double connect_timeout = 2.0; ///< s of wall time the adapters may take to deliver before the first step
 };
 
 /// Takes the hardware option at @p args[@p i] (and its value: @p i moves on); false when it is none.
@@ -51,6 +52,11 @@ class CellHardware {
   /// simulated arm starts): a HardwareBinding next to the tree, arm joints on udp://, rail on fieldbus://.
   /// @throws vsd::Error when the simulator cannot be started.
   vsd::robotics::HardwareBinding& attach(int i, vsd::Node& arm, vsd::robotics::KinematicTree& tree);
+  /// Cycles both bindings (holding the robots where they stand) until every adapter delivers, so that
+  /// the run starts with both robots Running at the posture they report.
+  /// @throws vsd::Error naming the robot and its binding's fault when that takes longer than
+  /// HardwareOptions::connect_timeout.
+  void connect(double dt);
   /// The binding of robot @p i (after attach).
   [[nodiscard]] vsd::robotics::HardwareBinding& binding(int i) const { return *bindings_[i]; }
   /// "udp://127.0.0.1:PORT?...;fieldbus://?..." of robot @p i.

@@ -64,6 +64,21 @@ TEST(CellHardware, EndpointsOfRunningSimulators) {
   ASSERT_EQ(r.hardware.size(), 2u);
   EXPECT_NE(r.hardware[0].find("udp 127.0.0.1:" + std::to_string(arm.port()) + ":"), std::string::npos)
       << r.hardware[0];
+  // An endpoint where nothing answers: a clear error before the first step, not a cell that waits.
+  auto dead = hardware_options(1);
+  dead.hardware.connect_timeout = 0.3;
+  {
+    vsd_example::SimulatorProcess gone(VSD_ROBOT_SIMULATOR, {"--port", "0"});
+    dead.hardware.arm[1] = "127.0.0.1:" + std::to_string(gone.port());
+  }  // killed: its port answers no more
+  try {
+    vsd_workcell::run_cell(dead);
+    ADD_FAILURE() << "no error";
+  } catch (const vsd::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--hardware: robot_b's adapters do not deliver (udp 127.0.0.1:"),
+              std::string::npos)
+        << e.what();
+  }
   // Its silence cannot be injected: this run does not own the process.
   o.faults.push_back(vsd_workcell::parse_fault("arm_a_silent@1+1"));
   EXPECT_THROW(vsd_workcell::run_cell(o), vsd::Error);
@@ -89,6 +104,9 @@ TEST(CellHardware, OptionsAndTheirErrors) {
   EXPECT_EQ(error({"--hardware", "--arm-a", "127.0.0.1:70000"}),
             "--arm-a: '127.0.0.1:70000' is not HOST:PORT (a loopback address and a port 1 to 65535)");
   EXPECT_EQ(error({"--arm-a", "127.0.0.1:4000"}), "--arm-a, --arm-b and --simulator go with --hardware");
+  EXPECT_EQ(error({"--hardware", "--arm-b", "10.0.0.7:4000"}),
+            "--arm-b: '10.0.0.7' is not a loopback address (127.x.y.z or localhost): the UDP adapter talks to "
+            "robots on this machine only");
   EXPECT_EQ(error({"--hardware-timeout", "2"}), "--hardware-timeout: '2' is not a number in [0.001, 1] (seconds)");
   auto bad = hardware_options(1);
   bad.hardware.simulator = "/nonexistent/vsd_robot_simulator";
