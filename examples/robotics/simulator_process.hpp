@@ -59,6 +59,10 @@ class SimulatorProcess {
 
   [[nodiscard]] std::uint16_t port() const noexcept { return port_; }
   [[nodiscard]] bool running() const noexcept { return pid_ > 0; }
+  /// Sends @p sig (SIGSTOP: the robot stops answering without going away; SIGCONT: it answers again).
+  void signal(int sig) const noexcept {
+    if (pid_ > 0) ::kill(pid_, sig);
+  }
   /// Kills the process (SIGKILL: a crash, no goodbye) and reaps it.
   void kill() noexcept {
     if (pid_ <= 0) return;

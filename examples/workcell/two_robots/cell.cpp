@@ -100,6 +100,7 @@ class Part : public vsd::scene::Hull {
   double slow_for = 0;     // s below rest_speed
   double resting_for = 0;  // s resting on a destination
   bool handed_over = false;  // it rested on the station
+  bool slipped = false;    // slipped from a gripper (a fault): resting again is no new arrival or hand-over
 };
 
 /// The order board between Meta Control (posts) and Multi Robot Control (takes).
@@ -194,6 +195,7 @@ class Robot : public vsd::Node {
   VSD_PROPERTY(bool, arrived, true)                          // σ
   VSD_PROPERTY(vsd::SharedRef<vsd::Node>, touched, nullptr)  // σ: collision, pad against a part
   VSD_PROPERTY(vsd::SharedRef<vsd::Node>, holding, nullptr)
+  VSD_PROPERTY(bool, faulted, false)  // σ: its hardware adapters do not deliver (--hardware); it holds
 
  public:
   vsd::robotics::JointController* controller = nullptr;
@@ -207,6 +209,7 @@ class Robot : public vsd::Node {
   std::uint64_t step = 0;
   std::uint64_t commanded_in_step = 0;
   double moving_time = 0;
+  double grasped_at = 0;  // s: the last grasp
   bool paused = false;  // by the operator: the controller holds (mode Idle) until resumed
   std::map<std::array<long, 3>, std::vector<double>> solutions;  // goal in the base frame (µm) -> joints
 
@@ -232,9 +235,11 @@ class Robot : public vsd::Node {
     b->set_resting(false);
     b->slow_for = 0;
     b->set_stage(held);
+    b->slipped = false;
     for (Conveyor* c : conveyors)
       if (c->at_sensor().get() == b) c->set_at_sensor(nullptr);
     if (station->part().get() == b) station->set_part(nullptr);
+    grasped_at = time();
     set_holding(part);
   }
   /// γ: opens the gripper: the part gets its rigid body back.
@@ -244,6 +249,15 @@ class Robot : public vsd::Node {
     if (log) *log << "t=" << Orders::fmt(time()) << " s  γ " << name() << ".release(" << b->name() << ")\n";
     view->release(*b);
     b->add_extension(b->state().create<vsd::physics::RigidBody>());
+    set_holding(nullptr);
+  }
+  /// A fault, not a command: the gripper loses its part, which gets its rigid body back and falls.
+  void slip() {
+    auto* b = dynamic_cast<Part*>(holding().get());
+    if (b == nullptr) return;
+    view->release(*b);
+    b->add_extension(b->state().create<vsd::physics::RigidBody>());
+    b->slipped = true;
     set_holding(nullptr);
   }
   std::string clock() const { return Orders::fmt(time()); }
@@ -458,6 +472,12 @@ CellReport run_cell(const CellOptions& o) {
   urdf_options.load_meshes = false;
   Robot* robots[2] = {nullptr, nullptr};
   std::vector<vsd::scene::Hull*> spheres[2];
+  // --hardware (hardware.hpp): each robot's joints bound to its adapters once it stands at its gate.
+  std::unique_ptr<CellHardware> hardware;
+  if (o.hardware.enabled) hardware = std::make_unique<CellHardware>(o.hardware);
+  check_faults(o.faults, o.hardware);
+  FaultMonitor faults(o.faults);
+  faults.timeline = tl;
   const char* arm_links[] = {"iiwa_link_4", "iiwa_link_6"};  // elbow and wrist; the pad stands for the hand
   auto& pad_shape = kit.geometry(GeometryKind::Box, {0.04, 0.04, 0.01});
   auto& sphere_shape = kit.geometry(GeometryKind::Sphere, {}, arm_sphere);
@@ -493,6 +513,7 @@ CellReport run_cell(const CellOptions& o) {
     kit.hull(pad, "pad_" + tag, pad_shape, flange->world_frame() * at(0, 0, tool_length - 0.005), cell_node);
     view.relate(pad, *flange, vsd::scene::SpatialRelation::AttachedTo);
     robot.pad = &pad;
+    if (hardware) hardware->attach(i, *rep.scene, tree);
     spheres[i].push_back(&pad);
     for (const char* link : arm_links) {
       Node3D* l = rep.scene->find_link(link);
@@ -504,6 +525,7 @@ CellReport run_cell(const CellOptions& o) {
     }
     robots[i] = &robot;
   }
+  if (hardware) hardware->connect(o.step);  // both robots Running before the first step
   // Who reaches what (the reason for the hand-over): checked by IK, not assumed.
   for (int i = 0; i < 2; ++i) {
     std::string line;
@@ -618,6 +640,8 @@ CellReport run_cell(const CellOptions& o) {
   double next_arrival = 0.5;
   CellReport report;
   int handled_by_route[3] = {0, 0, 0};  // routes 1, 2 (hand-over) and 3
+  bool zone_sensor_down = false;          // a fault: the zone's presence sensor delivers nothing
+  vsd::soml::Place* zone_free = nullptr;  // Multi Robot Control's zone.free (the fault monitor watches it)
 
   // --- The sensors, after control, physics and collision in each step: only changes reach the nets.
   env.scheduler().add_periodic(
@@ -683,6 +707,34 @@ CellReport run_cell(const CellOptions& o) {
           if (!r->controller->fault().empty())
             throw vsd::Error(r->name() + " controller: " + r->controller->fault());
         }
+        // The adapters' state (σ Robot.faulted) and the injected faults (faults.hpp): on and off by time,
+        // the cell's reaction seen through the views, the report lines written by the monitor.
+        if (hardware || !o.faults.empty()) {
+          FaultView views[2];
+          for (int i = 0; i < 2; ++i) {
+            Robot* r = robots[i];
+            views[i].name = r->name();
+            if (hardware) {
+              const auto& b = hardware->binding(i);
+              views[i].adapter_fault = b.fault();
+              views[i].delivering = b.status() == vsd::robotics::BindingStatus::Running;
+              const bool faulted = b.status() == vsd::robotics::BindingStatus::Fault;
+              if (faulted != r->faulted() && tl)
+                *tl << "t=" << Orders::fmt(now) << " s  σ " << r->name()
+                    << (faulted ? " faulted: " + b.fault() : std::string(" delivers again")) << '\n';
+              r->set_faulted(faulted);
+            }
+            if (auto* part = r->holding().get()) views[i].holding = part->name();
+            views[i].grasped_at = r->grasped_at;
+            const Eigen::Vector3d pad = r->pad->world_frame().translation();
+            for (int k = 0; k < 3; ++k) views[i].pad[k] = pad[k];
+          }
+          const FaultActions act = faults.step(now, views, zone_free != nullptr ? static_cast<int>(zone_free->count()) : 1);
+          for (int i = 0; i < 2; ++i)
+            if (hardware) hardware->silence(i, act.silent[i]);
+          zone_sensor_down = act.zone_sensor_down;
+          if (act.slip >= 0) robots[act.slip]->slip();
+        }
         // The zone: an arm is in it when one of its spheres touches the zone's box. Both at once is a
         // violation, counted from this geometry, whatever the nets' markings say.
         for (int i = 0; i < 2; ++i) {
@@ -691,7 +743,9 @@ CellReport run_cell(const CellOptions& o) {
             in_zone[i] =
                 in_zone[i] || sphere_in_box(h->world_frame().translation(), arm_sphere, zone_min, zone_max);
         }
-        const std::string by = in_zone[0] && in_zone[1] ? "robot_a and robot_b"
+        // A zone sensor that is down reads as occupied (fail-safe): no net lets a robot in.
+        const std::string by = zone_sensor_down            ? "unknown (the sensor is down)"
+                               : in_zone[0] && in_zone[1] ? "robot_a and robot_b"
                                : in_zone[0]             ? "robot_a"
                                : in_zone[1]             ? "robot_b"
                                                         : "";
@@ -736,8 +790,10 @@ CellReport run_cell(const CellOptions& o) {
                 << ") comes in\n";
         }
         for (Lane& l : lanes) {
+          // The stop is free when no part lies there (one that slipped from a gripper back onto it included).
           const auto at_stop = [&](Part* p) {
-            return p->stage() == on_belt && (p->world_frame().translation().head<2>() - l.pick).norm() < 0.05;
+            const double d = (p->world_frame().translation().head<2>() - l.pick).norm();
+            return (p->stage() == on_belt && d < 0.05) || (p->slipped && d < 0.1);
           };
           const bool spot_free = !l.stop->at_sensor() && std::none_of(placed.begin(), placed.end(), at_stop);
           for (std::size_t k = 0; k < l.belt.size(); ++k) {
@@ -783,20 +839,23 @@ CellReport run_cell(const CellOptions& o) {
               where = lane == &lanes[0] ? "the conveyor's sensor" : "the conveyor's sensor on lane B";
               p->set_stage(at_sensor);
               lane->stop->set_at_sensor(vsd::SharedRef<vsd::Node>(p));
-              lane->stop->set_last(vsd::SharedRef<vsd::Node>(p));
-              lane->stop->set_arrivals(lane->stop->arrivals() + 1);
-              ++report.parts_arrived;
+              if (!p->slipped) {  // a part that slipped back is no new arrival (its job goes on)
+                lane->stop->set_last(vsd::SharedRef<vsd::Node>(p));
+                lane->stop->set_arrivals(lane->stop->arrivals() + 1);
+                ++report.parts_arrived;
+              }
             } else if ((xy - station_xy).norm() < 0.06) {
               where = "the station";
               p->set_stage(on_station);
               p->handed_over = true;
               station.set_part(vsd::SharedRef<vsd::Node>(p));
-              ++report.handovers;
+              if (!p->slipped) ++report.handovers;
             } else if ((xy - (p->kind() == 1 ? dest_a_xy : dest_b_xy)).norm() < 0.06) {
               where = p->kind() == 1 ? "dest_a" : "dest_b";
               p->set_stage(on_destination);
             } else {
-              throw vsd::Error(p->name() + " came to rest at a wrong place at t=" + Orders::fmt(now));
+              throw vsd::Error(p->name() + " came to rest at a wrong place (" + Orders::fmt(xy.x()) + ", " +
+                               Orders::fmt(xy.y()) + ") at t=" + Orders::fmt(now));
             }
             if (tl) *tl << "t=" << Orders::fmt(now) << " s  σ " << p->name() << " rests on " << where << '\n';
           } else if (!rest) {
@@ -824,6 +883,10 @@ CellReport run_cell(const CellOptions& o) {
   run.out = tl != nullptr ? tl : &discard;
   vsd::soml::Program& mrc = soml.load(s, o.robot_script, read_text(o.robot_script), run);
   vsd::soml::Program& meta = soml.load(s, o.meta_script, read_text(o.meta_script), run);
+  if (vsd::Node* z = mrc.object("zone"))
+    z->visit([&](vsd::Node& c) {
+      if (auto* pl = dynamic_cast<vsd::soml::Place*>(&c); pl != nullptr && pl->name() == "free") zone_free = pl;
+    });
   for (vsd::soml::Program* p : {&mrc, &meta}) {
     if (tl == nullptr) continue;
     // "token: multi_robot_control a.fetch: a.idle -1, a.approaching +1": net, transition, black tokens moved
@@ -914,7 +977,8 @@ CellReport run_cell(const CellOptions& o) {
         (random_spawned < o.parts || !injected.empty()) && at_infeed == nullptr;
     // A robot the operator paused is waiting for the operator, not deadlocked.
     const bool moving = report.parts_handled == parts_wanted() || belt_moves || more_to_come ||
-                        robots[0]->paused || robots[1]->paused ||
+                        robots[0]->paused || robots[1]->paused || robots[0]->faulted() ||
+                        robots[1]->faulted() || zone_sensor_down ||
                         !robots[0]->controller->done() || !robots[1]->controller->done() ||
                         std::any_of(placed.begin(), placed.end(),
                                     [](Part* p) { return !p->resting() || p->stage() == on_destination; });
@@ -972,6 +1036,10 @@ CellReport run_cell(const CellOptions& o) {
       report.png_error = e.what();  // the run's figures are not lost with the picture
     }
   }
+  faults.finish(env.time());
+  report.faults = faults.records();
+  report.fault_lines = faults.lines();
+  for (int i = 0; hardware && i < 2; ++i) report.hardware.push_back(robots[i]->name() + ": " + hardware->summary(i));
   completed = true;
   return report;
 }
@@ -1030,6 +1098,13 @@ void print_summary(std::ostream& out, const CellReport& r) {
   for (const std::string& e : r.condition_errors) out << "condition error: " << e << '\n';
   put("step time: p50 %.3f ms, p99 %.3f ms (wall, both robots and both nets)", 1e3 * r.step_p50, 1e3 * r.step_p99);
   if (!r.png_error.empty()) out << "png: " << r.png_error << '\n';
+  for (const std::string& h : r.hardware) out << "hardware " << h << '\n';
+  if (!r.faults.empty()) {
+    int recovered = 0;
+    for (const FaultRecord& f : r.faults) recovered += f.recovered >= 0 ? 1 : 0;
+    put("faults injected: %d, recovered: %d", static_cast<int>(r.faults.size()), recovered);
+    for (const std::string& l : r.fault_lines) out << l << '\n';
+  }
   if (r.timed_out) out << "stopped: time limit reached\n";
   if (r.interrupted) out << "stopped: interrupted\n";
 }
@@ -1073,6 +1148,7 @@ void parse_options(const std::vector<std::string>& args, CellOptions& o) {
   };
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
+    if (take_hardware_option(args, i, o.hardware)) continue;
     if (a == "--seed")
       o.seed = static_cast<std::uint64_t>(whole(i, 0, 1e15));
     else if (a == "--parts")
@@ -1095,10 +1171,16 @@ void parse_options(const std::vector<std::string>& args, CellOptions& o) {
       o.meta_script = value(i);
     else if (a == "--robots")
       o.robot_script = value(i);
+    else if (a == "--fault")
+      o.faults.push_back(parse_fault(value(i)));
     else
       throw vsd::Error("unknown option '" + a + "'");
   }
   if (o.physics_step > o.step) throw vsd::Error("--physics-step must not exceed --step");
+  for (const std::string& e : {o.hardware.arm[0], o.hardware.arm[1], o.hardware.simulator})
+    if (!e.empty() && !o.hardware.enabled)
+      throw vsd::Error("--arm-a, --arm-b and --simulator go with --hardware");
+  check_faults(o.faults, o.hardware);
 }
 
 }  // namespace vsd_workcell

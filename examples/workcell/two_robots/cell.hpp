@@ -16,6 +16,8 @@
 #include <vector>
 
 #include "cycle_bound.hpp"
+#include "faults.hpp"
+#include "hardware.hpp"
 
 namespace vsd {
 class Environment;
@@ -39,6 +41,8 @@ struct CellOptions {
   std::string png;                   ///< when not empty: the picture of trace_plot.hpp (checked at the start)
   std::ostream* timeline = nullptr;  ///< when set: σ events, γ commands, token moves, parts handled
   double time_limit = 0;             ///< s of simulated time; 0: 60 s per part
+  HardwareOptions hardware;          ///< --hardware: the arms over UDP, the rails over the fieldbus
+  std::vector<FaultSpec> faults;     ///< --fault: injected faults (faults.hpp)
   /// Called once the cell is built, before the first step (the `--serve` inspector attaches here).
   std::function<void(vsd::Environment&)> on_built;
   /// Called before every step; false ends the run there (`interrupted` in the report).
@@ -73,6 +77,9 @@ struct CellReport {
   double step_p50 = 0;       ///< s of wall time per step (Environment::step: control, physics, collision,
   double step_p99 = 0;       ///< sensors, both nets), median and 99th percentile
   double step_total = 0;     ///< s of wall time in Environment::step over the run
+  std::vector<std::string> hardware;     ///< with --hardware: one line per robot, its adapters and their counts
+  std::vector<FaultRecord> faults;       ///< one per CellOptions::faults
+  std::vector<std::string> fault_lines;  ///< the faults' report lines, in time order
 };
 
 /// Adds the modules the cell uses to @p env — robotics, physics, collision (with the given update period),

@@ -5,6 +5,12 @@
 //                      [--time-limit S] [--urdf IIWA14.URDF] [--meta meta_control.soml]
 //                      [--robots multi_robot_control.soml] [--serve [PORT] [--no-linger]]
 //                      [--processes 1|2] [--role controller|ui --domain N] [--no-commands]
+//                      [--hardware [--simulator PATH] [--arm-a HOST:PORT] [--arm-b HOST:PORT]
+//                       [--hardware-timeout S]] [--fault SPEC]...
+//
+// --hardware drives each arm over the UDP FRI-like protocol to a vsd_robot_simulator process and each linear
+// axis through the fieldbus adapter (hardware.hpp); --fault injects a fault (faults.hpp has the grammar:
+// arm_a_silent@T+D, arm_b_silent@T+D, zone_sensor_drop@T+D, slip@partN, slip_a@partN, slip_b@partN).
 //
 //   vsd_two_robot_cell --net-dot SCRIPT.soml      (the net's picture as Graphviz DOT, made from the script)
 //
@@ -93,7 +99,9 @@ int main(int argc, char** argv) {
     std::cerr << "vsd_two_robot_cell: " << e.what()
               << "\nusage: vsd_two_robot_cell [--seed N] [--parts N] [--kinds 1|2] [--csv FILE] [--png FILE] [--quiet] [--step S] "
                  "[--physics-step S] [--time-limit S] [--urdf FILE] [--meta FILE] [--robots FILE] "
-                 "[--serve [PORT] [--no-linger]] [--processes 1|2] [--role controller|ui --domain N] [--no-commands]\n";
+                 "[--serve [PORT] [--no-linger]] [--processes 1|2] [--role controller|ui --domain N] [--no-commands] "
+                 "[--hardware [--simulator PATH] [--arm-a HOST:PORT] [--arm-b HOST:PORT] [--hardware-timeout S]] "
+                 "[--fault SPEC]...\n";
     return 2;
   }
   if (!quiet) o.timeline = &std::cout;

@@ -54,6 +54,20 @@ TEST(TwoProcessCell, WithoutCommandsTheRunIsTheSeedsOwn) {
   EXPECT_EQ(r.ui_exit, 0);
 }
 
+#ifdef VSD_CELL_PROGRAM_SERVES
+// `--processes 2 --serve`: the ui serves the inspector of its replica while the cell runs (the URL goes to
+// the ui's standard output, which is this test's), ends with the run (--no-linger), and the replica is
+// still byte-equal: the server on it reads and records, it does not change it.
+TEST(TwoProcessCell, TheUiServesItsReplicaAndItStaysByteEqual) {
+  std::ostringstream out;
+  const auto r = vsd_workcell::run_controller(options(1), test_domain() + 2, VSD_CELL_PROGRAM, false, out,
+                                              {"--serve", "0", "--no-linger"});
+  EXPECT_EQ(r.cell.parts_handled, 1) << out.str();
+  EXPECT_TRUE(r.replica_equal) << r.controller_digest << " vs " << r.replica_digest;
+  EXPECT_EQ(r.ui_exit, 0);
+}
+#endif
+
 TEST(TwoProcessCell, BadOptionsAreClearErrors) {
   auto error = [](std::vector<std::string> args) {
     vsd_workcell::ProcessOptions p;
