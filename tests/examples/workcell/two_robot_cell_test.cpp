@@ -38,7 +38,11 @@ void expect_clean(const CellReport& r, int parts) {
   EXPECT_FALSE(r.timed_out);
   EXPECT_TRUE(r.condition_errors.empty()) << r.condition_errors.front();
   EXPECT_GT(r.min_arm_distance, 0.05);
-  EXPECT_GT(r.handovers, 0);
+  // A large part is handed over only when lane B's queue runs ahead of lane A's, which a short run (the
+  // sanitizer build's 10 parts per seed) may never see; over 100 parts and more every seed has some.
+  if (parts >= 100) {
+    EXPECT_GT(r.handovers, 0);
+  }
   EXPECT_LT(r.handovers, parts);
   // Everything back at rest: both robots idle, the zone's token and the station's empty token at home.
   EXPECT_NE(r.final_marking.find("a.idle 1"), std::string::npos) << r.final_marking;
