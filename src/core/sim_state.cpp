@@ -492,21 +492,27 @@ void SimState::start_recording() {
 
 Transaction SimState::take_recording() {
   Transaction t;
-  if (!recorded_.empty()) {
-    t.bytes_ = std::move(recorded_);
-    t.ops_ = recorded_ops_;
-  }
-  recorded_.clear();
+  take_recording(t);
+  return t;
+}
+
+void SimState::take_recording(Transaction& into) {
+  into.bytes_.clear();
+  std::swap(into.bytes_, recorded_);
+  into.ops_ = recorded_ops_;
+  if (into.bytes_.empty()) detail::write_tx_header(into.bytes_);  // nothing was recorded: an empty bundle
   recorded_ops_ = 0;
   if (recording_) {
     // A stepped state records about as much each step: room for half as much again as the last bundle
-    // spares the buffer its doublings (one allocation a step, not a dozen, and no copies); it follows the
-    // bundles' size, so one large bundle costs memory for one step only.
-    recorded_.reserve(t.bytes_.size() + t.bytes_.size() / 2);
+    // spares the buffer its doublings (no copies); it follows the bundles' size, so one large bundle
+    // costs memory for one step only. A buffer handed back through take_recording(into) has the room
+    // already after a step or two.
+    recorded_.reserve(into.bytes_.size() + into.bytes_.size() / 2);
     detail::write_tx_header(recorded_);
+  } else {
+    recorded_ = std::vector<std::uint8_t>();  // stopped: hold no buffer
   }
-  if (t.size() != 0) bundle_.emit(t);
-  return t;
+  if (into.ops_ != 0) bundle_.emit(into);
 }
 
 SimState::Savepoint SimState::savepoint() {

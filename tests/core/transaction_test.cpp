@@ -101,6 +101,44 @@ TEST_F(TransactionTest, BundlesOfChangingSizeComeOutWhole) {
   EXPECT_TRUE(source.stop_recording().empty());
 }
 
+// take_recording(into): the same bundles as take_recording(), heard by the listeners the same way, and the
+// state records on into the buffer it was handed back (so two buffers take turns, both warm).
+TEST_F(TransactionTest, TakingIntoABundleRecordsIntoItsOldBuffer) {
+  auto& r = source.create<TRobot>();
+  replica.copy_from(source);
+  std::vector<std::size_t> heard;
+  const vsd::Connection c = source.on_bundle().connect([&](const vsd::Transaction& t) { heard.push_back(t.size()); });
+
+  vsd::Transaction into;
+  source.take_recording(into);  // not recording: an empty bundle, nothing heard
+  EXPECT_TRUE(into.empty());
+  EXPECT_EQ(into.bytes(), vsd::Transaction().bytes());
+
+  source.start_recording();
+  const std::uint8_t* buffers[2] = {nullptr, nullptr};
+  for (int step = 0; step < 8; ++step) {
+    for (int i = 0; i < 100; ++i) r.set_speed(step * 1000.0 + i + 0.5);
+    source.take_recording(into);
+    ASSERT_EQ(into.size(), 100u);
+    replica.apply(into);
+    expect_equal(source, replica);
+    // Once both buffers have grown to a step's size, neither is new again: the state records into the
+    // one handed back.
+    if (step >= 3) {
+      EXPECT_EQ(into.bytes().data(), buffers[step % 2]) << "step " << step;
+    }
+    buffers[step % 2] = into.bytes().data();
+  }
+  EXPECT_EQ(heard, std::vector<std::size_t>(8, 100));
+
+  // Nothing since the last cut: an empty bundle, and the state stops cleanly with the buffer taken back.
+  source.take_recording(into);
+  EXPECT_TRUE(into.empty());
+  EXPECT_EQ(into.bytes(), vsd::Transaction().bytes());
+  EXPECT_TRUE(source.stop_recording().empty());
+  EXPECT_EQ(heard.size(), 8u);
+}
+
 TEST_F(TransactionTest, ReplicaAppliesToEquality) {
   source.start_recording();
   auto& r = source.create<TRobot>();

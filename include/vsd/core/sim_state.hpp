@@ -133,6 +133,12 @@ class SimState : public Instance {
   /// @brief The changes recorded so far; recording goes on with an empty bundle. A bundle that is not
   /// empty is also handed to the on_bundle() listeners.
   Transaction take_recording();
+  /// @brief take_recording() into @p into: the bundle replaces what @p into held, and the state records
+  /// on into @p into's old buffer (emptied, its capacity kept). A reader that takes a bundle every step
+  /// and keeps a copy or nothing (the web inspector's timeline) so records into the same warm memory every
+  /// step instead of into a fresh allocation. The on_bundle() listeners hear the bundle as with
+  /// take_recording().
+  void take_recording(Transaction& into);
   /// @brief Listeners of every bundle the recording hands out (take_recording(), stop_recording()),
   /// whoever takes it: one reader cuts the recording (vsd::dist at each poll, or the web inspector at
   /// the end of a step), and every other reader still sees every recorded change once, in order.
