@@ -4,8 +4,9 @@
 // 1), and the same with the server's timeline off (arg 2). Issue 23's goal: the inspector adds at most
 // 5 % to a step of the work cell. Each iteration runs the cell over the same seeded 3 parts (the same
 // steps every time); its time is the sum of its steps' wall times (manual time, so building the cell and
-// its reach checks are not counted); the counters are the median and 99th percentile of one step, and
-// the change batches pushed to the page per run. Under callgrind the run takes some 50 times longer, so
+// its reach checks are not counted); the counters are the median and 99th percentile of one step, the
+// main thread's CPU time in the steps of a run (step_cpu_ms: preemption by other processes does not
+// count), and the change batches pushed to the page per run. Under callgrind the run takes some 50 times longer, so
 // the 30-a-second pushes come 50 times as often per step: count a push's instructions apart (README).
 #include <benchmark/benchmark.h>
 
@@ -18,7 +19,7 @@ namespace {
 
 void BM_WorkcellStep(benchmark::State& st) {
   constexpr int parts = 3;
-  double p50 = 0, p99 = 0, steps = 0, batches = 0;
+  double p50 = 0, p99 = 0, steps = 0, batches = 0, cpu = 0;
   for (auto _ : st) {
     vsd_workcell::CellOptions o;
     o.urdf = VSD_CELL_URDF;
@@ -26,6 +27,7 @@ void BM_WorkcellStep(benchmark::State& st) {
     o.robot_script = VSD_CELL_ROBOTS;
     o.seed = 1;
     o.parts = parts;
+    o.step_cpu = true;
     std::unique_ptr<vsd_bench::Inspected> inspector;
     o.on_built = [&](vsd::Environment& env) {
       inspector = std::make_unique<vsd_bench::Inspected>(env, env.main_state(), st.range(0));
@@ -43,12 +45,14 @@ void BM_WorkcellStep(benchmark::State& st) {
     p50 += r.step_p50;
     p99 += r.step_p99;
     steps += static_cast<double>(r.steps);
+    cpu += r.step_cpu_total;
   }
   const double n = static_cast<double>(st.iterations());
   if (n > 0) {
     st.counters["step_p50_us"] = 1e6 * p50 / n;
     st.counters["step_p99_us"] = 1e6 * p99 / n;
     st.counters["steps"] = steps / n;
+    st.counters["step_cpu_ms"] = 1e3 * cpu / n;  // the main thread's CPU time in the steps of a run
     st.counters["batches"] = batches / n;  // pushed to the page (at most 30 a second of wall time)
   }
 }

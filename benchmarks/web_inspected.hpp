@@ -65,6 +65,9 @@ struct Inspected {
     // pushes 50 times as often per step. VSD_BENCH_PUSH_RATE (batches per second, e.g. 1e-6) takes the
     // pushes out of the steps' count; a batch's cost is counted apart (benchmarks/README.md).
     if (const char* rate = std::getenv("VSD_BENCH_PUSH_RATE")) o.push_rate = std::strtod(rate, nullptr);
+    // VSD_BENCH_TIMELINE_BYTES sets the timeline's budget for mode 1 (default 64 MiB, the server's own).
+    if (const char* b = std::getenv("VSD_BENCH_TIMELINE_BYTES"); b != nullptr && mode == 1)
+      o.timeline_bytes = static_cast<std::size_t>(std::strtoull(b, nullptr, 10));
     server = std::make_unique<vsd::web::Server>(env, s, o);
     server->start();
     page = std::make_unique<StreamReader>(*server, [](std::string_view) {});

@@ -43,6 +43,7 @@ struct CellOptions {
   double time_limit = 0;             ///< s of simulated time; 0: 60 s per part
   HardwareOptions hardware;          ///< --hardware: the arms over UDP, the rails over the fieldbus
   std::vector<FaultSpec> faults;     ///< --fault: injected faults (faults.hpp)
+  bool step_cpu = false;             ///< also sum the thread's CPU time in the steps (CellReport::step_cpu_total)
   /// Called once the cell is built, before the first step (the `--serve` inspector attaches here).
   std::function<void(vsd::Environment&)> on_built;
   /// Called before every step; false ends the run there (`interrupted` in the report).
@@ -77,6 +78,8 @@ struct CellReport {
   double step_p50 = 0;       ///< s of wall time per step (Environment::step: control, physics, collision,
   double step_p99 = 0;       ///< sensors, both nets), median and 99th percentile
   double step_total = 0;     ///< s of wall time in Environment::step over the run
+  double step_cpu_total = 0;  ///< with CellOptions::step_cpu: s of this thread's CPU time in those steps
+                              ///< (time the thread was preempted does not count)
   std::vector<std::string> hardware;     ///< with --hardware: one line per robot, its adapters and their counts
   std::vector<FaultRecord> faults;       ///< one per CellOptions::faults
   std::vector<std::string> fault_lines;  ///< the faults' report lines, in time order
