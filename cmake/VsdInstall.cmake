@@ -90,6 +90,7 @@ write_basic_package_version_file(
 install(FILES
   "${PROJECT_BINARY_DIR}/vsdConfig.cmake"
   "${PROJECT_BINARY_DIR}/vsdConfigVersion.cmake"
+  "${CMAKE_CURRENT_LIST_DIR}/VsdSomlModule.cmake"
   DESTINATION ${VSD_INSTALL_CMAKEDIR}
   COMPONENT vsd_development)
 
