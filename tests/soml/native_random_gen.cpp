@@ -32,7 +32,7 @@ struct Gen {
     switch (pick(12)) {
       case 0: return var();
       case 1: return constant();
-      case 2: return "-" + expr(depth - 1);
+      case 2: return "-(" + expr(depth - 1) + ")";
       case 3: return "min(" + expr(depth - 1) + ", " + expr(depth - 1) + ")";
       case 4: return "max(" + expr(depth - 1) + ", " + expr(depth - 1) + ")";
       case 5: return "abs(" + expr(depth - 1) + ")";

@@ -29,12 +29,12 @@ std::string read_file(const std::string& path) {
 }
 
 // One program in an Environment of its own, run by the VM or (native) with the test library loaded.
-struct Run {
+struct Script {
   vsd::Registry reg;
   vsd::Environment env{0, reg};
   std::ostringstream out;
   vsd::soml::Program* program = nullptr;
-  Run(const std::string& file, const std::string& text, bool native, std::uint64_t budget = 10'000'000) {
+  Script(const std::string& file, const std::string& text, bool native, std::uint64_t budget = 10'000'000) {
     vsd::soml::RunOptions o;
     o.out = &out;
     o.instruction_budget = budget;
@@ -62,7 +62,7 @@ const std::string kArith = VSD_SOML_NATIVE_DIR "/arith.soml";
 
 TEST(SomlNative, ArithmeticMatchesTheVm) {
   const std::string text = read_file(kArith);
-  Run vm("arith.soml", text, false), native("arith.soml", text, true);
+  Script vm("arith.soml", text, false), native("arith.soml", text, true);
   EXPECT_EQ(vm.program->native_functions(), 0u);
   EXPECT_GE(native.program->native_functions(), 20u);
   struct Case {
@@ -108,7 +108,7 @@ TEST(SomlNative, ArithmeticMatchesTheVm) {
 TEST(SomlNative, BudgetAndDepthFailAtTheSamePointAsTheVm) {
   const std::string text = read_file(kArith);
   for (const std::uint64_t budget : {1ull, 2ull, 7ull, 1000ull, 54321ull}) {
-    Run vm("arith.soml", text, false, budget), native("arith.soml", text, true, budget);
+    Script vm("arith.soml", text, false, budget), native("arith.soml", text, true, budget);
     SCOPED_TRACE(budget);
     // A loop (backward jumps) and a recursion (calls) exhaust the budget where the VM's does.
     EXPECT_EQ(vm.call("outer", {vsd::Value(std::int64_t{0})}), native.call("outer", {vsd::Value(std::int64_t{0})}));
@@ -116,7 +116,7 @@ TEST(SomlNative, BudgetAndDepthFailAtTheSamePointAsTheVm) {
     EXPECT_EQ(vm.call("count_loop", {vsd::Value(std::int64_t{1000})}),
               native.call("count_loop", {vsd::Value(std::int64_t{1000})}));
   }
-  Run vm("arith.soml", text, false), native("arith.soml", text, true);
+  Script vm("arith.soml", text, false), native("arith.soml", text, true);
   const std::string deep = native.call("forever", {vsd::Value(std::int64_t{0})});
   EXPECT_EQ(vm.call("forever", {vsd::Value(std::int64_t{0})}), deep);
   EXPECT_NE(deep.find("call depth limit (256) reached calling forever\n  at forever (arith.soml:22:"),
@@ -134,7 +134,7 @@ TEST(SomlNative, BudgetAndDepthFailAtTheSamePointAsTheVm) {
 // every function on inputs small, large and at the edges gives the VM's result or error.
 TEST(SomlNative, RandomProgramsMatchTheVm) {
   const std::string text = read_file(VSD_SOML_NATIVE_RANDOM);
-  Run vm("random.soml", text, false, 200'000), native("random.soml", text, true, 200'000);
+  Script vm("random.soml", text, false, 200'000), native("random.soml", text, true, 200'000);
   ASSERT_GE(native.program->native_functions(), std::size_t{VSD_SOML_NATIVE_RANDOM_COUNT});
   const std::int64_t inputs[] = {0, 1, -1, 7, -13, 1000, 123456789, INT64_MAX, INT64_MIN, 4611686018427387904};
   int errors = 0, values = 0;
@@ -153,7 +153,7 @@ TEST(SomlNative, RandomProgramsMatchTheVm) {
 }
 
 TEST(SomlNative, AnotherVersionOfTheScriptIsRefused) {
-  Run changed("arith.soml", read_file(kArith) + "int extra(int n) { return n + 1; }\n", false);
+  Script changed("arith.soml", read_file(kArith) + "int extra(int n) { return n + 1; }\n", false);
   const std::string e = error_of([&] { changed.program->load_native(VSD_SOML_NATIVE_LIB); });
   EXPECT_NE(e.find("holds no native code of this version of arith.soml (image "), std::string::npos) << e;
   EXPECT_NE(e.find("regenerate it with vsd-soml compile"), std::string::npos) << e;
@@ -162,7 +162,7 @@ TEST(SomlNative, AnotherVersionOfTheScriptIsRefused) {
 }
 
 TEST(SomlNative, MissingOrBadLibraryIsAClearError) {
-  Run run("arith.soml", read_file(kArith), false);
+  Script run("arith.soml", read_file(kArith), false);
   const std::string missing = error_of([&] { run.program->load_native("/nonexistent/soml_native.so"); });
   EXPECT_NE(missing.find("cannot load the SOML++ native library '/nonexistent/soml_native.so'"), std::string::npos)
       << missing;
@@ -174,7 +174,7 @@ TEST(SomlNative, MissingOrBadLibraryIsAClearError) {
 // A program that ran in the VM goes on natively once the library is loaded, with the same results.
 TEST(SomlNative, LoadedMidRunGivesTheSameResults) {
   const std::string text = read_file(kArith);
-  Run run("arith.soml", text, false);
+  Script run("arith.soml", text, false);
   const std::string before = run.call("nested", {vsd::Value(std::int64_t{40})});
   run.program->load_native(VSD_SOML_NATIVE_LIB);
   EXPECT_EQ(run.call("nested", {vsd::Value(std::int64_t{40})}), before);
