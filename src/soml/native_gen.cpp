@@ -88,6 +88,13 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
     o << "  [[maybe_unused]] double d" << r << " = 0;\n";
   }
   for (int p = 0; p < f.nparams; ++p) o << "  " << view(f.param_kinds[static_cast<std::size_t>(p)]) << p << " = p" << p << ";\n";
+  // The budget: in a local (a register in loops) when the function calls nothing, written back on
+  // returns and when failing (fail() takes it); else the Context's own (a reference: the write-backs
+  // around calls and returns vanish), which costs one memory decrement per call but no store and reload
+  // around each call (fib).
+  bool calls = false;
+  for (const Ins& in : f.code) calls = calls || in.op == OP_CALL || in.op == OP_CALLS;
+  o << (calls ? "  std::uint64_t& budget = c->budget;\n" : "  std::uint64_t budget = c->budget;\n");
   auto I = [](int r) { return "i" + std::to_string(r); };
   auto D = [](int r) { return "d" + std::to_string(r); };
   for (std::size_t at = 0; at < f.code.size(); ++at) {
@@ -96,15 +103,15 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
     const std::string T = "L" + std::to_string(in.op < kOpCount && op_jumps(in.op) ? target_of(in) : 0);
     if (label[at]) o << "L" << at << ":\n";
     auto checked = [&](const char* builtin, const std::string& x, const std::string& y, const char* fault) {
-      o << "  { std::int64_t t; if (" << builtin << "(" << x << ", " << y << ", &t)) [[unlikely]] fail(c, Fault::"
+      o << "  { std::int64_t t; if (" << builtin << "(" << x << ", " << y << ", &t)) [[unlikely]] fail(c, budget, Fault::"
         << fault << ", " << F << ", " << AT << ", " << x << ", " << y << "); " << I(in.a) << " = t; }\n";
     };
     auto budget = [&](const char* fault) {
-      o << "{ if (--c->budget == 0) [[unlikely]] fail(c, Fault::" << fault << ", " << F << ", " << AT << "); } ";
+      o << "{ if (--budget == 0) [[unlikely]] fail(c, budget, Fault::" << fault << ", " << F << ", " << AT << "); } ";
     };
     auto loop = [&](const char* cmp, const std::string& bound) {
       o << "  { std::int64_t t; if (__builtin_add_overflow(" << I(in.a) << ", std::int64_t{1}, &t)) [[unlikely]] "
-        << "fail(c, Fault::Add, " << F << ", " << AT << ", " << I(in.a) << ", 1); " << I(in.a) << " = t; if (t "
+        << "fail(c, budget, Fault::Add, " << F << ", " << AT << ", " << I(in.a) << ", 1); " << I(in.a) << " = t; if (t "
         << cmp << " " << bound << ") { ";
       budget("LoopBudget");
       o << "goto " << T << "; } }\n";
@@ -138,10 +145,10 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
       case OP_DIVI:
       case OP_MODI: {
         const bool div = in.op == OP_DIVI;
-        o << "  { const std::int64_t x = " << I(in.b) << ", y = " << I(in.c) << "; if (y == 0) [[unlikely]] fail(c, "
+        o << "  { const std::int64_t x = " << I(in.b) << ", y = " << I(in.c) << "; if (y == 0) [[unlikely]] fail(c, budget, "
           << "Fault::DivisionByZero, " << F << ", " << AT << "); ";
         if (div)
-          o << "if (y == -1) { if (x == (-9223372036854775807ll - 1)) [[unlikely]] fail(c, Fault::Div, " << F << ", "
+          o << "if (y == -1) { if (x == (-9223372036854775807ll - 1)) [[unlikely]] fail(c, budget, Fault::Div, " << F << ", "
             << AT << ", x, y); " << I(in.a) << " = -x; } else " << I(in.a) << " = x / y; }\n";
         else
           o << I(in.a) << " = y == -1 ? 0 : x % y; }\n";
@@ -154,7 +161,7 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
       case OP_MULD: o << "  " << D(in.a) << " = " << D(in.b) << " * " << D(in.c) << ";\n"; break;
       case OP_DIVD: o << "  " << D(in.a) << " = " << D(in.b) << " / " << D(in.c) << ";\n"; break;
       case OP_NEGI:
-        o << "  if (" << I(in.b) << " == (-9223372036854775807ll - 1)) [[unlikely]] fail(c, Fault::Neg, " << F << ", "
+        o << "  if (" << I(in.b) << " == (-9223372036854775807ll - 1)) [[unlikely]] fail(c, budget, Fault::Neg, " << F << ", "
           << AT << ", " << I(in.b) << "); " << I(in.a) << " = -" << I(in.b) << ";\n";
         break;
       case OP_NEGD: o << "  " << D(in.a) << " = -" << D(in.b) << ";\n"; break;
@@ -162,7 +169,7 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
       case OP_I2D: o << "  " << D(in.a) << " = static_cast<double>(" << I(in.b) << ");\n"; break;
       case OP_D2I:
         o << "  if (!(" << D(in.b) << " >= -9.2233720368547758e18 && " << D(in.b)
-          << " < 9.2233720368547758e18)) [[unlikely]] fail(c, Fault::DoubleToInt, " << F << ", " << AT
+          << " < 9.2233720368547758e18)) [[unlikely]] fail(c, budget, Fault::DoubleToInt, " << F << ", " << AT
           << ", __builtin_bit_cast(std::int64_t, " << D(in.b) << ")); " << I(in.a) << " = static_cast<std::int64_t>("
           << D(in.b) << ");\n";
         break;
@@ -205,27 +212,27 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
         const std::string self = in.op == OP_CALLS ? "self" : "static_cast<std::uint64_t>(" + I(in.c) + ")";
         o << "  ";
         if (in.op == OP_CALL)
-          o << "{ if (" << I(in.c) << " == 0) [[unlikely]] fail(c, Fault::NullReference, " << F << ", " << AT << "); } ";
-        o << "{ if (depth >= c->max_depth) [[unlikely]] fail(c, Fault::Depth, " << F << ", " << AT << ", 0, " << in.b
+          o << "{ if (" << I(in.c) << " == 0) [[unlikely]] fail(c, budget, Fault::NullReference, " << F << ", " << AT << "); } ";
+        o << "{ if (depth >= c->max_depth) [[unlikely]] fail(c, budget, Fault::Depth, " << F << ", " << AT << ", 0, " << in.b
           << "); } ";
         budget("CallBudget");
-        o << "\n  try { ";
+        o << "\n  c->budget = budget;\n  try { ";
         if (callee.result != RK::None) o << view(callee.result) << in.a << " = ";
         else o << I(in.a) << " = ";
         o << "f" << in.b << "(c, depth + 1, " << self;
         for (int p = 0; p < callee.nparams; ++p)
           o << ", " << view(callee.param_kinds[static_cast<std::size_t>(p)]) << in.a + p;
-        o << "); } catch (...) { c->unwind(c, " << F << ", " << AT << "); throw; }\n";
+        o << "); } catch (...) { c->unwind(c, " << F << ", " << AT << "); throw; }\n  budget = c->budget;\n";
         break;
       }
       case OP_RET:
-        o << "  return " << view(f.result) << in.a << ";\n";
+        o << "  c->budget = budget;\n  return " << view(f.result) << in.a << ";\n";
         break;
       case OP_RET0:
-        o << "  return 0;\n";
+        o << "  c->budget = budget;\n  return 0;\n";
         break;
       case OP_FAIL:
-        o << "  fail(c, Fault::Fail, " << F << ", " << AT << ", 0, " << in.b << ");\n";
+        o << "  fail(c, budget, Fault::Fail, " << F << ", " << AT << ", 0, " << in.b << ");\n";
         break;
       case OP_BUILTIN: {
         const std::string a = I(in.a), d = D(in.a), a1 = I(in.a + 1), d1 = D(in.a + 1);
@@ -237,7 +244,7 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
             if (in.c != 0)
               o << "  " << d << " = std::fabs(" << d << ");\n";
             else
-              o << "  if (" << a << " == (-9223372036854775807ll - 1)) [[unlikely]] fail(c, Fault::Abs, " << F << ", "
+              o << "  if (" << a << " == (-9223372036854775807ll - 1)) [[unlikely]] fail(c, budget, Fault::Abs, " << F << ", "
                 << AT << ", " << a << "); " << a << " = " << a << " < 0 ? -" << a << " : " << a << ";\n";
             break;
           case Builtin::Min:
@@ -262,11 +269,11 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
         break;
       }
       default:
-        o << "  fail(c, Fault::Fail, " << F << ", " << AT << ", 0, 0);  // not translated\n";
+        o << "  fail(c, budget, Fault::Fail, " << F << ", " << AT << ", 0, 0);  // not translated\n";
     }
   }
   if (label[f.code.size()]) o << "L" << f.code.size() << ":\n";
-  o << "  return 0;\n}\n\n";
+  o << "  c->budget = budget;\n  return 0;\n}\n\n";
 }
 
 }  // namespace

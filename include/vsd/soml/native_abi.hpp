@@ -76,8 +76,11 @@ struct Module {
 inline constexpr const char* kModulesSymbol = "vsd_soml_native_modules";
 using Modules = const Module* const* (*)(std::uint32_t* count);
 
-[[noreturn, gnu::cold, gnu::noinline]] inline void fail(Context* c, Fault f, std::uint32_t fn, std::uint32_t at,
-                                                        std::int64_t a = 0, std::int64_t b = 0) {
+/// Generated code fails through this: @p budget (what is left, kept in a local) goes back to the Context
+/// first, then the runtime throws.
+[[noreturn, gnu::cold, gnu::noinline]] inline void fail(Context* c, std::uint64_t budget, Fault f, std::uint32_t fn,
+                                                        std::uint32_t at, std::int64_t a = 0, std::int64_t b = 0) {
+  c->budget = budget;
   c->fail(c, f, fn, at, a, b);
   __builtin_unreachable();
 }
