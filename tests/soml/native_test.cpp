@@ -181,3 +181,27 @@ TEST(SomlNative, LoadedMidRunGivesTheSameResults) {
 }
 
 }  // namespace
+
+namespace {
+
+// A debugger needs the VM: while one is attached, every call runs there (its breakpoints stop), with the
+// library loaded; detached, native code runs again.
+TEST(SomlNative, AnAttachedDebuggerRunsTheVm) {
+  Script run("arith.soml", read_file(kArith), true);
+  ASSERT_GT(run.program->native_functions(), 0u);
+  int stops = 0;
+  {
+    vsd::soml::Debugger d(*run.program);
+    d.break_at("arith.soml:3");  // fib
+    d.on_stop([&](vsd::soml::Debugger&, const vsd::soml::Stop&) {
+      ++stops;
+      return vsd::soml::Resume::Continue;
+    });
+    EXPECT_EQ(run.call("fib", {vsd::Value(std::int64_t{4})}), "3\nprinted: ");
+  }
+  EXPECT_EQ(stops, 9);  // fib(4) makes 9 calls
+  EXPECT_EQ(run.call("fib", {vsd::Value(std::int64_t{4})}), "3\nprinted: ");
+  EXPECT_EQ(stops, 9);
+}
+
+}  // namespace
