@@ -65,6 +65,9 @@ bool translatable(const ProgramImage& img, const Function& f, const std::vector<
 }
 
 const char* ctype(RK k) { return k == RK::D ? "double" : "std::int64_t"; }
+// What a translated function returns: its result and the budget left (both in registers: a struct of two
+// 8-byte scalars is returned in two registers).
+const char* rtype(RK k) { return k == RK::D ? "RD" : "RI"; }
 char view(RK k) { return k == RK::D ? 'd' : 'i'; }
 
 std::uint32_t target_of(const Ins& in) { return (static_cast<std::uint32_t>(in.x) << 16) | in.c; }
@@ -79,8 +82,9 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
   for (const Ins& in : f.code)
     if (op_jumps(in.op)) label[target_of(in)] = 1;
   o << "// " << f.name << "\n";
-  o << ctype(f.result) << " f" << fi
-    << "([[maybe_unused]] Context* c, [[maybe_unused]] std::uint32_t depth, [[maybe_unused]] std::uint64_t self";
+  o << rtype(f.result) << " f" << fi
+    << "([[maybe_unused]] Context* c, [[maybe_unused]] std::uint32_t depth, std::uint64_t budget, "
+       "[[maybe_unused]] std::uint64_t self";
   for (int p = 0; p < f.nparams; ++p) o << ", " << ctype(f.param_kinds[static_cast<std::size_t>(p)]) << " p" << p;
   o << ") {\n";
   for (int r = 0; r < f.nregs + 1; ++r) {
@@ -88,13 +92,8 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
     o << "  [[maybe_unused]] double d" << r << " = 0;\n";
   }
   for (int p = 0; p < f.nparams; ++p) o << "  " << view(f.param_kinds[static_cast<std::size_t>(p)]) << p << " = p" << p << ";\n";
-  // The budget: in a local (a register in loops) when the function calls nothing, written back on
-  // returns and when failing (fail() takes it); else the Context's own (a reference: the write-backs
-  // around calls and returns vanish), which costs one memory decrement per call but no store and reload
-  // around each call (fib).
-  bool calls = false;
-  for (const Ins& in : f.code) calls = calls || in.op == OP_CALL || in.op == OP_CALLS;
-  o << (calls ? "  std::uint64_t& budget = c->budget;\n" : "  std::uint64_t budget = c->budget;\n");
+  // The budget travels in a register: a parameter, returned with the result (no memory traffic per call
+  // or iteration); it goes to the Context only when failing (fail() takes it) and at the entry (e<n>).
   auto I = [](int r) { return "i" + std::to_string(r); };
   auto D = [](int r) { return "d" + std::to_string(r); };
   for (std::size_t at = 0; at < f.code.size(); ++at) {
@@ -216,20 +215,18 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
         o << "{ if (depth >= c->max_depth) [[unlikely]] fail(c, budget, Fault::Depth, " << F << ", " << AT << ", 0, " << in.b
           << "); } ";
         budget("CallBudget");
-        o << "\n  c->budget = budget;\n  try { ";
-        if (callee.result != RK::None) o << view(callee.result) << in.a << " = ";
-        else o << I(in.a) << " = ";
-        o << "f" << in.b << "(c, depth + 1, " << self;
+        o << "\n  try { const auto r = f" << in.b << "(c, depth + 1, budget, " << self;
         for (int p = 0; p < callee.nparams; ++p)
           o << ", " << view(callee.param_kinds[static_cast<std::size_t>(p)]) << in.a + p;
-        o << "); } catch (...) { c->unwind(c, " << F << ", " << AT << "); throw; }\n  budget = c->budget;\n";
+        o << "); " << (callee.result == RK::D ? D(in.a) : I(in.a)) << " = r.v; budget = r.budget; } catch (...) { "
+          << "c->unwind(c, " << F << ", " << AT << "); throw; }\n";
         break;
       }
       case OP_RET:
-        o << "  c->budget = budget;\n  return " << view(f.result) << in.a << ";\n";
+        o << "  return {" << view(f.result) << in.a << ", budget};\n";
         break;
       case OP_RET0:
-        o << "  c->budget = budget;\n  return 0;\n";
+        o << "  return {0, budget};\n";
         break;
       case OP_FAIL:
         o << "  fail(c, budget, Fault::Fail, " << F << ", " << AT << ", 0, " << in.b << ");\n";
@@ -273,7 +270,7 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
     }
   }
   if (label[f.code.size()]) o << "L" << f.code.size() << ":\n";
-  o << "  c->budget = budget;\n  return 0;\n}\n\n";
+  o << "  return {0, budget};\n}\n\n";
 }
 
 }  // namespace
@@ -344,7 +341,7 @@ void native_module_source(std::ostream& o, const ProgramImage& img, const std::s
   for (std::size_t i = 0; i < ok.size(); ++i) {
     if (!ok[i]) continue;
     const Function& f = *img.functions[i];
-    o << ctype(f.result) << " f" << i << "(Context*, std::uint32_t, std::uint64_t";
+    o << rtype(f.result) << " f" << i << "(Context*, std::uint32_t, std::uint64_t, std::uint64_t";
     for (int p = 0; p < f.nparams; ++p) o << ", " << ctype(f.param_kinds[static_cast<std::size_t>(p)]);
     o << ");\n";
   }
@@ -358,9 +355,9 @@ void native_module_source(std::ostream& o, const ProgramImage& img, const std::s
     ++count;
     const Function& f = *img.functions[i];
     o << "Reg e" << i << "(Context* c, std::uint32_t depth, std::uint64_t self, [[maybe_unused]] const Reg* a) {\n"
-      << "  Reg r;\n  r." << view(f.result) << " = f" << i << "(c, depth, self";
+      << "  const auto x = f" << i << "(c, depth, c->budget, self";
     for (int p = 0; p < f.nparams; ++p) o << ", a[" << p << "]." << view(f.param_kinds[static_cast<std::size_t>(p)]);
-    o << ");\n  return r;\n}\n";
+    o << ");\n  c->budget = x.budget;\n  Reg r;\n  r." << view(f.result) << " = x.v;\n  return r;\n}\n";
   }
   o << "\nconst FunctionEntry functions[] = {\n";
   for (std::size_t i = 0; i < ok.size(); ++i)
@@ -384,7 +381,8 @@ void native_library_source(std::ostream& o, const std::vector<const ProgramImage
        "// Build: c++ -std=c++20 -O2 -fPIC -shared -I<vsd include dir> THIS.cpp -o THIS.so\n"
        "// Load: Program::load_native(path) (docs/soml.md, \"Native compilation\").\n"
        "#include <algorithm>\n#include <cmath>\n#include <cstdint>\n\n#include \"vsd/soml/native_abi.hpp\"\n\n"
-       "namespace {\n\nusing namespace vsd::soml::native;\n\n";
+       "namespace {\n\nusing namespace vsd::soml::native;\n\n"
+       "struct RI {\n  std::int64_t v;\n  std::uint64_t budget;\n};\nstruct RD {\n  double v;\n  std::uint64_t budget;\n};\n\n";
   for (std::size_t i = 0; i < images.size(); ++i)
     native_module_source(o, *images[i], "s" + std::to_string(i), scripts[i]);
   o << "const Module* const modules[] = {";
