@@ -3,6 +3,8 @@
 // image's hash, and its functions replace the VM's for calls (RunCode::native). The callbacks below give
 // native code the VM's messages: the same words, the same call stack (native frames reported as they
 // unwind, then the VM's).
+#include "native.hpp"
+
 #include <dlfcn.h>
 
 #include <bit>
@@ -10,7 +12,6 @@
 #include <iostream>
 #include <sstream>
 
-#include "native.hpp"
 #include "program_impl.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/core/instance.hpp"
@@ -29,16 +30,26 @@ ProgramImpl& impl_of(native::Context* c) { return *static_cast<ProgramImpl*>(c->
   p.native_sites_.emplace_back(fn, at);
   p.budget_ = c->budget;
   switch (f) {
-    case Fault::Add: p.int_overflow(a, "+", b);
-    case Fault::Sub: p.int_overflow(a, "-", b);
-    case Fault::Mul: p.int_overflow(a, "*", b);
-    case Fault::Div: p.int_overflow(a, "/", b);
-    case Fault::Neg: p.int_overflow("-", a);
-    case Fault::Abs: p.int_overflow("abs", a);
-    case Fault::DivisionByZero: p.fail("division by zero");
-    case Fault::NullReference: p.fail("null reference");
-    case Fault::DoubleToInt: p.fail("the double " + fmt_double(std::bit_cast<double>(a)) + " does not fit an int");
-    case Fault::LoopBudget: p.loop_budget_exhausted();
+    case Fault::Add:
+      p.int_overflow(a, "+", b);
+    case Fault::Sub:
+      p.int_overflow(a, "-", b);
+    case Fault::Mul:
+      p.int_overflow(a, "*", b);
+    case Fault::Div:
+      p.int_overflow(a, "/", b);
+    case Fault::Neg:
+      p.int_overflow("-", a);
+    case Fault::Abs:
+      p.int_overflow("abs", a);
+    case Fault::DivisionByZero:
+      p.fail("division by zero");
+    case Fault::NullReference:
+      p.fail("null reference");
+    case Fault::DoubleToInt:
+      p.fail("the double " + fmt_double(std::bit_cast<double>(a)) + " does not fit an int");
+    case Fault::LoopBudget:
+      p.loop_budget_exhausted();
     case Fault::CallBudget:
       p.fail("instruction budget exhausted (" + std::to_string(p.opt_.instruction_budget) +
              " jumps and calls): runaway recursion?");
@@ -95,7 +106,8 @@ std::size_t ProgramImpl::load_native(const std::string& path) {
   void* h = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (h == nullptr) {
     const char* why = ::dlerror();
-    throw Error("cannot load the SOML++ native library '" + path + "': " + (why != nullptr ? why : "unknown"));
+    throw Error("cannot load the SOML++ native library '" + path +
+                "': " + (why != nullptr ? why : "unknown"));
   }
   std::shared_ptr<void> lib(h, [](void* x) { ::dlclose(x); });
   void* sym = ::dlsym(h, native::kModulesSymbol);
@@ -109,8 +121,9 @@ std::size_t ProgramImpl::load_native(const std::string& path) {
   for (std::uint32_t i = 0; i < n; ++i) {
     const native::Module& m = *mods[i];
     if (m.abi != native::kNativeAbi)
-      throw Error("'" + path + "' was generated for native ABI " + std::to_string(m.abi) + ", this runtime has " +
-                  std::to_string(native::kNativeAbi) + ": regenerate it (vsd-soml compile)");
+      throw Error("'" + path + "' was generated for native ABI " + std::to_string(m.abi) +
+                  ", this runtime has " + std::to_string(native::kNativeAbi) +
+                  ": regenerate it (vsd-soml compile)");
     std::ostringstream hex;
     hex << std::hex << std::setw(16) << std::setfill('0') << m.image_hash;
     have += std::string(have.empty() ? "" : ", ") + m.script + " (" + hex.str() + ")";
@@ -127,7 +140,8 @@ std::size_t ProgramImpl::load_native(const std::string& path) {
     if (found->functions[i].index >= run_.size() || found->functions[i].entry == nullptr)
       throw Error("'" + path + "': a bad function entry");
   for (RunCode& rc : run_) rc.native = nullptr;
-  for (std::uint32_t i = 0; i < found->count; ++i) run_[found->functions[i].index].native = found->functions[i].entry;
+  for (std::uint32_t i = 0; i < found->count; ++i)
+    run_[found->functions[i].index].native = found->functions[i].entry;
   native_lib_ = std::move(lib);
   native_count_ = found->count;
   return found->count;

@@ -28,17 +28,58 @@ bool translatable(const ProgramImage& img, const Function& f, const std::vector<
   if (!scalar(f.result) && f.result != RK::None) return false;
   for (const Ins& in : f.code) {
     switch (in.op) {
-      case OP_NOP: case OP_LOADI: case OP_LOADK: case OP_MOV:
-      case OP_ADDI: case OP_SUBI: case OP_MULI: case OP_DIVI: case OP_MODI:
-      case OP_ADDD: case OP_SUBD: case OP_MULD: case OP_DIVD:
-      case OP_ADDIK: case OP_MULIK: case OP_DIVIK: case OP_MODIK:
-      case OP_NEGI: case OP_NEGD: case OP_NOT: case OP_I2D: case OP_D2I:
-      case OP_LTI: case OP_LEI: case OP_EQI: case OP_NEI: case OP_LTD: case OP_LED: case OP_EQD: case OP_NED:
-      case OP_JMP: case OP_JMPF: case OP_JMPT:
-      case OP_JGEI: case OP_JGTI: case OP_JLTI: case OP_JLEI: case OP_JEQI: case OP_JNEI:
-      case OP_JGEIK: case OP_JGTIK: case OP_JLTIK: case OP_JLEIK: case OP_JEQIK: case OP_JNEIK:
-      case OP_LOOPLT: case OP_LOOPLE: case OP_LOOPLTK: case OP_LOOPLEK:
-      case OP_RET: case OP_RET0: case OP_FAIL:
+      case OP_NOP:
+      case OP_LOADI:
+      case OP_LOADK:
+      case OP_MOV:
+      case OP_ADDI:
+      case OP_SUBI:
+      case OP_MULI:
+      case OP_DIVI:
+      case OP_MODI:
+      case OP_ADDD:
+      case OP_SUBD:
+      case OP_MULD:
+      case OP_DIVD:
+      case OP_ADDIK:
+      case OP_MULIK:
+      case OP_DIVIK:
+      case OP_MODIK:
+      case OP_NEGI:
+      case OP_NEGD:
+      case OP_NOT:
+      case OP_I2D:
+      case OP_D2I:
+      case OP_LTI:
+      case OP_LEI:
+      case OP_EQI:
+      case OP_NEI:
+      case OP_LTD:
+      case OP_LED:
+      case OP_EQD:
+      case OP_NED:
+      case OP_JMP:
+      case OP_JMPF:
+      case OP_JMPT:
+      case OP_JGEI:
+      case OP_JGTI:
+      case OP_JLTI:
+      case OP_JLEI:
+      case OP_JEQI:
+      case OP_JNEI:
+      case OP_JGEIK:
+      case OP_JGTIK:
+      case OP_JLTIK:
+      case OP_JLEIK:
+      case OP_JEQIK:
+      case OP_JNEIK:
+      case OP_LOOPLT:
+      case OP_LOOPLE:
+      case OP_LOOPLTK:
+      case OP_LOOPLEK:
+      case OP_RET:
+      case OP_RET0:
+      case OP_FAIL:
         break;
       case OP_CALL:
       case OP_CALLS:
@@ -46,8 +87,12 @@ bool translatable(const ProgramImage& img, const Function& f, const std::vector<
         break;
       case OP_BUILTIN:
         switch (static_cast<Builtin>(in.b)) {
-          case Builtin::Sqrt: case Builtin::Floor: case Builtin::Ceil: case Builtin::Abs:
-          case Builtin::Min: case Builtin::Max:
+          case Builtin::Sqrt:
+          case Builtin::Floor:
+          case Builtin::Ceil:
+          case Builtin::Abs:
+          case Builtin::Min:
+          case Builtin::Max:
             break;
           default:
             return false;
@@ -81,7 +126,9 @@ char view(RK k) { return k == RK::D ? 'd' : 'i'; }
 
 std::uint32_t target_of(const Ins& in) { return (static_cast<std::uint32_t>(in.x) << 16) | in.c; }
 
-std::string imm(std::uint16_t v) { return "std::int64_t{" + std::to_string(static_cast<std::int16_t>(v)) + "}"; }
+std::string imm(std::uint16_t v) {
+  return "std::int64_t{" + std::to_string(static_cast<std::int16_t>(v)) + "}";
+}
 
 // The body of function @p fi (translatable) as C++.
 void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
@@ -94,13 +141,15 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
   o << rtype(f.result) << " f" << fi
     << "([[maybe_unused]] Context* c, [[maybe_unused]] std::uint32_t depth, std::uint64_t budget, "
        "[[maybe_unused]] std::uint64_t self";
-  for (int p = 0; p < f.nparams; ++p) o << ", " << ctype(f.param_kinds[static_cast<std::size_t>(p)]) << " p" << p;
+  for (int p = 0; p < f.nparams; ++p)
+    o << ", " << ctype(f.param_kinds[static_cast<std::size_t>(p)]) << " p" << p;
   o << ") {\n";
   for (int r = 0; r < f.nregs + 1; ++r) {
     o << "  [[maybe_unused]] std::int64_t i" << r << " = 0;\n";
     o << "  [[maybe_unused]] double d" << r << " = 0;\n";
   }
-  for (int p = 0; p < f.nparams; ++p) o << "  " << view(f.param_kinds[static_cast<std::size_t>(p)]) << p << " = p" << p << ";\n";
+  for (int p = 0; p < f.nparams; ++p)
+    o << "  " << view(f.param_kinds[static_cast<std::size_t>(p)]) << p << " = p" << p << ";\n";
   // The budget travels in a register: a parameter, returned with the result (no memory traffic per call
   // or iteration); it goes to the Context only when failing (fail() takes it) and at the entry (e<n>).
   auto I = [](int r) { return "i" + std::to_string(r); };
@@ -111,16 +160,19 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
     const std::string T = "L" + std::to_string(in.op < kOpCount && op_jumps(in.op) ? target_of(in) : 0);
     if (label[at]) o << "L" << at << ":\n";
     auto checked = [&](const char* builtin, const std::string& x, const std::string& y, const char* fault) {
-      o << "  { std::int64_t t; if (" << builtin << "(" << x << ", " << y << ", &t)) [[unlikely]] fail(c, budget, Fault::"
-        << fault << ", " << F << ", " << AT << ", " << x << ", " << y << "); " << I(in.a) << " = t; }\n";
+      o << "  { std::int64_t t; if (" << builtin << "(" << x << ", " << y
+        << ", &t)) [[unlikely]] fail(c, budget, Fault::" << fault << ", " << F << ", " << AT << ", " << x
+        << ", " << y << "); " << I(in.a) << " = t; }\n";
     };
     auto budget = [&](const char* fault) {
-      o << "{ if (--budget == 0) [[unlikely]] fail(c, budget, Fault::" << fault << ", " << F << ", " << AT << "); } ";
+      o << "{ if (--budget == 0) [[unlikely]] fail(c, budget, Fault::" << fault << ", " << F << ", " << AT
+        << "); } ";
     };
     auto loop = [&](const char* cmp, const std::string& bound) {
-      o << "  { std::int64_t t; if (__builtin_add_overflow(" << I(in.a) << ", std::int64_t{1}, &t)) [[unlikely]] "
-        << "fail(c, budget, Fault::Add, " << F << ", " << AT << ", " << I(in.a) << ", 1); " << I(in.a) << " = t; if (t "
-        << cmp << " " << bound << ") { ";
+      o << "  { std::int64_t t; if (__builtin_add_overflow(" << I(in.a)
+        << ", std::int64_t{1}, &t)) [[unlikely]] "
+        << "fail(c, budget, Fault::Add, " << F << ", " << AT << ", " << I(in.a) << ", 1); " << I(in.a)
+        << " = t; if (t " << cmp << " " << bound << ") { ";
       budget("LoopBudget");
       o << "goto " << T << "; } }\n";
     };
@@ -145,73 +197,156 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
       case OP_MOV:
         o << "  " << I(in.a) << " = " << I(in.b) << "; " << D(in.a) << " = " << D(in.b) << ";\n";
         break;
-      case OP_ADDI: checked("__builtin_add_overflow", I(in.b), I(in.c), "Add"); break;
-      case OP_SUBI: checked("__builtin_sub_overflow", I(in.b), I(in.c), "Sub"); break;
-      case OP_MULI: checked("__builtin_mul_overflow", I(in.b), I(in.c), "Mul"); break;
-      case OP_ADDIK: checked("__builtin_add_overflow", I(in.b), imm(in.c), "Add"); break;
-      case OP_MULIK: checked("__builtin_mul_overflow", I(in.b), imm(in.c), "Mul"); break;
+      case OP_ADDI:
+        checked("__builtin_add_overflow", I(in.b), I(in.c), "Add");
+        break;
+      case OP_SUBI:
+        checked("__builtin_sub_overflow", I(in.b), I(in.c), "Sub");
+        break;
+      case OP_MULI:
+        checked("__builtin_mul_overflow", I(in.b), I(in.c), "Mul");
+        break;
+      case OP_ADDIK:
+        checked("__builtin_add_overflow", I(in.b), imm(in.c), "Add");
+        break;
+      case OP_MULIK:
+        checked("__builtin_mul_overflow", I(in.b), imm(in.c), "Mul");
+        break;
       case OP_DIVI:
       case OP_MODI: {
         const bool div = in.op == OP_DIVI;
-        o << "  { const std::int64_t x = " << I(in.b) << ", y = " << I(in.c) << "; if (y == 0) [[unlikely]] fail(c, budget, "
+        o << "  { const std::int64_t x = " << I(in.b) << ", y = " << I(in.c)
+          << "; if (y == 0) [[unlikely]] fail(c, budget, "
           << "Fault::DivisionByZero, " << F << ", " << AT << "); ";
         if (div)
-          o << "if (y == -1) { if (x == (-9223372036854775807ll - 1)) [[unlikely]] fail(c, budget, Fault::Div, " << F << ", "
-            << AT << ", x, y); " << I(in.a) << " = -x; } else " << I(in.a) << " = x / y; }\n";
+          o << "if (y == -1) { if (x == (-9223372036854775807ll - 1)) [[unlikely]] fail(c, budget, "
+               "Fault::Div, "
+            << F << ", " << AT << ", x, y); " << I(in.a) << " = -x; } else " << I(in.a) << " = x / y; }\n";
         else
           o << I(in.a) << " = y == -1 ? 0 : x % y; }\n";
         break;
       }
-      case OP_DIVIK: o << "  " << I(in.a) << " = " << I(in.b) << " / " << imm(in.c) << ";\n"; break;
-      case OP_MODIK: o << "  " << I(in.a) << " = " << I(in.b) << " % " << imm(in.c) << ";\n"; break;
-      case OP_ADDD: o << "  " << D(in.a) << " = " << D(in.b) << " + " << D(in.c) << ";\n"; break;
-      case OP_SUBD: o << "  " << D(in.a) << " = " << D(in.b) << " - " << D(in.c) << ";\n"; break;
-      case OP_MULD: o << "  " << D(in.a) << " = " << D(in.b) << " * " << D(in.c) << ";\n"; break;
-      case OP_DIVD: o << "  " << D(in.a) << " = " << D(in.b) << " / " << D(in.c) << ";\n"; break;
-      case OP_NEGI:
-        o << "  if (" << I(in.b) << " == (-9223372036854775807ll - 1)) [[unlikely]] fail(c, budget, Fault::Neg, " << F << ", "
-          << AT << ", " << I(in.b) << "); " << I(in.a) << " = -" << I(in.b) << ";\n";
+      case OP_DIVIK:
+        o << "  " << I(in.a) << " = " << I(in.b) << " / " << imm(in.c) << ";\n";
         break;
-      case OP_NEGD: o << "  " << D(in.a) << " = -" << D(in.b) << ";\n"; break;
-      case OP_NOT: o << "  " << I(in.a) << " = " << I(in.b) << " == 0 ? 1 : 0;\n"; break;
-      case OP_I2D: o << "  " << D(in.a) << " = static_cast<double>(" << I(in.b) << ");\n"; break;
+      case OP_MODIK:
+        o << "  " << I(in.a) << " = " << I(in.b) << " % " << imm(in.c) << ";\n";
+        break;
+      case OP_ADDD:
+        o << "  " << D(in.a) << " = " << D(in.b) << " + " << D(in.c) << ";\n";
+        break;
+      case OP_SUBD:
+        o << "  " << D(in.a) << " = " << D(in.b) << " - " << D(in.c) << ";\n";
+        break;
+      case OP_MULD:
+        o << "  " << D(in.a) << " = " << D(in.b) << " * " << D(in.c) << ";\n";
+        break;
+      case OP_DIVD:
+        o << "  " << D(in.a) << " = " << D(in.b) << " / " << D(in.c) << ";\n";
+        break;
+      case OP_NEGI:
+        o << "  if (" << I(in.b)
+          << " == (-9223372036854775807ll - 1)) [[unlikely]] fail(c, budget, Fault::Neg, " << F << ", " << AT
+          << ", " << I(in.b) << "); " << I(in.a) << " = -" << I(in.b) << ";\n";
+        break;
+      case OP_NEGD:
+        o << "  " << D(in.a) << " = -" << D(in.b) << ";\n";
+        break;
+      case OP_NOT:
+        o << "  " << I(in.a) << " = " << I(in.b) << " == 0 ? 1 : 0;\n";
+        break;
+      case OP_I2D:
+        o << "  " << D(in.a) << " = static_cast<double>(" << I(in.b) << ");\n";
+        break;
       case OP_D2I:
         o << "  if (!(" << D(in.b) << " >= -9.2233720368547758e18 && " << D(in.b)
           << " < 9.2233720368547758e18)) [[unlikely]] fail(c, budget, Fault::DoubleToInt, " << F << ", " << AT
-          << ", __builtin_bit_cast(std::int64_t, " << D(in.b) << ")); " << I(in.a) << " = static_cast<std::int64_t>("
-          << D(in.b) << ");\n";
+          << ", __builtin_bit_cast(std::int64_t, " << D(in.b) << ")); " << I(in.a)
+          << " = static_cast<std::int64_t>(" << D(in.b) << ");\n";
         break;
-      case OP_LTI: cmp("<", 'i'); break;
-      case OP_LEI: cmp("<=", 'i'); break;
-      case OP_EQI: cmp("==", 'i'); break;
-      case OP_NEI: cmp("!=", 'i'); break;
-      case OP_LTD: cmp("<", 'd'); break;
-      case OP_LED: cmp("<=", 'd'); break;
-      case OP_EQD: cmp("==", 'd'); break;
-      case OP_NED: cmp("!=", 'd'); break;
+      case OP_LTI:
+        cmp("<", 'i');
+        break;
+      case OP_LEI:
+        cmp("<=", 'i');
+        break;
+      case OP_EQI:
+        cmp("==", 'i');
+        break;
+      case OP_NEI:
+        cmp("!=", 'i');
+        break;
+      case OP_LTD:
+        cmp("<", 'd');
+        break;
+      case OP_LED:
+        cmp("<=", 'd');
+        break;
+      case OP_EQD:
+        cmp("==", 'd');
+        break;
+      case OP_NED:
+        cmp("!=", 'd');
+        break;
       case OP_JMP:
         o << "  ";
         if (target_of(in) <= at) budget("LoopBudget");  // backward: one unit of the budget, as in the VM
         o << "goto " << T << ";\n";
         break;
-      case OP_JMPF: o << "  if (" << I(in.a) << " == 0) goto " << T << ";\n"; break;
-      case OP_JMPT: o << "  if (" << I(in.a) << " != 0) goto " << T << ";\n"; break;
-      case OP_JGEI: jump(">=", I(in.b)); break;
-      case OP_JGTI: jump(">", I(in.b)); break;
-      case OP_JLTI: jump("<", I(in.b)); break;
-      case OP_JLEI: jump("<=", I(in.b)); break;
-      case OP_JEQI: jump("==", I(in.b)); break;
-      case OP_JNEI: jump("!=", I(in.b)); break;
-      case OP_JGEIK: jump(">=", imm(in.b)); break;
-      case OP_JGTIK: jump(">", imm(in.b)); break;
-      case OP_JLTIK: jump("<", imm(in.b)); break;
-      case OP_JLEIK: jump("<=", imm(in.b)); break;
-      case OP_JEQIK: jump("==", imm(in.b)); break;
-      case OP_JNEIK: jump("!=", imm(in.b)); break;
-      case OP_LOOPLT: loop("<", I(in.b)); break;
-      case OP_LOOPLE: loop("<=", I(in.b)); break;
-      case OP_LOOPLTK: loop("<", imm(in.b)); break;
-      case OP_LOOPLEK: loop("<=", imm(in.b)); break;
+      case OP_JMPF:
+        o << "  if (" << I(in.a) << " == 0) goto " << T << ";\n";
+        break;
+      case OP_JMPT:
+        o << "  if (" << I(in.a) << " != 0) goto " << T << ";\n";
+        break;
+      case OP_JGEI:
+        jump(">=", I(in.b));
+        break;
+      case OP_JGTI:
+        jump(">", I(in.b));
+        break;
+      case OP_JLTI:
+        jump("<", I(in.b));
+        break;
+      case OP_JLEI:
+        jump("<=", I(in.b));
+        break;
+      case OP_JEQI:
+        jump("==", I(in.b));
+        break;
+      case OP_JNEI:
+        jump("!=", I(in.b));
+        break;
+      case OP_JGEIK:
+        jump(">=", imm(in.b));
+        break;
+      case OP_JGTIK:
+        jump(">", imm(in.b));
+        break;
+      case OP_JLTIK:
+        jump("<", imm(in.b));
+        break;
+      case OP_JLEIK:
+        jump("<=", imm(in.b));
+        break;
+      case OP_JEQIK:
+        jump("==", imm(in.b));
+        break;
+      case OP_JNEIK:
+        jump("!=", imm(in.b));
+        break;
+      case OP_LOOPLT:
+        loop("<", I(in.b));
+        break;
+      case OP_LOOPLE:
+        loop("<=", I(in.b));
+        break;
+      case OP_LOOPLTK:
+        loop("<", imm(in.b));
+        break;
+      case OP_LOOPLEK:
+        loop("<=", imm(in.b));
+        break;
       case OP_CALL:
       case OP_CALLS: {
         // As the VM: a null self, the depth limit, then the budget; then the call, whose frame the
@@ -220,14 +355,16 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
         const std::string self = in.op == OP_CALLS ? "self" : "static_cast<std::uint64_t>(" + I(in.c) + ")";
         o << "  ";
         if (in.op == OP_CALL)
-          o << "{ if (" << I(in.c) << " == 0) [[unlikely]] fail(c, budget, Fault::NullReference, " << F << ", " << AT << "); } ";
-        o << "{ if (depth >= c->max_depth) [[unlikely]] fail(c, budget, Fault::Depth, " << F << ", " << AT << ", 0, " << in.b
-          << "); } ";
+          o << "{ if (" << I(in.c) << " == 0) [[unlikely]] fail(c, budget, Fault::NullReference, " << F
+            << ", " << AT << "); } ";
+        o << "{ if (depth >= c->max_depth) [[unlikely]] fail(c, budget, Fault::Depth, " << F << ", " << AT
+          << ", 0, " << in.b << "); } ";
         budget("CallBudget");
         o << "\n  try { const auto r = f" << in.b << "(c, depth + 1, budget, " << self;
         for (int p = 0; p < callee.nparams; ++p)
           o << ", " << view(callee.param_kinds[static_cast<std::size_t>(p)]) << in.a + p;
-        o << "); " << (callee.result == RK::D ? D(in.a) : I(in.a)) << " = r.v; budget = r.budget; } catch (...) { "
+        o << "); " << (callee.result == RK::D ? D(in.a) : I(in.a))
+          << " = r.v; budget = r.budget; } catch (...) { "
           << "c->unwind(c, " << F << ", " << AT << "); throw; }\n";
         break;
       }
@@ -243,23 +380,34 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
       case OP_BUILTIN: {
         const std::string a = I(in.a), d = D(in.a), a1 = I(in.a + 1), d1 = D(in.a + 1);
         switch (static_cast<Builtin>(in.b)) {
-          case Builtin::Sqrt: o << "  " << d << " = std::sqrt(" << d << ");\n"; break;
-          case Builtin::Floor: o << "  " << d << " = std::floor(" << d << ");\n"; break;
-          case Builtin::Ceil: o << "  " << d << " = std::ceil(" << d << ");\n"; break;
+          case Builtin::Sqrt:
+            o << "  " << d << " = std::sqrt(" << d << ");\n";
+            break;
+          case Builtin::Floor:
+            o << "  " << d << " = std::floor(" << d << ");\n";
+            break;
+          case Builtin::Ceil:
+            o << "  " << d << " = std::ceil(" << d << ");\n";
+            break;
           case Builtin::Abs:
             if (in.c != 0)
               o << "  " << d << " = std::fabs(" << d << ");\n";
             else
-              o << "  if (" << a << " == (-9223372036854775807ll - 1)) [[unlikely]] fail(c, budget, Fault::Abs, " << F << ", "
+              o << "  if (" << a
+                << " == (-9223372036854775807ll - 1)) [[unlikely]] fail(c, budget, Fault::Abs, " << F << ", "
                 << AT << ", " << a << "); " << a << " = " << a << " < 0 ? -" << a << " : " << a << ";\n";
             break;
           case Builtin::Min:
-            if (in.c != 0) o << "  " << d << " = std::min(" << d << ", " << d1 << ");\n";
-            else o << "  " << a << " = std::min(" << a << ", " << a1 << ");\n";
+            if (in.c != 0)
+              o << "  " << d << " = std::min(" << d << ", " << d1 << ");\n";
+            else
+              o << "  " << a << " = std::min(" << a << ", " << a1 << ");\n";
             break;
           case Builtin::Max:
-            if (in.c != 0) o << "  " << d << " = std::max(" << d << ", " << d1 << ");\n";
-            else o << "  " << a << " = std::max(" << a << ", " << a1 << ");\n";
+            if (in.c != 0)
+              o << "  " << d << " = std::max(" << d << ", " << d1 << ");\n";
+            else
+              o << "  " << a << " = std::max(" << a << ", " << a1 << ");\n";
             break;
           default:
             break;
@@ -270,7 +418,8 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
         const auto& kinds = img.print_kinds[in.c];
         o << "  { Reg r[" << std::max<std::size_t>(1, kinds.size()) << "];";
         for (std::size_t k = 0; k < kinds.size(); ++k)
-          o << " r[" << k << "]." << view(kinds[k]) << " = " << view(kinds[k]) << in.a + static_cast<int>(k) << ";";
+          o << " r[" << k << "]." << view(kinds[k]) << " = " << view(kinds[k]) << in.a + static_cast<int>(k)
+            << ";";
         o << " c->print(c, " << in.c << "u, r); }\n";
         break;
       }
@@ -363,9 +512,11 @@ void native_module_source(std::ostream& o, const ProgramImage& img, const std::s
     if (!ok[i]) continue;
     ++count;
     const Function& f = *img.functions[i];
-    o << "Reg e" << i << "(Context* c, std::uint32_t depth, std::uint64_t self, [[maybe_unused]] const Reg* a) {\n"
+    o << "Reg e" << i
+      << "(Context* c, std::uint32_t depth, std::uint64_t self, [[maybe_unused]] const Reg* a) {\n"
       << "  const auto x = f" << i << "(c, depth, c->budget, self";
-    for (int p = 0; p < f.nparams; ++p) o << ", a[" << p << "]." << view(f.param_kinds[static_cast<std::size_t>(p)]);
+    for (int p = 0; p < f.nparams; ++p)
+      o << ", a[" << p << "]." << view(f.param_kinds[static_cast<std::size_t>(p)]);
     o << ");\n  c->budget = x.budget;\n  Reg r;\n  r." << view(f.result) << " = x.v;\n  return r;\n}\n";
   }
   o << "\nconst FunctionEntry functions[] = {\n";
@@ -389,9 +540,11 @@ void native_library_source(std::ostream& o, const std::vector<const ProgramImage
   o << ". Do not edit: regenerate.\n"
        "// Build: c++ -std=c++20 -O2 -fPIC -shared -I<vsd include dir> THIS.cpp -o THIS.so\n"
        "// Load: Program::load_native(path) (docs/soml.md, \"Native compilation\").\n"
-       "#include <algorithm>\n#include <cmath>\n#include <cstdint>\n\n#include \"vsd/soml/native_abi.hpp\"\n\n"
+       "#include <algorithm>\n#include <cmath>\n#include <cstdint>\n\n#include "
+       "\"vsd/soml/native_abi.hpp\"\n\n"
        "namespace {\n\nusing namespace vsd::soml::native;\n\n"
-       "struct RI {\n  std::int64_t v;\n  std::uint64_t budget;\n};\nstruct RD {\n  double v;\n  std::uint64_t budget;\n};\n\n";
+       "struct RI {\n  std::int64_t v;\n  std::uint64_t budget;\n};\nstruct RD {\n  double v;\n  "
+       "std::uint64_t budget;\n};\n\n";
   for (std::size_t i = 0; i < images.size(); ++i)
     native_module_source(o, *images[i], "s" + std::to_string(i), scripts[i]);
   o << "const Module* const modules[] = {";

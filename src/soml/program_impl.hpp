@@ -16,7 +16,6 @@
 #include "image.hpp"
 #include "opcodes.hpp"
 #include "vsd/core/config.hpp"
-#include "vsd/soml/native_abi.hpp"
 #include "vsd/core/meta_instance.hpp"
 #include "vsd/core/signal.hpp"
 #include "vsd/core/sim_state.hpp"
@@ -24,6 +23,7 @@
 #include "vsd/core/value.hpp"
 #include "vsd/core/watch.hpp"
 #include "vsd/soml/checker.hpp"
+#include "vsd/soml/native_abi.hpp"
 #include "vsd/soml/net_classes.hpp"
 #include "vsd/soml/runtime.hpp"
 

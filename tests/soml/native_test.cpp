@@ -111,8 +111,10 @@ TEST(SomlNative, BudgetAndDepthFailAtTheSamePointAsTheVm) {
     Script vm("arith.soml", text, false, budget), native("arith.soml", text, true, budget);
     SCOPED_TRACE(budget);
     // A loop (backward jumps) and a recursion (calls) exhaust the budget where the VM's does.
-    EXPECT_EQ(vm.call("outer", {vsd::Value(std::int64_t{0})}), native.call("outer", {vsd::Value(std::int64_t{0})}));
-    EXPECT_EQ(vm.call("fib", {vsd::Value(std::int64_t{25})}), native.call("fib", {vsd::Value(std::int64_t{25})}));
+    EXPECT_EQ(vm.call("outer", {vsd::Value(std::int64_t{0})}),
+              native.call("outer", {vsd::Value(std::int64_t{0})}));
+    EXPECT_EQ(vm.call("fib", {vsd::Value(std::int64_t{25})}),
+              native.call("fib", {vsd::Value(std::int64_t{25})}));
     EXPECT_EQ(vm.call("count_loop", {vsd::Value(std::int64_t{1000})}),
               native.call("count_loop", {vsd::Value(std::int64_t{1000})}));
   }
@@ -123,9 +125,10 @@ TEST(SomlNative, BudgetAndDepthFailAtTheSamePointAsTheVm) {
             std::string::npos)
       << deep.substr(0, 300);
   const std::string endless = native.call("outer", {vsd::Value(std::int64_t{0})});
-  EXPECT_NE(endless.find("instruction budget exhausted (10000000 jumps and calls): an endless loop?\n  at spin "
-                         "(arith.soml:"),
-            std::string::npos)
+  EXPECT_NE(
+      endless.find("instruction budget exhausted (10000000 jumps and calls): an endless loop?\n  at spin "
+                   "(arith.soml:"),
+      std::string::npos)
       << endless;
   EXPECT_NE(endless.find("\n  at outer (arith.soml:27:"), std::string::npos) << endless;
 }
@@ -136,7 +139,8 @@ TEST(SomlNative, RandomProgramsMatchTheVm) {
   const std::string text = read_file(VSD_SOML_NATIVE_RANDOM);
   Script vm("random.soml", text, false, 200'000), native("random.soml", text, true, 200'000);
   ASSERT_GE(native.program->native_functions(), std::size_t{VSD_SOML_NATIVE_RANDOM_COUNT});
-  const std::int64_t inputs[] = {0, 1, -1, 7, -13, 1000, 123456789, INT64_MAX, INT64_MIN, 4611686018427387904};
+  const std::int64_t inputs[] = {0,    1,         -1,        7,         -13,
+                                 1000, 123456789, INT64_MAX, INT64_MIN, 4611686018427387904};
   int errors = 0, values = 0;
   for (int f = 0; f < VSD_SOML_NATIVE_RANDOM_COUNT; ++f) {
     const std::string fn = "g" + std::to_string(f);
@@ -164,7 +168,8 @@ TEST(SomlNative, AnotherVersionOfTheScriptIsRefused) {
 TEST(SomlNative, MissingOrBadLibraryIsAClearError) {
   Script run("arith.soml", read_file(kArith), false);
   const std::string missing = error_of([&] { run.program->load_native("/nonexistent/soml_native.so"); });
-  EXPECT_NE(missing.find("cannot load the SOML++ native library '/nonexistent/soml_native.so'"), std::string::npos)
+  EXPECT_NE(missing.find("cannot load the SOML++ native library '/nonexistent/soml_native.so'"),
+            std::string::npos)
       << missing;
   const std::string not_lib = error_of([&] { run.program->load_native(kArith); });
   EXPECT_NE(not_lib.find("cannot load the SOML++ native library"), std::string::npos) << not_lib;

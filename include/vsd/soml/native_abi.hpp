@@ -64,9 +64,9 @@ struct FunctionEntry {
 
 /// The functions of one script (a native library holds one or more).
 struct Module {
-  std::uint32_t abi;        ///< kNativeAbi of the generator
-  std::uint32_t count;      ///< functions
-  std::uint64_t image_hash; ///< the hash of the image it was generated from (Program::image_hash)
+  std::uint32_t abi;         ///< kNativeAbi of the generator
+  std::uint32_t count;       ///< functions
+  std::uint64_t image_hash;  ///< the hash of the image it was generated from (Program::image_hash)
   const FunctionEntry* functions;
   const char* script;  ///< the script's name when it was compiled (for messages)
 };
@@ -78,8 +78,9 @@ using Modules = const Module* const* (*)(std::uint32_t* count);
 
 /// Generated code fails through this: @p budget (what is left, kept in a local) goes back to the Context
 /// first, then the runtime throws.
-[[noreturn, gnu::cold, gnu::noinline]] inline void fail(Context* c, std::uint64_t budget, Fault f, std::uint32_t fn,
-                                                        std::uint32_t at, std::int64_t a = 0, std::int64_t b = 0) {
+[[noreturn, gnu::cold, gnu::noinline]] inline void fail(Context* c, std::uint64_t budget, Fault f,
+                                                        std::uint32_t fn, std::uint32_t at,
+                                                        std::int64_t a = 0, std::int64_t b = 0) {
   c->budget = budget;
   c->fail(c, f, fn, at, a, b);
   __builtin_unreachable();
