@@ -24,7 +24,9 @@ function(vsd_add_soml_module target)
     set(tool "$<TARGET_FILE:vsd_soml_tool>")
     set(tool_dep vsd_soml_tool)
   else()
-    find_program(VSD_SOML_TOOL vsd-soml HINTS "${CMAKE_CURRENT_FUNCTION_LIST_DIR}/../../../bin" REQUIRED)
+    # Installed: <prefix>/lib/cmake/vsd/ -> <prefix>/bin; a build tree: <build>/tools.
+    find_program(VSD_SOML_TOOL vsd-soml
+      HINTS "${CMAKE_CURRENT_FUNCTION_LIST_DIR}/../../../bin" "${CMAKE_CURRENT_FUNCTION_LIST_DIR}/tools" REQUIRED)
     set(tool "${VSD_SOML_TOOL}")
     set(tool_dep "${VSD_SOML_TOOL}")
   endif()
