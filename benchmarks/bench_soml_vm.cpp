@@ -6,8 +6,10 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <fstream>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <unordered_map>
 
@@ -44,19 +46,15 @@ struct Soml {
 // LuaJitInterp (the same with jit.off(): its interpreter), both loaded through luajit_peer.hpp, and Cpp
 // (hand-written C++). Every engine's result is checked against the known value before timing and after
 // every iteration (a wrong result marks the benchmark failed); the input comes in at run time.
-constexpr const char* kFunctions = R"(
-int fib(int n) { if (n < 2) return n; return fib(n - 1) + fib(n - 2); }
-int count_loop(int n) {
-  int s = 0;
-  for (int i = 0; i < n; i++) s += i;
-  return s;
+// The functions (benchmarks/soml/functions.soml, read at run time: the same text that
+// vsd_add_soml_module compiled into the native library VSD_BENCH_SOML_NATIVE).
+std::string functions_text() {
+  std::ifstream in(VSD_BENCH_SOML_FUNCTIONS);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  if (ss.str().empty()) throw std::runtime_error("cannot read " VSD_BENCH_SOML_FUNCTIONS);
+  return ss.str();
 }
-int loop(int n) {
-  int s = 0;
-  for (int i = 0; i < n; i++) { s = s + i * 3 % 7; }
-  return s;
-}
-)";
 
 // The same functions in Lua 5.1 / 5.4 (both run it: integers in 5.4, doubles in LuaJIT, exact here).
 constexpr const char* kLua = R"(
@@ -131,7 +129,9 @@ void run_workload(benchmark::State& state, Engine& engine, const Workload& w) {
 }
 
 struct SomlEngine : Soml {
-  SomlEngine() : Soml(kFunctions) {}
+  explicit SomlEngine(bool native = false) : Soml(functions_text()) {
+    if (native && program->load_native(VSD_BENCH_SOML_NATIVE) < 3) throw std::runtime_error("not native");
+  }
   std::int64_t call(const char* fn, std::int64_t n) {
     return program->root().call(fn, {vsd::Value(n)}).as<std::int64_t>();
   }
@@ -172,6 +172,11 @@ const bool kRegistered = [] {
     const std::string name = w.name;
     benchmark::RegisterBenchmark(("BM_Soml" + name).c_str(), [&w](benchmark::State& s) {
       SomlEngine e;
+      run_workload(s, e, w);
+    })->Unit(benchmark::kMillisecond);
+    // The same script compiled to native code (vsd_add_soml_module; docs/soml.md "Native compilation").
+    benchmark::RegisterBenchmark(("BM_SomlNative" + name).c_str(), [&w](benchmark::State& s) {
+      SomlEngine e(true);
       run_workload(s, e, w);
     })->Unit(benchmark::kMillisecond);
 #if VSD_BENCH_HAVE_LUA

@@ -87,9 +87,13 @@ write_basic_package_version_file(
   VERSION ${PROJECT_VERSION}
   COMPATIBILITY SameMajorVersion)
 
+# vsd_add_soml_module() next to the config file in the build tree too (the config includes it from there).
+configure_file("${CMAKE_CURRENT_LIST_DIR}/VsdSomlModule.cmake" "${PROJECT_BINARY_DIR}/VsdSomlModule.cmake" COPYONLY)
+
 install(FILES
   "${PROJECT_BINARY_DIR}/vsdConfig.cmake"
   "${PROJECT_BINARY_DIR}/vsdConfigVersion.cmake"
+  "${CMAKE_CURRENT_LIST_DIR}/VsdSomlModule.cmake"
   DESTINATION ${VSD_INSTALL_CMAKEDIR}
   COMPONENT vsd_development)
 

@@ -679,7 +679,15 @@ void ProgramImpl::define_image(std::string name, std::string text) {
   };
 
   // 7. Compile.
-  for (auto& [fd, fi] : build().function_index) compile_function(*this, fi, *fd);
+  // In function order, not the map's (pointer hashes): the operand tables (constants, strings, ...) fill
+  // as the code is compiled, and the same text must give the same image every time (the native code
+  // generated from it is matched by the image's hash).
+  {
+    std::vector<std::pair<int, const FunctionDecl*>> order;
+    for (auto& [fd, fi] : build().function_index) order.emplace_back(fi, fd);
+    std::sort(order.begin(), order.end());
+    for (const auto& [fi, fd] : order) compile_function(*this, fi, *fd);
+  }
   for (const ClassDecl* c : build().class_order) {
     ClassInfo& ci = *build().class_info.at(c);
     const std::string cname = c->kind == DeclKind::Script ? build().stem : qualified(*c);

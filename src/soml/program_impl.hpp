@@ -23,6 +23,7 @@
 #include "vsd/core/value.hpp"
 #include "vsd/core/watch.hpp"
 #include "vsd/soml/checker.hpp"
+#include "vsd/soml/native_abi.hpp"
 #include "vsd/soml/net_classes.hpp"
 #include "vsd/soml/runtime.hpp"
 
@@ -78,6 +79,9 @@ struct RunCode {
   // as a frame may still run in it).
   std::vector<Ins> tramp;
   bool patched = false;  // code differs from the image's (a debugger patched it, not restored yet)
+  // Its native code (a library loaded by Program::load_native), called instead of running `code` unless a
+  // debugger is attached (native.cpp).
+  native::Entry native = nullptr;
 };
 
 struct Frame {
@@ -306,6 +310,19 @@ class ProgramImpl {
   }
   [[noreturn, gnu::cold, gnu::noinline]] void memory_exhausted(std::size_t bytes);
   int entry_depth_ = 0;
+  // ---- native code (native.cpp) ----
+  // Routes the functions of the library at @p path generated from this image to native code; returns
+  // how many. @throws vsd::Error when it cannot be loaded or holds no module of this image.
+  std::size_t load_native(const std::string& path);
+  // Calls native @p e with @p depth frames active (its own counted): the budget goes in and comes back,
+  // an error gets the native frames of its call stack (the caller adds the VM's).
+  Val call_native(native::Entry e, std::uint64_t self, const Val* args, std::size_t depth);
+  native::Context nctx_{};
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> native_sites_;  // (function, instruction) of an error
+  std::shared_ptr<void> native_lib_;                                   // the dlopen handle
+  std::size_t native_count_ = 0;
+  // "\n  at NAME (FILE:LINE:COL)": one frame of a reported call stack, at instruction @p at of @p f.
+  std::string frame_text(const Function& f, std::size_t at) const;
   std::vector<std::pair<std::uint64_t, const MetaProperty*>>* deps_ = nullptr;
   std::string stack_text(std::size_t from) const;
 

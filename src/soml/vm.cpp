@@ -189,12 +189,15 @@ std::string ProgramImpl::stack_text(std::size_t from) const {
   std::string s;
   for (std::size_t i = frames_.size(); i-- > from;) {
     const Frame& f = frames_[i];
-    const std::size_t at = pc_index(f);
-    const Function::Pos pos = at < f.fn->positions.size() ? f.fn->positions[at] : Function::Pos{};
-    s += "\n  at " + f.fn->name + " (" + image().checked->source->name() + ":" + std::to_string(pos.line) +
-         ":" + std::to_string(pos.column) + ")";
+    s += frame_text(*f.fn, pc_index(f));
   }
   return s;
+}
+
+std::string ProgramImpl::frame_text(const Function& f, std::size_t at) const {
+  const Function::Pos pos = at < f.positions.size() ? f.positions[at] : Function::Pos{};
+  return "\n  at " + f.name + " (" + image().checked->source->name() + ":" + std::to_string(pos.line) + ":" +
+         std::to_string(pos.column) + ")";
 }
 
 void ProgramImpl::fail(const std::string& what) { throw Error("SOML++ run-time error: " + what); }
@@ -271,6 +274,10 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
   if (entry >= static_cast<std::size_t>(opt_.max_depth))
     fail("call depth limit (" + std::to_string(opt_.max_depth) + ") reached calling " + f.name +
          stack_text(0));
+  if (native::Entry e = run_[static_cast<std::size_t>(fi)].native; e != nullptr && debug_ == nullptr) {
+    // Native code (Program::load_native) takes scalar arguments and returns a scalar: nothing to move.
+    return call_native(e, self, args, entry + 1);
+  }
   const std::uint32_t saved_top = top_;
   const std::uint32_t base = top_;
   if (regs_.size() < base + static_cast<std::size_t>(f.nregs) + 1) {
@@ -1006,6 +1013,11 @@ Val ProgramImpl::exec(std::size_t entry) {
         if (--budget_ == 0)
           fail("instruction budget exhausted (" + std::to_string(opt_.instruction_budget) +
                " jumps and calls): runaway recursion?");
+        if (rc.native != nullptr && debug_ == nullptr) [[unlikely]] {
+          // Native code: arguments from R[a], the result into R[a], as if the callee had run here.
+          R[in.a] = call_native(rc.native, self, &R[in.a], frames_.size() + 1);
+          break;
+        }
         const std::uint32_t nb = fr->base + in.a;
         const std::size_t need = nb + static_cast<std::size_t>(callee.nregs) + 1;
         if (regs_.size() < need) {

@@ -17,6 +17,10 @@ foreach(line IN LISTS lines)
 endforeach()
 # The script's own name, run from its directory: diagnostics and call stacks name "NAME.soml", not a
 # path that depends on the checkout.
+# NATIVE (optional): a native library of the script (vsd-soml compile), passed as `--native NATIVE`.
+if(NATIVE)
+  list(APPEND args --native "${NATIVE}")
+endif()
 get_filename_component(dir "${SCRIPT}" DIRECTORY)
 get_filename_component(name "${SCRIPT}" NAME)
 execute_process(COMMAND "${TOOL}" run "${name}" ${args} WORKING_DIRECTORY "${dir}" OUTPUT_VARIABLE out

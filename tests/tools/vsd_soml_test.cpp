@@ -93,5 +93,31 @@ TEST(VsdSoml, NumbersAreStrict) {
   }
 }
 
+// compile: the C++ of a native library (one module per script; functions outside the native subset left
+// out), -o required, a script with errors reported with its position; run --native refuses what is not a
+// native library of the script.
+TEST(VsdSoml, CompileWritesTheNativeLibrarySource) {
+  const TempDir tmp("vsd_soml_compile");
+  const std::string a = tmp.write("a.soml", "int twice(int n) { return 2 * n; }\nstring s() { return \"x\"; }\n");
+  const std::string b = tmp.write("b.soml", "double half(double x) { return x / 2.0; }\n");
+  const ToolRun r = run({"compile", a, b, "-o", tmp.dir().string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("soml_native.cpp"));
+  const std::string src = TempDir::read(tmp.path("soml_native.cpp"));
+  EXPECT_THAT(src, HasSubstr("#include \"vsd/soml/native_abi.hpp\""));
+  EXPECT_THAT(src, HasSubstr("vsd_soml_native_modules"));
+  EXPECT_THAT(src, HasSubstr("// twice\n"));
+  EXPECT_THAT(src, HasSubstr("// half\n"));
+  EXPECT_THAT(src, testing::Not(HasSubstr("// s\n")));  // a string: stays in the VM
+  EXPECT_EQ(run({"compile", a}).code, 2);                 // no -o
+  const std::string bad = tmp.write("bad.soml", "int f() { return x; }\n");
+  const ToolRun e = run({"compile", bad, "-o", tmp.dir().string()});
+  EXPECT_EQ(e.code, 1);
+  EXPECT_THAT(e.err, HasSubstr("bad.soml:1:"));
+  const ToolRun n = run({"run", a, "--native", a});
+  EXPECT_EQ(n.code, 1);
+  EXPECT_THAT(n.err, HasSubstr("cannot load the SOML++ native library"));
+}
+
 }  // namespace
 }  // namespace vsd_soml_tool_test

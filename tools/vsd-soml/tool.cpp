@@ -26,10 +26,11 @@ namespace an = vsd::analysis;
 
 constexpr std::string_view usage =
     "Usage: vsd-soml analyze FILE [--json] [--threads N] [--limit-mem SIZE] [--progress | --no-progress]\n"
-    "       vsd-soml run FILE [--steps N] [--trace] [--seed S]\n"
+    "       vsd-soml run FILE [--steps N] [--trace] [--seed S] [--native LIB]\n"
     "       vsd-soml debug FILE [--break FILE:LINE]... [--break-transition NAME]... [--seed S] [--steps N]\n"
     "       vsd-soml convert IN OUT\n"
     "       vsd-soml disasm FILE\n"
+    "       vsd-soml compile FILE... -o DIR\n"
     "       vsd-soml --help\n"
     "\n"
     "run      Loads the SOML++ script FILE into a database and fires its transitions: N firings, or until\n"
@@ -39,6 +40,8 @@ constexpr std::string_view usage =
     "  --steps N         fire at most N transitions\n"
     "  --trace           print every firing: step, transition, the token it moved, from where to where\n"
     "  --seed S          the seed of the choice among enabled transitions (default 1)\n"
+    "  --native LIB      run the functions the native library LIB holds for FILE natively (made by\n"
+    "                    compile from the same FILE; another version of FILE is refused)\n"
     "\n"
     "debug    Loads FILE like run and reads debugger commands from stdin: break, delete, step, next,\n"
     "         finish, continue, bt, frame, locals, print, marking, trace, quit (`help` lists them).\n"
@@ -76,6 +79,12 @@ constexpr std::string_view usage =
     "         # immediate, k constant, s string, p property, f function, c class, m method, -> target) and\n"
     "         the line:column it computes, with what an operand names; then the constants and strings.\n"
     "         Errors in the script are printed with file:line:col.\n"
+    "\n"
+    "compile  Loads each SOML++ script FILE as disasm does and writes DIR/soml_native.cpp: C++ of the\n"
+    "         functions that have a native translation (int and double arithmetic, comparisons, loops,\n"
+    "         calls of such functions, print of numbers), one module per FILE. Build it as a shared\n"
+    "         library (c++ -std=c++20 -O2 -fPIC -shared -I<vsd include dir>; CMake: vsd_add_soml_module)\n"
+    "         and load it with `run --native` or Program::load_native. DIR must exist.\n"
     "\n"
     "FILE and IN may be \"-\" (standard input; a net in XML is taken as PNML) or a pipe, except for debug,\n"
     "which reads its commands there. vsd-soml knows vsd's own classes (Node, the scene, robotics and\n"
@@ -144,7 +153,7 @@ std::set<std::string> undefined_classes(std::string_view message) {
 }
 
 int run_script(std::span<const std::string_view> args, std::ostream& out, std::ostream& err) {
-  const Arguments a(args, {with_value("--steps"), with_value("--seed"), flag("--trace")});
+  const Arguments a(args, {with_value("--steps"), with_value("--seed"), flag("--trace"), with_value("--native")});
   a.expect_positional(1, 1, "one FILE");
   const std::string_view path = a.positional()[0];
   const std::uint64_t steps = a.unsigned_integer("--steps", 1'000'000, UINT64_MAX);
@@ -179,6 +188,14 @@ int run_script(std::span<const std::string_view> args, std::ostream& out, std::o
              "objects\" in README.md)\n";
     }
     return exit_failure;
+  }
+  if (const auto lib = a.value("--native")) {
+    try {
+      p->load_native(std::string(*lib));
+    } catch (const vsd::Error& e) {
+      err << printable_lines(e.what()) << "\n";
+      return exit_failure;
+    }
   }
   if (trace)
     p->on_firing([&out](const vsd::soml::Firing& f) {
@@ -269,17 +286,46 @@ int disasm(std::span<const std::string_view> args, std::ostream& out, std::ostre
   return exit_ok;
 }
 
+// vsd-soml compile FILE... -o DIR: the C++ of a native library of the scripts (native_library_source).
+int compile(std::span<const std::string_view> args, std::ostream& out, std::ostream& err) {
+  const Arguments a(args, {with_value("-o")});
+  a.expect_positional(1, 1000, "one or more FILEs");
+  const auto dir = a.value("-o");
+  if (!dir) throw UsageError("compile needs -o DIR");
+  Workspace ws;
+  auto& soml = ws.env().use<vsd::soml::Module>();
+  std::vector<const vsd::soml::Program*> programs;
+  for (const std::string_view path : a.positional()) {
+    const std::string file = path == "-" ? "<stdin>" : std::string(path);
+    try {
+      // Each script in a state of its own (their objects and classes do not meet).
+      vsd::SimState& state = programs.empty() ? ws.state() : ws.env().create_state(file);
+      const vsd::soml::Program& p = soml.load(state, file, as_text(read_input(path)));
+      programs.push_back(&p);
+    } catch (const vsd::Error& e) {
+      const std::string m = printable_lines(e.what());
+      err << m << (m.ends_with("\n") ? "" : "\n");
+      return exit_failure;
+    }
+  }
+  const std::string target = std::string(*dir) + "/soml_native.cpp";
+  write_output(target, vsd::soml::native_library_source(programs), out);
+  out << "wrote " << printable(target) << "\n";
+  return exit_ok;
+}
+
 }  // namespace
 
 int run(std::span<const std::string_view> args, std::istream& in, std::ostream& out, std::ostream& err) {
   return tool::run(tool, args, out, err, [&in](std::span<const std::string_view> a, std::ostream& o, std::ostream& e) {
-    if (a.empty()) throw UsageError("no command (run, debug, analyze, convert or disasm)");
+    if (a.empty()) throw UsageError("no command (run, debug, analyze, convert, disasm or compile)");
     const auto rest = a.subspan(1);
     if (a[0] == "analyze") return analyze(rest, o, e);
     if (a[0] == "run") return run_script(rest, o, e);
     if (a[0] == "debug") return debug_command(rest, in, o, e);
     if (a[0] == "convert") return convert(rest, o, e);
     if (a[0] == "disasm") return disasm(rest, o, e);
+    if (a[0] == "compile") return compile(rest, o, e);
     throw UsageError("unknown command '" + printable(a[0]) + "'");
   });
 }

@@ -183,6 +183,21 @@ class Program {
   /// patches are not shown, constants naming objects show 0 (their ids are linked at run time).
   [[nodiscard]] std::string disassemble() const;
 
+  /// @brief Runs the functions that the native library at @p path holds for this program's image in
+  /// native code from now on (docs/soml.md, "Native compilation"): calls from C++ (MetaMethods), from
+  /// VM code and from native code. The library is made by `vsd-soml compile` (or the CMake function
+  /// vsd_add_soml_module) from the same script; functions it does not hold keep running in the VM, and
+  /// so does everything while a debugger is attached. A second call replaces the first library.
+  /// @return how many functions run natively.
+  /// @throws vsd::Error when the library cannot be opened, is no SOML++ native library, was made for
+  /// another native ABI, or holds no code of this version of the script (another image hash); the
+  /// program then runs as before.
+  std::size_t load_native(const std::string& path);
+  /// @brief How many functions run natively (0 until load_native succeeded).
+  [[nodiscard]] std::size_t native_functions() const noexcept;
+  /// @brief The hash of the compiled program that a native library must have been generated from.
+  [[nodiscard]] std::uint64_t image_hash() const;
+
   /// @brief The implementation (for the Module and the tools).
   [[nodiscard]] ProgramImpl& impl() noexcept { return *impl_; }
 
@@ -190,5 +205,10 @@ class Program {
   explicit Program(std::shared_ptr<ProgramImpl> impl);
   std::shared_ptr<ProgramImpl> impl_;
 };
+
+/// @brief The C++ source of a native library (`vsd-soml compile`; docs/soml.md, "Native compilation")
+/// holding the functions of each of @p programs that have a native translation: one module per program,
+/// found by its image hash when loaded. It includes only vsd/soml/native_abi.hpp.
+[[nodiscard]] std::string native_library_source(const std::vector<const Program*>& programs);
 
 }  // namespace vsd::soml

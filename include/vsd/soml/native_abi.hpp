@@ -1,0 +1,89 @@
+/// @file
+/// @brief The interface between the SOML++ runtime and the C++ that `vsd-soml compile` generates from a
+/// script (docs/soml.md, "Native compilation"). Generated code includes only this header (it compiles in
+/// a fraction of a second per thousand lines); nothing else of vsd is needed to build a native module.
+/// The layout is versioned by kNativeAbi: a module of another version is refused when loaded.
+#pragma once
+
+#include <cstdint>
+
+namespace vsd::soml::native {
+
+/// The ABI version a module was generated for (Program::load_native refuses any other).
+inline constexpr std::uint32_t kNativeAbi = 1;
+
+/// A register as the VM holds it: ints, bools and enums in i, doubles in d, references as ids.
+union Reg {
+  std::int64_t i;
+  double d;
+  std::uint64_t id;
+};
+
+/// What a failing instruction reports (the runtime words the message exactly as the VM does).
+enum class Fault : std::uint32_t {
+  Add,  ///< a + b does not fit an int
+  Sub,  ///< a - b does not fit an int
+  Mul,  ///< a * b does not fit an int
+  Div,  ///< a / b does not fit an int
+  Neg,  ///< -a does not fit an int
+  Abs,  ///< abs(a) does not fit an int
+  DivisionByZero,
+  NullReference,  ///< a call on a null instance
+  DoubleToInt,    ///< the double whose bits are a does not fit an int
+  LoopBudget,     ///< a backward jump found the instruction budget spent
+  CallBudget,     ///< a call found the instruction budget spent
+  Depth,          ///< the call depth limit reached calling function b
+  Fail,           ///< OP_FAIL: run-time error strings[b]
+};
+
+/// The runtime's side: the budget and depth limit the VM keeps, and the calls back for what native code
+/// does not do itself (errors, print). Filled by the runtime before every entry into native code.
+struct Context {
+  std::uint64_t budget;     ///< jumps and calls left (the VM's count: backward jumps and calls)
+  std::uint32_t max_depth;  ///< RunOptions::max_depth: frames (VM and native) at most
+  std::uint32_t pad;
+  void* runtime;  ///< the ProgramImpl
+  /// Throws the run-time error of @p fault at instruction @p at of function @p fn (never returns).
+  void (*fail)(Context* ctx, Fault fault, std::uint32_t fn, std::uint32_t at, std::int64_t a, std::int64_t b);
+  /// An exception passes the call at instruction @p at of function @p fn: the runtime adds the frame to
+  /// the call stack it reports.
+  void (*unwind)(Context* ctx, std::uint32_t fn, std::uint32_t at);
+  /// OP_PRINT number @p index of the image (its print_kinds) over @p regs.
+  void (*print)(Context* ctx, std::uint32_t index, const Reg* regs);
+};
+
+/// A function of the module as the runtime calls it: arguments in @p args (as the VM's registers), the
+/// result (0 for none) returned; @p depth frames are active (the new one counted).
+using Entry = Reg (*)(Context* ctx, std::uint32_t depth, std::uint64_t self, const Reg* args);
+
+/// One compiled function: its index in the program image and its entry.
+struct FunctionEntry {
+  std::uint32_t index;
+  Entry entry;
+};
+
+/// The functions of one script (a native library holds one or more).
+struct Module {
+  std::uint32_t abi;         ///< kNativeAbi of the generator
+  std::uint32_t count;       ///< functions
+  std::uint64_t image_hash;  ///< the hash of the image it was generated from (Program::image_hash)
+  const FunctionEntry* functions;
+  const char* script;  ///< the script's name when it was compiled (for messages)
+};
+
+/// What a native library exports: an extern "C" function of this name, of type Modules, that returns
+/// its modules (Program::load_native picks the one generated from the program's image).
+inline constexpr const char* kModulesSymbol = "vsd_soml_native_modules";
+using Modules = const Module* const* (*)(std::uint32_t* count);
+
+/// Generated code fails through this: @p budget (what is left, kept in a local) goes back to the Context
+/// first, then the runtime throws.
+[[noreturn, gnu::cold, gnu::noinline]] inline void fail(Context* c, std::uint64_t budget, Fault f,
+                                                        std::uint32_t fn, std::uint32_t at,
+                                                        std::int64_t a = 0, std::int64_t b = 0) {
+  c->budget = budget;
+  c->fail(c, f, fn, at, a, b);
+  __builtin_unreachable();
+}
+
+}  // namespace vsd::soml::native
