@@ -74,16 +74,19 @@ struct Callback {
 };
 
 PyConnection connect_instance_signal(const std::shared_ptr<StateBox>& box, vsd::SimState::InstanceSink sink,
-                                     py::object fn, const char* where) {
+                                     py::object fn, const char* where, bool deleting = false) {
   Callback cb(std::move(fn));
   std::weak_ptr<StateBox> weak = box;
   PyConnection c;
   c.box = box;
-  c.connection = sink.connect([cb, weak, where](SimStateInstance& inst) {
+  c.connection = sink.connect([cb, weak, where, deleting](SimStateInstance& inst) {
     py::gil_scoped_acquire gil;
     auto b = weak.lock();
     if (!b) return;
+    const vsd::SimStateInstance* outer = b->dying;
+    if (deleting) b->dying = &inst;
     call_listener(*cb.fn, where, wrap(b, &inst));
+    b->dying = outer;
   });
   return c;
 }
@@ -187,17 +190,19 @@ void bind_entry_points(py::module_& m) {
         for (SimStateInstance* i : s.get().instances()) l.append(wrap(s.box, i));
         return l;
       })
-      .def("index", [](const PyState& s, py::handle cls) { return py::module_::import("vsd._core").attr("_instances")(s.box, cls); },
+      .def("index", [](const PyState& s, py::handle cls) { s.get();
+             return instance_list(s.box, cls);
+           },
            "The instances of a class (subclasses included), in the order column() uses")
       .def("column", [](const PyState& s, py::handle cls, const std::string& p) {
              s.get();
-             return py::module_::import("vsd._core").attr("_column")(s.box, cls, p);
+             return column(s.box, cls, p);
            },
            "One property of every instance of a class as a NumPy array (or a list), in index() order")
       .def("set_column",
            [](const PyState& s, py::handle cls, const std::string& p, py::handle values) {
              s.get();
-             py::module_::import("vsd._core").attr("_set_column")(s.box, cls, p, values);
+             set_column(s.box, cls, p, values);
            },
            "Sets one property of every instance of a class from an array, through the setters")
       .def("start_recording", [](const PyState& s) { s.get().start_recording(); })
@@ -220,7 +225,7 @@ void bind_entry_points(py::module_& m) {
         return connect_instance_signal(s.box, s.get().on_created(), std::move(fn), "vsd on_created listener");
       })
       .def("on_deleted", [](const PyState& s, py::object fn) {
-        return connect_instance_signal(s.box, s.get().on_deleted(), std::move(fn), "vsd on_deleted listener");
+        return connect_instance_signal(s.box, s.get().on_deleted(), std::move(fn), "vsd on_deleted listener", true);
       })
       .def(
           "on_property_changed",

@@ -21,7 +21,9 @@ using vsd::TypeKind;
 
 // Python classes of vsd classes, by class. Made on first use by the factory vsd/__init__.py installs.
 struct Classes {
-  std::unordered_map<const MetaInstance*, py::object> by_class;
+  // By MetaInstance::index(), which no other class ever gets: a class that SOML++ or a closing
+  // Environment undefined may leave its memory to a new class, never its index.
+  std::unordered_map<std::size_t, py::object> by_class;
   py::object factory;      // vsd._class_for(name) -> Python class
   py::object handle_init;  // the pybind11 __init__ of the handle type
 };
@@ -32,10 +34,10 @@ Classes& classes() {
 
 py::object python_class(const MetaInstance& cls) {
   auto& c = classes();
-  auto it = c.by_class.find(&cls);
+  auto it = c.by_class.find(cls.index());
   if (it != c.by_class.end()) return it->second;
   py::object type = c.factory(cls.name());
-  c.by_class.emplace(&cls, type);
+  c.by_class.emplace(cls.index(), type);
   return type;
 }
 
@@ -137,6 +139,8 @@ void set_column_of(const std::vector<SimStateInstance*>& items, const MetaProper
   for (std::size_t i = 0; i < items.size(); ++i) p.set<T>(*items[i], in[i]);  // recorded and signalled
 }
 
+}  // namespace
+
 py::object column(const std::shared_ptr<StateBox>& box, py::handle cls, const std::string& name) {
   const MetaInstance& c = class_of_arg(cls);
   const MetaProperty& p = [&]() -> const MetaProperty& {
@@ -184,6 +188,8 @@ void set_column(const std::shared_ptr<StateBox>& box, py::handle cls, const std:
     converted.push_back(from_py(t, values[py::int_(i)], who(*p) + "[" + std::to_string(i) + "]"));
   for (std::size_t i = 0; i < items.size(); ++i) p->assign_raw(*items[i], converted[i].data());
 }
+
+namespace {
 
 std::string type_hint(const MetaType& t) {
   switch (t.kind()) {
@@ -266,10 +272,10 @@ void bind_instances(py::module_& m) {
 
   m.def("_set_class_factory", [](py::object f) { classes().factory = std::move(f); });
   m.def("_register_class", [](const std::string& name, py::object cls) {
-    classes().by_class[&class_named(name)] = std::move(cls);
+    classes().by_class[class_named(name).index()] = std::move(cls);
   });
   m.def("_forget_class", [](const std::string& name) {
-    if (const MetaInstance* c = registry().find_class_exact(name)) classes().by_class.erase(c);
+    if (const MetaInstance* c = registry().find_class_exact(name)) classes().by_class.erase(c->index());
   });
   m.def(
       "class_info",
@@ -277,6 +283,7 @@ void bind_instances(py::module_& m) {
         const MetaInstance& c = class_named(name);
         py::dict d;
         d["name"] = c.name();
+        d["index"] = c.index();
         d["base"] = c.base() != nullptr ? py::object(py::str(c.base()->name())) : py::object(py::none());
         d["abstract"] = c.is_abstract();
         d["runtime"] = c.is_runtime();
@@ -309,9 +316,6 @@ void bind_instances(py::module_& m) {
     for (const MetaInstance* c : registry().classes()) names.push_back(c->name());
     return names;
   });
-  m.def("_column", &column);
-  m.def("_set_column", &set_column);
-  m.def("_instances", &instance_list);
   m.def("_node_add_child", [](const Handle& parent, const Handle& child) {
     auto* p = parent.get().as<vsd::Node>();
     auto* c = child.get().as<vsd::Node>();

@@ -17,19 +17,34 @@ using vsd::MetaType;
 using vsd::TypeKind;
 
 // Python enum classes of vsd enum and flags types, made by vsd/__init__.py's factory on first use.
-std::unordered_map<const MetaType*, py::object>& enum_classes() {
-  static auto* m = new std::unordered_map<const MetaType*, py::object>();  // lives as long as the module
+// A run-time enum that is undefined may leave its memory to another: an entry is used only while the
+// type at its address still has its name and values.
+struct EnumEntry {
+  std::string name;
+  std::vector<MetaType::EnumValue> values;
+  py::object cls;
+};
+std::unordered_map<const MetaType*, EnumEntry>& enum_classes() {
+  static auto* m = new std::unordered_map<const MetaType*, EnumEntry>();  // lives as long as the module
   return *m;
+}
+
+bool same_values(const std::vector<MetaType::EnumValue>& a, const std::vector<MetaType::EnumValue>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i].name != b[i].name || a[i].value != b[i].value) return false;
+  return true;
 }
 
 py::object enum_class(const MetaType& t) {
   auto& cache = enum_classes();
   auto it = cache.find(&t);
-  if (it != cache.end()) return it->second;
+  if (it != cache.end() && it->second.name == t.name() && same_values(it->second.values, t.enum_values()))
+    return it->second.cls;
   py::list values;
   for (const auto& v : t.enum_values()) values.append(py::make_tuple(v.name, v.value));
   py::object cls = py::module_::import("vsd").attr("_make_enum")(t.name(), values, t.kind() == TypeKind::Flags);
-  cache.emplace(&t, cls);
+  cache[&t] = EnumEntry{t.name(), t.enum_values(), cls};
   return cls;
 }
 

@@ -21,6 +21,9 @@ struct StateBox {
   vsd::SimState* state = nullptr;
   bool alive = true;
   std::shared_ptr<EnvBox> env;
+  // The instance an on_deleted listener is told about: it has left the id map already, but is whole
+  // until the listeners return, so its handles work meanwhile.
+  const vsd::SimStateInstance* dying = nullptr;
 };
 
 /// The Environment a Python `vsd.Environment` owns; destroyed when the last Python object that needs it
@@ -42,7 +45,7 @@ struct Handle {
   vsd::Id id = vsd::null_id;
 
   [[nodiscard]] bool alive() const noexcept {
-    return box != nullptr && box->alive && box->state->find(id) == ptr;
+    return box != nullptr && box->alive && (box->state->find(id) == ptr || (ptr == box->dying && ptr != nullptr));
   }
   /// The instance; raises vsd.DeadInstanceError when it is gone.
   vsd::SimStateInstance& get() const {
@@ -61,6 +64,14 @@ py::object wrap_in(const std::shared_ptr<EnvBox>& env, vsd::SimStateInstance* in
 py::object to_py(const vsd::MetaType& t, const void* p, const std::shared_ptr<StateBox>& box);
 /// A Python object as a Value of type @p t; raises TypeError naming @p what and the expected type.
 vsd::Value from_py(const vsd::MetaType& t, py::handle o, const std::string& what);
+
+/// The instances of a class (a Python vsd class or a class name; subclasses included), in index order.
+py::list instance_list(const std::shared_ptr<StateBox>& box, py::handle cls);
+/// Property @p name of every instance of @p cls (index order): a NumPy array for numbers, stacked arrays
+/// for the Eigen types, else a list.
+py::object column(const std::shared_ptr<StateBox>& box, py::handle cls, const std::string& name);
+/// Sets property @p name of every instance of @p cls from @p values, through the setters.
+void set_column(const std::shared_ptr<StateBox>& box, py::handle cls, const std::string& name, py::handle values);
 
 /// The registry the module uses (the global one).
 vsd::Registry& registry();

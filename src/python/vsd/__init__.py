@@ -37,7 +37,7 @@ except ImportError:  # vsd::soml not built
 
 Instance = None  # replaced below by the Python class of vsd's root class
 
-_classes = {}  # full vsd class name -> Python class
+_classes = {}  # full vsd class name -> (class index, Python class): an undefined class's name may come back
 _enums = {}
 
 
@@ -47,11 +47,12 @@ def _short(name):
 
 def _make_enum(name, values, is_flags):
     """The Python enum (IntEnum, or IntFlag for flags) of a vsd enum or flags type."""
-    cls = _enums.get(name)
+    key = (name, tuple(values))
+    cls = _enums.get(key)
     if cls is None:
         base = _enum.IntFlag if is_flags else _enum.IntEnum
         cls = base(_short(name), [(n, v) for n, v in values], module=__name__)
-        _enums[name] = cls
+        _enums[key] = cls
     return cls
 
 
@@ -81,9 +82,9 @@ def _class_for(name):
     """The Python class of the vsd class `name` (made on first use, with its bases)."""
     info = class_info(name)
     full = info["name"]
-    cls = _classes.get(full)
-    if cls is not None:
-        return cls
+    known = _classes.get(full)
+    if known is not None and known[0] == info["index"]:
+        return known[1]
     base = _class_for(info["base"]) if info["base"] is not None else _core._Handle
     ns = {
         "__slots__": (),
@@ -100,7 +101,7 @@ def _class_for(name):
     for k, v in _extras.get(full, {}).items():
         ns.setdefault(k, v)
     cls = type(_short(full), (base,), ns)
-    _classes[full] = cls
+    _classes[full] = (info["index"], cls)
     return cls
 
 
@@ -145,7 +146,7 @@ def _define_from_python(cls):
         if mname not in cls.__dict__:
             setattr(cls, mname, meth)
     cls._vsd_class = info["name"]
-    _classes[info["name"]] = cls
+    _classes[info["name"]] = (info["index"], cls)
     _core._register_class(info["name"], cls)
 
 
