@@ -25,19 +25,6 @@ using vsd::SimStateInstance;
 
 py::object python_callback_error_hook;
 
-// A Python environment: owns the C++ one through its EnvBox.
-struct PyEnvironment {
-  std::shared_ptr<EnvBox> box;
-};
-
-// A Python SimState: a StateBox.
-struct PyState {
-  std::shared_ptr<StateBox> box;
-  SimState& get() const {
-    if (!box->alive) throw py::value_error("the state was removed");
-    return *box->state;
-  }
-};
 
 // A listener connected from Python; disconnects when closed or collected.
 struct PyConnection {
@@ -352,4 +339,5 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "vsd's Python bindings (the compiled part; import vsd)";
   vsdpy::bind_entry_points(m);
   vsdpy::bind_instances(m);
+  vsdpy::bind_modules(m);
 }

@@ -270,6 +270,12 @@ void bind_instances(py::module_& m) {
       });
   classes().handle_init = m.attr("_Handle").attr("__init__");
 
+  // The benchmark's reference (benchmarks/python_bench.py): a plain C++ member bound with def_readwrite.
+  struct BenchStruct {
+    double x = 0.0;
+  };
+  py::class_<BenchStruct>(m, "_BenchStruct").def(py::init<>()).def_readwrite("x", &BenchStruct::x);
+
   m.def("_set_class_factory", [](py::object f) { classes().factory = std::move(f); });
   m.def("_register_class", [](const std::string& name, py::object cls) {
     classes().by_class[class_named(name).index()] = std::move(cls);

@@ -55,6 +55,20 @@ struct Handle {
   [[noreturn]] void throw_dead() const;
 };
 
+/// A Python environment: owns the C++ one through its EnvBox.
+struct PyEnvironment {
+  std::shared_ptr<EnvBox> box;
+};
+
+/// A Python SimState: a StateBox.
+struct PyState {
+  std::shared_ptr<StateBox> box;
+  vsd::SimState& get() const {
+    if (!box->alive) throw py::value_error("the state was removed");
+    return *box->state;
+  }
+};
+
 /// The Python object (of the Python class of its vsd class) for @p inst; None for nullptr.
 py::object wrap(const std::shared_ptr<StateBox>& box, vsd::SimStateInstance* inst);
 /// The Python object for @p inst, found through the state box of its SimState in @p env.
@@ -78,6 +92,7 @@ vsd::Registry& registry();
 
 // Parts of the module, each in its own file.
 void bind_instances(py::module_& m);   // instances.cpp: handles, classes, properties, methods, columns
-void bind_entry_points(py::module_& m);  // entry.cpp: Environment, SimState, Transaction, io, modules
+void bind_entry_points(py::module_& m);  // entry.cpp: Environment, SimState, Transaction, io, SOML++
+void bind_modules(py::module_& m);       // modules.cpp: scene (URDF) and robotics (FK, IK), when built
 
 }  // namespace vsdpy

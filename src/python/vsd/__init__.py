@@ -34,6 +34,14 @@ try:
     from ._core import soml  # noqa: F401
 except ImportError:  # vsd::soml not built
     pass
+try:
+    from ._core import scene  # noqa: F401
+except ImportError:  # vsd::scene not built
+    pass
+try:
+    from ._core import robotics  # noqa: F401
+except ImportError:  # vsd::robotics not built
+    pass
 
 Instance = None  # replaced below by the Python class of vsd's root class
 
