@@ -1,4 +1,5 @@
 # Every ```python block of docs/python.md runs, in order, in one namespace.
+import gc
 import os
 import re
 
@@ -18,3 +19,5 @@ def test_docs_python_blocks(monkeypatch):
             exec(compile(block, f"docs/python.md block {i + 1}", "exec"), ns)
         except Exception as e:  # pragma: no cover - the message says which block
             pytest.fail(f"docs/python.md block {i + 1}: {type(e).__name__}: {e}")
+    ns.clear()  # the environments go, and the SOML++ classes with them
+    gc.collect()
