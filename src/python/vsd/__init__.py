@@ -26,22 +26,10 @@ from ._core import (  # noqa: F401  (the package's API)
     type_names,
 )
 
-try:
-    from ._core import io  # noqa: F401
-except ImportError:  # vsd::io not built
-    pass
-try:
-    from ._core import soml  # noqa: F401
-except ImportError:  # vsd::soml not built
-    pass
-try:
-    from ._core import scene  # noqa: F401
-except ImportError:  # vsd::scene not built
-    pass
-try:
-    from ._core import robotics  # noqa: F401
-except ImportError:  # vsd::robotics not built
-    pass
+# The modules' entry points (vsd.io, vsd.soml, vsd.scene, vsd.robotics): only those of the modules built.
+for _name in ("io", "soml", "scene", "robotics"):
+    if hasattr(_core, _name):
+        globals()[_name] = getattr(_core, _name)
 
 Instance = None  # replaced below by the Python class of vsd's root class
 
