@@ -139,3 +139,22 @@ def test_soml_load_errors(env):
     with pytest.raises(vsd.Error, match="bad.soml"):
         vsd.soml.load(env, env.main_state, "bad.soml", "class {")
     gc.collect()
+
+
+def test_python_class_annotations(env):
+    class Holder(vsd.Node):
+        target: vsd.Node
+        samples: "vector<double>" = [1.0, 2.0]
+        on: bool = True
+
+    s = env.main_state
+    h = s.create(Holder)
+    assert h.target is None and h.samples == [1.0, 2.0] and h.on is True
+    other = s.create("Node", name="o")
+    h.target = other
+    assert h.target == other
+    s.destroy(other)
+    assert h.target is None  # a shared reference is nulled when its target dies
+    with pytest.raises(vsd.Error, match="defined already"):
+        class Holder(vsd.Node):  # noqa: F811  (the same name, other properties)
+            something_else: int = 1
