@@ -25,7 +25,8 @@ struct Classes {
   // Environment undefined may leave its memory to a new class, never its index.
   std::unordered_map<std::size_t, py::object> by_class;
   py::object factory;      // vsd._class_for(name) -> Python class
-  py::object handle_init;  // the pybind11 __init__ of the handle type
+  py::object handle_new;   // the pybind11 __new__ and __init__ of the handle type: the Python classes'
+  py::object handle_init;  // own __new__ refuses direct construction (instances come from SimState.create)
 };
 Classes& classes() {
   static auto* c = new Classes();  // lives as long as the interpreter (never destroyed: holds Python objects)
@@ -226,7 +227,7 @@ void Handle::throw_dead() const {
 py::object wrap(const std::shared_ptr<StateBox>& box, SimStateInstance* inst) {
   if (inst == nullptr) return py::none();
   py::object type = python_class(inst->meta());
-  py::object obj = type.attr("__new__")(type);
+  py::object obj = classes().handle_new(type);
   classes().handle_init(obj);
   Handle& h = obj.cast<Handle&>();
   h.box = box;
@@ -268,6 +269,7 @@ void bind_instances(py::module_& m) {
           r += " '" + p->get<std::string>(*h.ptr) + "'";
         return r + ">";
       });
+  classes().handle_new = m.attr("_Handle").attr("__new__");
   classes().handle_init = m.attr("_Handle").attr("__init__");
 
   // The benchmark's reference (benchmarks/python_bench.py): a plain C++ member bound with def_readwrite.

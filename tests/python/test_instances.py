@@ -23,6 +23,11 @@ def test_create_with_keywords_and_python_class(env):
     assert n.name == "k" and type(n) is vsd.Node
 
 
+def test_no_direct_construction():
+    with pytest.raises(TypeError, match=r"state.create\(Node"):
+        vsd.Node()
+
+
 def test_unknown_class_names(env):
     with pytest.raises(KeyError, match="NoSuchClass"):
         env.main_state.create("NoSuchClass")

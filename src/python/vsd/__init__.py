@@ -155,6 +155,14 @@ def _init_subclass(cls, **kwargs):
 Instance.__init_subclass__ = classmethod(_init_subclass)
 
 
+def _no_direct_construction(cls, *args, **kwargs):
+    raise TypeError(f"vsd instances live in a SimState: use state.create({cls.__name__}, ...), "
+                    f"not {cls.__name__}()")
+
+
+Instance.__new__ = _no_direct_construction
+
+
 class _Recording:
     """`with state.record() as r: ...` records the changes made inside into r.transaction."""
 
