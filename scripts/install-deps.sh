@@ -15,6 +15,9 @@
 #   web         vsd::web: cpp-httplib; npm (the page's JavaScript libraries come from the npm registry,
 #               pinned by src/web/page/package-lock.json) unless an npm is installed already
 #   modules     all of the six above
+#   python      the Python bindings (the extension module vsd, VSD_WITH_PYTHON): pybind11 and the Python
+#               headers to build it, NumPy (arrays of vectors, frames and columns), pytest (its tests) and
+#               matplotlib (the example's plot)
 #   tests       GoogleTest and GoogleMock; Orocos KDL (the robotics tests' reference), gnuplot (the
 #               examples' plots), python3 (the docs' C++ blocks are compiled by a test), ccache (the
 #               packaging tests' builds reuse the Release tree's objects), Chromium (the inspector's
@@ -37,18 +40,19 @@ GROUP[dist]="cyclonedds-dev cyclonedds-tools"
 GROUP[collision]="libfcl-dev libccd-dev"
 GROUP[physics]="libode-dev pkg-config"
 GROUP[web]="libcpp-httplib-dev pkg-config @npm"
+GROUP[python]="pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib"
 GROUP[tests]="libgtest-dev libgmock-dev liborocos-kdl-dev gnuplot-nox python3 ccache chromium"
 GROUP[benchmarks]="libbenchmark-dev librttr-dev qtbase5-dev libboost-dev libsigc++-3.0-dev liblua5.4-dev libluajit-5.1-dev libmujoco-dev libdart-dev libdart-utils-urdf-dev libdart-collision-ode-dev"
 GROUP[fuzzing]="clang libclang-rt-14-dev"
 MODULES="analysis scene dist collision physics web"
-ALL="core $MODULES tests benchmarks fuzzing"
+ALL="core $MODULES python tests benchmarks fuzzing"
 
 if [[ "${VSD_SKIP_DEPS:-0}" == "1" ]]; then
   echo "install-deps: VSD_SKIP_DEPS=1, skipping"
   exit 0
 fi
 if [[ $# -eq 0 ]]; then
-  echo "usage: install-deps.sh GROUP... (core analysis scene dist collision physics web modules tests benchmarks fuzzing all)" >&2
+  echo "usage: install-deps.sh GROUP... (core analysis scene dist collision physics web modules python tests benchmarks fuzzing all)" >&2
   exit 2
 fi
 

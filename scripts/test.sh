@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Builds everything and runs the whole vsd test suite with ctest.
 #   bash scripts/test.sh [extra cmake configure arguments...]
-# It installs the core, every module's libraries and the tests' packages (scripts/install-deps.sh core
-# modules tests), and the benchmarks' too when the arguments switch them on (-DVSD_BUILD_BENCHMARKS=ON).
+# It installs the core, every module's libraries, the Python bindings' packages and the tests' packages
+# (scripts/install-deps.sh core modules python tests), and the benchmarks' too when the arguments switch them on (-DVSD_BUILD_BENCHMARKS=ON).
 # Environment:
 #   BUILD_DIR        build directory (default build)
 #   BUILD_TYPE       CMAKE_BUILD_TYPE (default Release, the same tree scripts/demo.sh uses)
@@ -16,7 +16,7 @@ BUILD_DIR="${BUILD_DIR:-build}"
 BUILD_TYPE="${BUILD_TYPE:-Release}"
 VSD_WERROR="${VSD_WERROR:-OFF}"
 
-groups=(core modules tests)
+groups=(core modules python tests)
 for arg in "$@"; do
   [[ "$arg" == "-DVSD_BUILD_BENCHMARKS=ON" ]] && groups+=(benchmarks)
 done
