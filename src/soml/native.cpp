@@ -121,17 +121,9 @@ std::uint64_t native_outer(native::Context* c, std::uint32_t fn, std::uint32_t a
 Val ProgramImpl::call_native(native::Entry e, std::uint64_t self, std::uint64_t mark, const Val* args,
                              std::size_t depth) {
   static_assert(sizeof(Val) == sizeof(native::Reg) && alignof(Val) == alignof(native::Reg));
-  nctx_.budget = budget_;
-  nctx_.max_depth = static_cast<std::uint32_t>(opt_.max_depth);
-  nctx_.runtime = this;
-  nctx_.fail = &native_fail;
-  nctx_.unwind = &native_unwind;
-  nctx_.print = &native_print;
+  nctx_.budget = budget_;  // the callbacks and limits were filled by load_native
   nctx_.consts = consts_.data();
   nctx_.outer_ids = outer_ids_.data();
-  nctx_.getp = &native_getp;
-  nctx_.setp = &native_setp;
-  nctx_.outer = &native_outer;
   native_sites_.clear();
   struct Depth {  // native_depth_ counts this call until it returns or throws
     int& n;
@@ -188,6 +180,15 @@ std::size_t ProgramImpl::load_native(const std::string& path) {
   for (std::uint32_t i = 0; i < found->count; ++i)
     if (found->functions[i].index >= run_.size() || found->functions[i].entry == nullptr)
       throw Error("'" + path + "': a bad function entry");
+  // The callbacks and the depth limit, once (the tables are set per call: call_native).
+  nctx_.max_depth = static_cast<std::uint32_t>(opt_.max_depth);
+  nctx_.runtime = this;
+  nctx_.fail = &native_fail;
+  nctx_.unwind = &native_unwind;
+  nctx_.print = &native_print;
+  nctx_.getp = &native_getp;
+  nctx_.setp = &native_setp;
+  nctx_.outer = &native_outer;
   for (RunCode& rc : run_) rc.native = nullptr;
   for (std::uint32_t i = 0; i < found->count; ++i)
     run_[found->functions[i].index].native = found->functions[i].entry;
