@@ -112,6 +112,25 @@ TEST(SomlNative, ArithmeticMatchesTheVm) {
       << overflow;
 }
 
+// Properties of the narrower types (int16, uint8, float, bool): the same conversions and the same errors.
+TEST(SomlNative, NarrowPropertiesMatchTheVm) {
+  const std::string text = read_file(VSD_SOML_NATIVE_DIR "/props.soml");
+  Script vm("props.soml", text, false), native("props.soml", text, true);
+  EXPECT_EQ(native.program->native_functions(), 8u);  // the five functions and the three initialisers
+  for (const char* fn : {"narrow", "unsigned8", "flip", "all"})
+    for (const std::int64_t v : {std::int64_t{0}, std::int64_t{1}, std::int64_t{-1}, std::int64_t{255}, std::int64_t{256},
+                                 std::int64_t{32767}, std::int64_t{32768}, std::int64_t{-32769}, INT64_MAX}) {
+      SCOPED_TRACE(std::string(fn) + " " + std::to_string(v));
+      EXPECT_EQ(vm.call(fn, one(v)), native.call(fn, one(v)));
+    }
+  for (const double v : {0.1, 1e40, -2.5, 3.0000001})
+    EXPECT_EQ(vm.call("single", {vsd::Value(v)}), native.call("single", {vsd::Value(v)}));
+  const std::string e = native.call("narrow", one(40000));
+  EXPECT_NE(e.find("the value 40000 does not fit property 's' (int16)\n  at narrow (props.soml:5:"),
+            std::string::npos)
+      << e;
+}
+
 TEST(SomlNative, BudgetAndDepthFailAtTheSamePointAsTheVm) {
   const std::string text = read_file(kArith);
   for (const std::uint64_t budget : {1ull, 2ull, 7ull, 1000ull, 54321ull}) {
