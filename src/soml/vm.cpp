@@ -266,9 +266,11 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
                      const Value* xargs, Value* xresult) {
   const Function& f = *image().functions[static_cast<std::size_t>(fi)];
   const std::size_t entry = frames_.size();
-  if (entry == 0 && native_depth_ == 0) {  // a call from outside (not from a listener under native code)
-    budget_ = opt_.instruction_budget == 0 ? 1 : opt_.instruction_budget;
-    mem_left_ = opt_.memory_budget;
+  if (entry == 0) {
+    if (native_depth_ == 0) {  // a call from outside (not from a listener while native code runs)
+      budget_ = opt_.instruction_budget == 0 ? 1 : opt_.instruction_budget;
+      mem_left_ = opt_.memory_budget;
+    }
     frames_.reserve(static_cast<std::size_t>(opt_.max_depth) + 8);
   }
   if (entry >= static_cast<std::size_t>(opt_.max_depth))
