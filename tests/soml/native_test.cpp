@@ -254,11 +254,12 @@ struct NetRun {
   vsd::soml::Program* program = nullptr;
   std::string log;
   std::size_t errors = 0, firings = 0;
+  std::uint64_t budget = 200'000;
   vsd::soml::RunOptions options(std::uint64_t seed) {
     vsd::soml::RunOptions o;
     o.out = &out;
     o.seed = seed;
-    o.instruction_budget = 200'000;
+    o.instruction_budget = budget;
     return o;
   }
   void watch() {
@@ -268,7 +269,8 @@ struct NetRun {
     });
   }
   NetRun() { env.use<vsd::soml::Module>(); }
-  NetRun(const std::string& text, bool native, std::uint64_t seed) {
+  NetRun(const std::string& text, bool native, std::uint64_t seed, std::uint64_t budget_per_call = 200'000)
+      : budget(budget_per_call) {
     program = &env.use<vsd::soml::Module>().load(env.main_state(), "random.soml", text, options(seed));
     if (native) program->load_native(VSD_SOML_NATIVE_LIB);
     watch();
@@ -322,11 +324,19 @@ TEST(SomlNative, RandomNetsFireAsUnderTheVm) {
   // The corpus exercises firings and failed firings (overflow, division by zero, null peers).
   EXPECT_GT(firings, 150u);
   EXPECT_GT(errors, 50u);
+  // A budget of a few units per test and firing: conditions and actions (loops in the functions they
+  // call, calls of methods) exhaust it at the same instruction as the VM's.
+  for (const std::uint64_t budget : {2u, 3u}) {  // (the objects' constructors need 2 to load)
+    NetRun vm(text, false, 1, budget), native(text, true, 1, budget);
+    vm.steps(40);
+    native.steps(40);
+    EXPECT_EQ(vm.log, native.log);
+    EXPECT_NE(native.log.find("instruction budget exhausted (" + std::to_string(budget) + " jumps and calls)"),
+              std::string::npos)
+        << native.log.substr(0, 2000);
+  }
 }
 
-// The hash covers the layout of the classes whose properties native code reads: the same bytecode over a
-// class whose field is a float instead of a double (another size and offsets; the same columns) is
-// refused, and the VM runs it.
 TEST(SomlNative, ALibraryOfAnotherClassLayoutIsRefused) {
   const std::string text = read_file(VSD_SOML_NATIVE_RANDOM);
   std::string changed = text;
