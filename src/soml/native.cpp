@@ -77,19 +77,60 @@ void native_print(native::Context* c, std::uint32_t index, const native::Reg* re
   out << line << '\n';
 }
 
+// Properties and enclosing instances through the VM's own code (read_scalar, write_scalar, enclosing):
+// the same checks and errors, the same path of a store. An error passing here gets the instruction's
+// frame, as native_fail gives it.
+native::Reg native_getp(native::Context* c, std::uint32_t fn, std::uint32_t at, std::uint64_t id,
+                        std::uint32_t prop) {
+  ProgramImpl& p = impl_of(c);
+  try {
+    return std::bit_cast<native::Reg>(p.read_scalar(id, prop));
+  } catch (...) {
+    p.native_sites_.emplace_back(fn, at);
+    throw;
+  }
+}
+
+// The budget comes in and goes back through the Context: a listener of the change may run SOML++ code.
+void native_setp(native::Context* c, std::uint32_t fn, std::uint32_t at, std::uint64_t id, std::uint32_t prop,
+                 native::Reg v) {
+  ProgramImpl& p = impl_of(c);
+  p.budget_ = c->budget;
+  try {
+    p.write_scalar(id, prop, std::bit_cast<Val>(v));
+  } catch (...) {
+    p.native_sites_.emplace_back(fn, at);
+    throw;
+  }
+  c->budget = p.budget_;
+}
+
+std::uint64_t native_outer(native::Context* c, std::uint32_t fn, std::uint32_t at, std::uint64_t id,
+                           std::uint32_t parents) {
+  ProgramImpl& p = impl_of(c);
+  try {
+    return p.enclosing(id, static_cast<int>(parents));
+  } catch (...) {
+    p.native_sites_.emplace_back(fn, at);
+    throw;
+  }
+}
+
 }  // namespace
 
-Val ProgramImpl::call_native(native::Entry e, std::uint64_t self, const Val* args, std::size_t depth) {
+Val ProgramImpl::call_native(native::Entry e, std::uint64_t self, std::uint64_t mark, const Val* args,
+                             std::size_t depth) {
   static_assert(sizeof(Val) == sizeof(native::Reg) && alignof(Val) == alignof(native::Reg));
-  nctx_.budget = budget_;
-  nctx_.max_depth = static_cast<std::uint32_t>(opt_.max_depth);
-  nctx_.runtime = this;
-  nctx_.fail = &native_fail;
-  nctx_.unwind = &native_unwind;
-  nctx_.print = &native_print;
+  nctx_.budget = budget_;  // the callbacks and limits were filled by load_native
+  nctx_.consts = consts_.data();
+  nctx_.outer_ids = outer_ids_.data();
   native_sites_.clear();
+  struct Depth {  // native_depth_ counts this call until it returns or throws
+    int& n;
+    ~Depth() { --n; }
+  } depth_guard{++native_depth_};
   try {
-    const native::Reg r = e(&nctx_, static_cast<std::uint32_t>(depth), self,
+    const native::Reg r = e(&nctx_, static_cast<std::uint32_t>(depth), self, mark,
                             reinterpret_cast<const native::Reg*>(args));  // same layout (asserted above)
     budget_ = nctx_.budget;
     return std::bit_cast<Val>(r);
@@ -139,6 +180,15 @@ std::size_t ProgramImpl::load_native(const std::string& path) {
   for (std::uint32_t i = 0; i < found->count; ++i)
     if (found->functions[i].index >= run_.size() || found->functions[i].entry == nullptr)
       throw Error("'" + path + "': a bad function entry");
+  // The callbacks and the depth limit, once (the tables are set per call: call_native).
+  nctx_.max_depth = static_cast<std::uint32_t>(opt_.max_depth);
+  nctx_.runtime = this;
+  nctx_.fail = &native_fail;
+  nctx_.unwind = &native_unwind;
+  nctx_.print = &native_print;
+  nctx_.getp = &native_getp;
+  nctx_.setp = &native_setp;
+  nctx_.outer = &native_outer;
   for (RunCode& rc : run_) rc.native = nullptr;
   for (std::uint32_t i = 0; i < found->count; ++i)
     run_[found->functions[i].index].native = found->functions[i].entry;

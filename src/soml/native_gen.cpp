@@ -1,7 +1,8 @@
 // The native code generator (docs/soml.md, "Native compilation"): the program image's bytecode translated
 // to C++, one C++ function per SOML++ function whose instructions all have a translation here (the
 // "native subset": int and double arithmetic, comparisons, jumps and loops, calls of other such
-// functions, print of numbers, fail). Each register becomes two typed C++ variables (i<n>, d<n>): the VM's
+// functions, print of numbers, fail; self, marks, static objects and properties of scalar kinds, read and
+// written through the runtime's callbacks). Each register becomes two typed C++ variables (i<n>, d<n>): the VM's
 // register is a union read by static type, so an instruction reads and writes the view of its type, and
 // a move copies both (the optimiser drops the dead one). Jumps become gotos to the instruction's label;
 // the checks the VM makes (overflow, division by zero, budget on backward jumps and calls, call depth)
@@ -85,6 +86,14 @@ bool translatable(const ProgramImage& img, const Function& f, const std::vector<
       case OP_CALLS:
         if (!ok[in.b]) return false;
         break;
+      case OP_SELF:
+      case OP_MARK:
+      case OP_OBJ:
+        break;
+      case OP_GETP:
+      case OP_SETP:
+        if (!scalar_property(img.props[in.c])) return false;
+        break;
       case OP_BUILTIN:
         switch (static_cast<Builtin>(in.b)) {
           case Builtin::Sqrt:
@@ -140,7 +149,7 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
   o << "// " << one_line(f.name) << "\n";
   o << rtype(f.result) << " f" << fi
     << "([[maybe_unused]] Context* c, [[maybe_unused]] std::uint32_t depth, std::uint64_t budget, "
-       "[[maybe_unused]] std::uint64_t self";
+       "[[maybe_unused]] std::uint64_t self, [[maybe_unused]] std::uint64_t mark";
   for (int p = 0; p < f.nparams; ++p)
     o << ", " << ctype(f.param_kinds[static_cast<std::size_t>(p)]) << " p" << p;
   o << ") {\n";
@@ -360,12 +369,44 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
         o << "{ if (depth >= c->max_depth) [[unlikely]] fail(c, budget, Fault::Depth, " << F << ", " << AT
           << ", 0, " << in.b << "); } ";
         budget("CallBudget");
-        o << "\n  try { const auto r = f" << in.b << "(c, depth + 1, budget, " << self;
+        o << "\n  try { const auto r = f" << in.b << "(c, depth + 1, budget, " << self << ", mark";
         for (int p = 0; p < callee.nparams; ++p)
           o << ", " << view(callee.param_kinds[static_cast<std::size_t>(p)]) << in.a + p;
         o << "); " << (callee.result == RK::D ? D(in.a) : I(in.a))
           << " = r.v; budget = r.budget; } catch (...) { "
           << "c->unwind(c, " << F << ", " << AT << "); throw; }\n";
+        break;
+      }
+      case OP_SELF: {
+        const OuterPlan& plan = img.outer_plans[in.b];
+        if (plan.static_decl != nullptr)
+          o << "  " << I(in.a) << " = static_cast<std::int64_t>(c->outer_ids[" << in.b << "]);\n";
+        else if (plan.parents == 0)
+          o << "  " << I(in.a) << " = static_cast<std::int64_t>(self);\n";
+        else
+          o << "  " << I(in.a) << " = static_cast<std::int64_t>(c->outer(c, " << F << ", " << AT << ", self, "
+            << plan.parents << "u));\n";
+        break;
+      }
+      case OP_MARK:
+        o << "  " << I(in.a) << " = static_cast<std::int64_t>(mark);\n";
+        break;
+      case OP_OBJ:
+        o << "  " << I(in.a) << " = c->consts[" << in.b << "];\n";
+        break;
+      case OP_GETP:
+        // Through the runtime (read_scalar): the instance is found by its id, the read recorded as a
+        // dependency while a condition is tested.
+        o << "  { const Reg r = c->getp(c, " << F << ", " << AT << ", static_cast<std::uint64_t>(" << I(in.b)
+          << "), " << in.c << "u); " << I(in.a) << " = r.i; " << D(in.a) << " = r.d; }\n";
+        break;
+      case OP_SETP: {
+        // Through the runtime (write_scalar): recorded, signalled, conditions re-tested; the budget goes
+        // with it (a listener may run SOML++ code).
+        const bool dbl = img.props[in.c].kind == PK::Double || img.props[in.c].kind == PK::Other;
+        o << "  { Reg r; r." << (dbl ? 'd' : 'i') << " = " << (dbl ? D(in.b) : I(in.b))
+          << "; c->budget = budget; c->setp(c, " << F << ", " << AT << ", static_cast<std::uint64_t>("
+          << I(in.a) << "), " << in.c << "u, r); budget = c->budget; }\n";
         break;
       }
       case OP_RET:
@@ -467,6 +508,26 @@ std::uint64_t image_hash(const ProgramImage& img) {
   for (std::int64_t k : img.consts) num(static_cast<std::uint64_t>(k));
   num(img.strings.size());
   for (const std::string& s : img.strings) str(s);
+  // What native code assumes of the run-time tables: each property slot (its kind, type, where it lives
+  // in its class, the class's size — another class layout gives another hash) and each outer plan.
+  num(img.props.size());
+  for (const PropSlot& ps : img.props) {
+    if (ps.prop == nullptr) {
+      num(0);
+      continue;
+    }
+    str(ps.prop->name());
+    num(static_cast<std::uint64_t>(ps.kind));
+    num(static_cast<std::uint64_t>(ps.prop->type().kind()));
+    num(ps.prop->type().size());
+    num(ps.prop->offset());
+    num(ps.prop->owner().size());
+  }
+  num(img.outer_plans.size());
+  for (const OuterPlan& op : img.outer_plans) {
+    num(op.static_decl != nullptr ? 1 : 0);
+    num(static_cast<std::uint64_t>(op.parents));
+  }
   num(img.print_kinds.size());
   for (const auto& ks : img.print_kinds) {
     num(ks.size());
@@ -499,7 +560,7 @@ void native_module_source(std::ostream& o, const ProgramImage& img, const std::s
   for (std::size_t i = 0; i < ok.size(); ++i) {
     if (!ok[i]) continue;
     const Function& f = *img.functions[i];
-    o << rtype(f.result) << " f" << i << "(Context*, std::uint32_t, std::uint64_t, std::uint64_t";
+    o << rtype(f.result) << " f" << i << "(Context*, std::uint32_t, std::uint64_t, std::uint64_t, std::uint64_t";
     for (int p = 0; p < f.nparams; ++p) o << ", " << ctype(f.param_kinds[static_cast<std::size_t>(p)]);
     o << ");\n";
   }
@@ -513,8 +574,9 @@ void native_module_source(std::ostream& o, const ProgramImage& img, const std::s
     ++count;
     const Function& f = *img.functions[i];
     o << "Reg e" << i
-      << "(Context* c, std::uint32_t depth, std::uint64_t self, [[maybe_unused]] const Reg* a) {\n"
-      << "  const auto x = f" << i << "(c, depth, c->budget, self";
+      << "(Context* c, std::uint32_t depth, std::uint64_t self, std::uint64_t mark, "
+         "[[maybe_unused]] const Reg* a) {\n"
+      << "  const auto x = f" << i << "(c, depth, c->budget, self, mark";
     for (int p = 0; p < f.nparams; ++p)
       o << ", a[" << p << "]." << view(f.param_kinds[static_cast<std::size_t>(p)]);
     o << ");\n  c->budget = x.budget;\n  Reg r;\n  r." << view(f.result) << " = x.v;\n  return r;\n}\n";

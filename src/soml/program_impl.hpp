@@ -186,6 +186,17 @@ class ProgramImpl {
                                 const std::string* sargs, int nargs, const VecReg* vargs = nullptr,
                                 const Value* xargs = nullptr);
   [[noreturn]] void fail(const std::string& what);
+  // Properties (vm.cpp), shared by the VM's OP_GETP/OP_SETP/OP_SELF and native code's callbacks: the same
+  // errors, the same path of a store (the state's transaction, signals, re-tests).
+  [[noreturn, gnu::cold, gnu::noinline]] void no_instance(std::uint64_t id);  // null or deleted
+  [[noreturn, gnu::cold, gnu::noinline]] void no_property(const SimStateInstance& o, const MetaProperty& p);
+  void check_settable(const SimStateInstance& o, const MetaProperty& p);  // its class's, not read-only
+  std::uint64_t enclosing(std::uint64_t id, int parents);                  // OP_SELF @p parents levels up
+  // Stores @p v into a property of a scalar kind (scalar_property); false for the other kinds.
+  bool store_scalar(const PropSlot& ps, SimStateInstance& o, Val v);
+  // OP_GETP and OP_SETP of a scalar property props[@p prop] of instance @p id, whole (native code).
+  Val read_scalar(std::uint64_t id, std::size_t prop);
+  void write_scalar(std::uint64_t id, std::size_t prop, Val v);
   // "integer overflow: a op b does not fit an int (64 bits)", and "what(a)" for unary operations.
   [[noreturn, gnu::cold, gnu::noinline]] void int_overflow(std::int64_t a, const char* op, std::int64_t b);
   [[noreturn, gnu::cold, gnu::noinline]] void int_overflow(const char* what, std::int64_t a);
@@ -316,7 +327,8 @@ class ProgramImpl {
   std::size_t load_native(const std::string& path);
   // Calls native @p e with @p depth frames active (its own counted): the budget goes in and comes back,
   // an error gets the native frames of its call stack (the caller adds the VM's).
-  Val call_native(native::Entry e, std::uint64_t self, const Val* args, std::size_t depth);
+  Val call_native(native::Entry e, std::uint64_t self, std::uint64_t mark, const Val* args, std::size_t depth);
+  int native_depth_ = 0;  // native calls under way (a listener's call into the VM is then no outer call)
   native::Context nctx_{};
   std::vector<std::pair<std::uint32_t, std::uint32_t>> native_sites_;  // (function, instruction) of an error
   std::shared_ptr<void> native_lib_;                                   // the dlopen handle
@@ -414,6 +426,10 @@ class ProgramImpl {
 // Program::reload (migrate.cpp): moves the state from the running version @p old to @p nw (made, not
 // loaded), all or nothing.
 MigrationReport migrate(ProgramImpl& old, ProgramImpl& nw, std::string name, std::string text);
+
+/// Whether property slot @p ps holds a scalar (int, bool, enum, double, float, reference): what native
+/// code reads and writes (vm.cpp).
+bool scalar_property(const PropSlot& ps) noexcept;
 
 // Loader helpers shared by the compiler.
 RK reg_kind(const Type& t) noexcept;

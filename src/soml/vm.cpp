@@ -267,8 +267,10 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
   const Function& f = *image().functions[static_cast<std::size_t>(fi)];
   const std::size_t entry = frames_.size();
   if (entry == 0) {
-    budget_ = opt_.instruction_budget == 0 ? 1 : opt_.instruction_budget;
-    mem_left_ = opt_.memory_budget;
+    if (native_depth_ == 0) {  // a call from outside (not from a listener while native code runs)
+      budget_ = opt_.instruction_budget == 0 ? 1 : opt_.instruction_budget;
+      mem_left_ = opt_.memory_budget;
+    }
     frames_.reserve(static_cast<std::size_t>(opt_.max_depth) + 8);
   }
   if (entry >= static_cast<std::size_t>(opt_.max_depth))
@@ -276,7 +278,7 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
          stack_text(0));
   if (native::Entry e = run_[static_cast<std::size_t>(fi)].native; e != nullptr && debug_ == nullptr) {
     // Native code (Program::load_native) takes scalar arguments and returns a scalar: nothing to move.
-    return call_native(e, self, args, entry + 1);
+    return call_native(e, self, mark, args, entry + 1);
   }
   const std::uint32_t saved_top = top_;
   const std::uint32_t base = top_;
@@ -696,6 +698,147 @@ static void from_registers(const MetaType& t, void* addr, const Val& v, const st
   }
 }
 
+// A property of a scalar kind (what a register holds without a side array: ints, bools, enums, doubles,
+// floats, references) at @p addr into @p v; false for the others. OP_GETP and native code (read_scalar).
+static bool load_scalar(const PropSlot& ps, const void* addr, Val& v) {
+  switch (ps.kind) {
+    case PK::I64:
+      v.i = *static_cast<const std::int64_t*>(addr);
+      return true;
+    case PK::Bool:
+      v.i = *static_cast<const bool*>(addr) ? 1 : 0;
+      return true;
+    case PK::Double:
+      v.d = *static_cast<const double*>(addr);
+      return true;
+    case PK::Int:
+    case PK::Enum:
+      v.i = ps.prop->type().load_integer(addr);
+      return true;
+    case PK::Ref: {
+      const SimStateInstance* t = static_cast<const RefBase*>(addr)->get();
+      v.id = t != nullptr ? t->id() : 0;
+      return true;
+    }
+    case PK::Other:
+      if (ps.prop->type().kind() != TypeKind::Float) return false;
+      v.d = *static_cast<const float*>(addr);
+      return true;
+    default:
+      return false;
+  }
+}
+
+bool scalar_property(const PropSlot& ps) noexcept {
+  if (ps.prop == nullptr) return false;
+  switch (ps.kind) {
+    case PK::I64:
+    case PK::Bool:
+    case PK::Double:
+    case PK::Int:
+    case PK::Enum:
+    case PK::Ref:
+      return true;
+    case PK::Other:
+      return ps.prop->type().kind() == TypeKind::Float;
+    default:
+      return false;
+  }
+}
+
+void ProgramImpl::no_instance(std::uint64_t id) {
+  fail(id == 0 ? "null reference" : "reference to a deleted instance (id " + std::to_string(id) + ")");
+}
+
+void ProgramImpl::no_property(const SimStateInstance& o, const MetaProperty& p) {
+  fail("instance of " + o.meta().name() + " has no property '" + p.name() + "'");
+}
+
+void ProgramImpl::check_settable(const SimStateInstance& o, const MetaProperty& p) {
+  if (!o.meta().is_a(p.owner())) no_property(o, p);
+  if (p.has(ReadOnly)) fail("property '" + p.name() + "' is read-only");
+}
+
+std::uint64_t ProgramImpl::enclosing(std::uint64_t id, int parents) {
+  for (int k = 0; k < parents; ++k) {
+    SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
+    if (o == nullptr) no_instance(id);
+    Node* n = o->as<Node>();
+    Node* up = n != nullptr ? n->parent() : nullptr;
+    if (up == nullptr) fail("the enclosing instance of " + std::to_string(id) + " is gone");
+    id = up->id();
+  }
+  return id;
+}
+
+bool ProgramImpl::store_scalar(const PropSlot& ps, SimStateInstance& o, Val v) {
+  const MetaProperty& p = *ps.prop;
+  switch (ps.kind) {
+    case PK::I64:
+      p.set<std::int64_t>(o, v.i);
+      return true;
+    case PK::Bool:
+      p.set<bool>(o, v.i != 0);
+      return true;
+    case PK::Double:
+      p.set<double>(o, v.d);
+      return true;
+    case PK::Int:
+      if (!p.type().integer_fits(v.i))
+        fail("the value " + std::to_string(v.i) + " does not fit property '" + p.name() + "' (" +
+             p.type().name() + ")");
+      store_integer(p, o, v.i);
+      return true;
+    case PK::Enum:
+      store_integer(p, o, v.i);
+      return true;
+    case PK::Ref: {
+      SimStateInstance* t = v.id == 0 ? nullptr : state_.find(v.id);
+      if (v.id != 0 && t == nullptr) no_instance(v.id);
+      if (t != nullptr && p.type().target() != nullptr && !t->meta().is_a(*p.type().target()))
+        fail("a " + t->meta().name() + " cannot be stored in property '" + p.name() + "' (" + p.type().name() +
+             ")");
+      if (p.type().kind() == TypeKind::Ref) {
+        Ref<SimStateInstance> r(t);
+        p.assign_raw(o, &r);
+      } else {
+        SharedRef<SimStateInstance> r(t);
+        p.assign_raw(o, &r);
+      }
+      return true;
+    }
+    case PK::Other:
+      if (p.type().kind() != TypeKind::Float) return false;
+      {
+        const auto f = static_cast<float>(v.d);
+        p.assign_raw(o, &f);
+      }
+      return true;
+    default:
+      return false;
+  }
+}
+
+Val ProgramImpl::read_scalar(std::uint64_t id, std::size_t prop) {
+  SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
+  if (o == nullptr) no_instance(id);
+  const PropSlot& ps = image().props[prop];
+  if (!o->meta().is_a(ps.prop->owner())) no_property(*o, *ps.prop);
+  if (deps_ != nullptr) deps_->emplace_back(id, ps.prop);
+  Val v{};
+  load_scalar(ps, ps.prop->address(*o), v);
+  return v;
+}
+
+void ProgramImpl::write_scalar(std::uint64_t id, std::size_t prop, Val v) {
+  SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
+  if (o == nullptr) no_instance(id);
+  const PropSlot& ps = image().props[prop];
+  check_settable(*o, *ps.prop);
+  charge_record(8);
+  store_scalar(ps, *o, v);
+}
+
 Val ProgramImpl::exec(std::size_t entry) {
   Frame* fr = &frames_.back();
   const Ins* code = fr->run->code.data();
@@ -747,7 +890,7 @@ Val ProgramImpl::exec(std::size_t entry) {
     SimStateInstance* o = id == 0 ? nullptr : state_.find(id);
     if (o == nullptr) {
       VSD_SAVE();
-      fail(id == 0 ? "null reference" : "reference to a deleted instance (id " + std::to_string(id) + ")");
+      no_instance(id);
     }
     return *o;
   };
@@ -1015,7 +1158,7 @@ Val ProgramImpl::exec(std::size_t entry) {
                " jumps and calls): runaway recursion?");
         if (rc.native != nullptr && debug_ == nullptr) [[unlikely]] {
           // Native code: arguments from R[a], the result into R[a], as if the callee had run here.
-          R[in.a] = call_native(rc.native, self, &R[in.a], frames_.size() + 1);
+          R[in.a] = call_native(rc.native, self, fr->mark, &R[in.a], frames_.size() + 1);
           break;
         }
         const std::uint32_t nb = fr->base + in.a;
@@ -1062,18 +1205,11 @@ Val ProgramImpl::exec(std::size_t entry) {
         const OuterPlan& p = img.outer_plans[in.b];
         if (p.static_decl != nullptr) {
           R[in.a].id = outer_ids_[in.b];
+        } else if (p.parents == 0) {
+          R[in.a].id = fr->self;
         } else {
-          std::uint64_t id = fr->self;
-          for (int k = 0; k < p.parents; ++k) {
-            Node* n = obj(id).as<Node>();
-            Node* up = n != nullptr ? n->parent() : nullptr;
-            if (up == nullptr) {
-              VSD_SAVE();
-              fail("the enclosing instance of " + std::to_string(id) + " is gone");
-            }
-            id = up->id();
-          }
-          R[in.a].id = id;
+          VSD_SAVE();
+          R[in.a].id = enclosing(fr->self, p.parents);
         }
         break;
       }
@@ -1089,33 +1225,16 @@ Val ProgramImpl::exec(std::size_t entry) {
         const PropSlot& ps = img.props[in.c];
         if (!o.meta().is_a(ps.prop->owner())) {
           VSD_SAVE();
-          fail("instance of " + o.meta().name() + " has no property '" + ps.prop->name() + "'");
+          no_property(o, *ps.prop);
         }
         if (deps_ != nullptr) deps_->emplace_back(id, ps.prop);
         const void* addr = ps.prop->address(o);
+        if (load_scalar(ps, addr, R[in.a])) break;
         switch (ps.kind) {
-          case PK::I64:
-            R[in.a].i = *static_cast<const std::int64_t*>(addr);
-            break;
-          case PK::Bool:
-            R[in.a].i = *static_cast<const bool*>(addr) ? 1 : 0;
-            break;
-          case PK::Double:
-            R[in.a].d = *static_cast<const double*>(addr);
-            break;
           case PK::String:
             string_room(S[in.a], static_cast<const std::string*>(addr)->size());
             S[in.a] = *static_cast<const std::string*>(addr);
             break;
-          case PK::Int:
-          case PK::Enum:
-            R[in.a].i = ps.prop->type().load_integer(addr);
-            break;
-          case PK::Ref: {
-            const SimStateInstance* t = static_cast<const RefBase*>(addr)->get();
-            R[in.a].id = t != nullptr ? t->id() : 0;
-            break;
-          }
           case PK::Vector: {
             VSD_SAVE();
             VecReg& v = vregs_[fr->base + in.a];
@@ -1133,10 +1252,6 @@ Val ProgramImpl::exec(std::size_t entry) {
             break;
           }
           default:
-            if (ps.prop->type().kind() == TypeKind::Float) {
-              R[in.a].d = *static_cast<const float*>(addr);
-              break;
-            }
             VSD_SAVE();
             fail("property '" + ps.prop->name() + "' of type " + ps.prop->type().name() +
                  " cannot be read as a value yet");
@@ -1148,9 +1263,7 @@ Val ProgramImpl::exec(std::size_t entry) {
         SimStateInstance& o = obj(R[in.a].id);
         const PropSlot& ps = img.props[in.c];
         const MetaProperty& p = *ps.prop;
-        if (!o.meta().is_a(p.owner()))
-          fail("instance of " + o.meta().name() + " has no property '" + p.name() + "'");
-        if (p.has(ReadOnly)) fail("property '" + p.name() + "' is read-only");
+        check_settable(o, p);
         // The memory budget first (nothing changed if it is exhausted): what the stored value grows by,
         // and the record of the change.
         switch (ps.kind) {
@@ -1168,42 +1281,14 @@ Val ProgramImpl::exec(std::size_t entry) {
           default:
             charge_record(8);
         }
+        if (store_scalar(ps, o, R[in.b])) {
+          VSD_REFRESH();  // listeners of the change may have called into the VM
+          break;
+        }
         switch (ps.kind) {
-          case PK::I64:
-            p.set<std::int64_t>(o, R[in.b].i);
-            break;
-          case PK::Bool:
-            p.set<bool>(o, R[in.b].i != 0);
-            break;
-          case PK::Double:
-            p.set<double>(o, R[in.b].d);
-            break;
           case PK::String:
             p.assign_raw(o, &S[in.b]);
             break;
-          case PK::Int:
-            if (!p.type().integer_fits(R[in.b].i))
-              fail("the value " + std::to_string(R[in.b].i) + " does not fit property '" + p.name() + "' (" +
-                   p.type().name() + ")");
-            store_integer(p, o, R[in.b].i);
-            break;
-          case PK::Enum:
-            store_integer(p, o, R[in.b].i);
-            break;
-          case PK::Ref: {
-            SimStateInstance* t = R[in.b].id == 0 ? nullptr : &obj(R[in.b].id);
-            if (t != nullptr && p.type().target() != nullptr && !t->meta().is_a(*p.type().target()))
-              fail("a " + t->meta().name() + " cannot be stored in property '" + p.name() + "' (" +
-                   p.type().name() + ")");
-            if (p.type().kind() == TypeKind::Ref) {
-              Ref<SimStateInstance> r(t);
-              p.assign_raw(o, &r);
-            } else {
-              SharedRef<SimStateInstance> r(t);
-              p.assign_raw(o, &r);
-            }
-            break;
-          }
           case PK::Vector:
             store_vector(p, o, vregs_[fr->base + in.b]);
             break;
@@ -1216,11 +1301,6 @@ Val ProgramImpl::exec(std::size_t entry) {
             break;
           }
           default:
-            if (p.type().kind() == TypeKind::Float) {
-              const auto f = static_cast<float>(R[in.b].d);
-              p.assign_raw(o, &f);
-              break;
-            }
             fail("property '" + p.name() + "' of type " + p.type().name() + " cannot be assigned yet");
         }
         VSD_REFRESH();  // listeners of the change may have called into the VM

@@ -14,6 +14,7 @@
 
 #include "vsd/core.hpp"
 #include "vsd/soml.hpp"
+#include "state_dump.hpp"
 
 #if VSD_SOML_TEST_IO
 #include "vsd/io/snapshot.hpp"
@@ -22,6 +23,8 @@
 namespace {
 
 using ::testing::HasSubstr;
+using vsd_test::describe;
+using vsd_test::dump;
 using vsd::soml::Program;
 
 std::string read_script(const std::string& name) {
@@ -36,58 +39,6 @@ std::uint64_t seed_of(const std::string& text) {
   const auto at = text.find("--seed ");
   if (at == std::string::npos || at > text.find('\n')) return 1;
   return std::stoull(text.substr(at + 7));
-}
-
-// Where a node is in the tree, by names: ids of instances made after a reload may differ from the
-// original's (each Environment counts its own), names and places in the tree do not.
-std::string path(const vsd::SimStateInstance* x) {
-  if (x == nullptr) return "-";
-  const vsd::Node* n = x->as<vsd::Node>();
-  if (n == nullptr) return "#?";
-  std::string s;
-  for (; n != nullptr && n->parent() != nullptr; n = n->parent()) s = "/" + n->name() + s;
-  return s.empty() ? "/" : s;
-}
-
-// The text of a value with every "@id" replaced by the path of that instance.
-std::string with_paths(const vsd::SimState& state, const std::string& text) {
-  std::string out;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    if (text[i] != '@' || i + 1 >= text.size() ||
-        std::isdigit(static_cast<unsigned char>(text[i + 1])) == 0) {
-      out += text[i];
-      continue;
-    }
-    std::size_t j = i + 1;
-    while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j])) != 0) ++j;
-    out += path(state.find(std::stoull(text.substr(i + 1, j - i - 1))));
-    i = j - 1;
-  }
-  return out;
-}
-
-// The whole tree: every node's class and every property (references as paths), depth first.
-std::string dump(const vsd::SimState& state) {
-  std::string s;
-  state.database().visit([&](const vsd::Node& n) {
-    s += path(&n) + " " + n.meta().name() + " {";
-    for (const vsd::MetaProperty* p : n.meta().properties()) {
-      if (p->name() == "children") continue;
-      s += " " + p->name() + "=" + with_paths(state, p->type().to_text(p->address(n)));
-    }
-    s += " }\n";
-  });
-  return s;
-}
-
-std::string describe(const vsd::SimState& state, const vsd::soml::Firing& f) {
-  static const char* kinds[] = {"plain", "invoke", "finish", "complete"};
-  std::string s = std::to_string(f.step) + " " + kinds[static_cast<int>(f.kind)] + " " + path(f.transition) +
-                  " mark " + path(f.mark != 0 ? state.find(f.mark) : nullptr) + " " + path(f.from) + " -> " +
-                  path(f.to);
-  for (const auto& m : f.taken) s += " -" + std::to_string(m.count) + path(m.place);
-  for (const auto& m : f.given) s += " +" + std::to_string(m.count) + path(m.place);
-  return s;
 }
 
 // One Environment running one program, with its trace and its printed output.

@@ -4,7 +4,9 @@
 // gives: results, printed lines, and errors word for word with their SOML++ call stacks — overflow,
 // division by zero, the instruction budget and the depth limit. A library of another version of the
 // script, a missing file and a file that is no native library are refused with a clear error, and the
-// program keeps running in the VM.
+// program keeps running in the VM. Nets whose conditions and actions read and write properties (a seeded
+// corpus of random nets) fire natively exactly as under the VM: the same token trace, printed lines,
+// errors, undone firings and final database; a run saved by vsd::io continues under the other engine.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -14,8 +16,13 @@
 #include <vector>
 
 #include "../core/test_util.hpp"
+#include "state_dump.hpp"
 #include "vsd/core.hpp"
 #include "vsd/soml.hpp"
+
+#if VSD_SOML_TEST_IO
+#include "vsd/io/snapshot.hpp"
+#endif
 
 namespace {
 
@@ -103,6 +110,25 @@ TEST(SomlNative, ArithmeticMatchesTheVm) {
                           "  at mul (arith.soml:17:"),
             std::string::npos)
       << overflow;
+}
+
+// Properties of the narrower types (int16, uint8, float, bool): the same conversions and the same errors.
+TEST(SomlNative, NarrowPropertiesMatchTheVm) {
+  const std::string text = read_file(VSD_SOML_NATIVE_DIR "/props.soml");
+  Script vm("props.soml", text, false), native("props.soml", text, true);
+  EXPECT_EQ(native.program->native_functions(), 8u);  // the five functions and the three initialisers
+  for (const char* fn : {"narrow", "unsigned8", "flip", "all"})
+    for (const std::int64_t v : {std::int64_t{0}, std::int64_t{1}, std::int64_t{-1}, std::int64_t{255}, std::int64_t{256},
+                                 std::int64_t{32767}, std::int64_t{32768}, std::int64_t{-32769}, INT64_MAX}) {
+      SCOPED_TRACE(std::string(fn) + " " + std::to_string(v));
+      EXPECT_EQ(vm.call(fn, one(v)), native.call(fn, one(v)));
+    }
+  for (const double v : {0.1, 1e40, -2.5, 3.0000001})
+    EXPECT_EQ(vm.call("single", {vsd::Value(v)}), native.call("single", {vsd::Value(v)}));
+  const std::string e = native.call("narrow", one(40000));
+  EXPECT_NE(e.find("the value 40000 does not fit property 's' (int16)\n  at narrow (props.soml:5:"),
+            std::string::npos)
+      << e;
 }
 
 TEST(SomlNative, BudgetAndDepthFailAtTheSamePointAsTheVm) {
@@ -208,5 +234,159 @@ TEST(SomlNative, AnAttachedDebuggerRunsTheVm) {
   EXPECT_EQ(run.call("fib", {vsd::Value(std::int64_t{4})}), "3\nprinted: ");
   EXPECT_EQ(stops, 9);
 }
+
+}  // namespace
+
+namespace {
+
+using vsd_test::describe;
+
+// The database without the script's source text and the executor's state (its choices: a failed firing
+// has taken its random number, as under the VM).
+std::string dump(const vsd::SimState& state) { return vsd_test::dump(state, {"soml::SourceFile", "soml::Executor"}); }
+
+// One program whose nets fire step by step: its log holds every firing (paths, token moves), what it
+// printed, each error of a failed firing and the failed conditions, in order.
+struct NetRun {
+  vsd::Registry reg;
+  vsd::Environment env{0, reg};
+  std::ostringstream out;
+  vsd::soml::Program* program = nullptr;
+  std::string log;
+  std::size_t errors = 0, firings = 0;
+  std::uint64_t budget = 200'000;
+  vsd::soml::RunOptions options(std::uint64_t seed) {
+    vsd::soml::RunOptions o;
+    o.out = &out;
+    o.seed = seed;
+    o.instruction_budget = budget;
+    return o;
+  }
+  void watch() {
+    program->on_firing([this](const vsd::soml::Firing& f) {
+      log += describe(env.main_state(), f) + "\n";
+      ++firings;
+    });
+  }
+  NetRun() { env.use<vsd::soml::Module>(); }
+  NetRun(const std::string& text, bool native, std::uint64_t seed, std::uint64_t budget_per_call = 200'000)
+      : budget(budget_per_call) {
+    program = &env.use<vsd::soml::Module>().load(env.main_state(), "random.soml", text, options(seed));
+    if (native) program->load_native(VSD_SOML_NATIVE_LIB);
+    watch();
+  }
+  // Attaches to what the state holds (loaded by vsd::io), natively or not.
+  void adopt(const std::string& text, bool native, std::uint64_t seed) {
+    program = &env.use<vsd::soml::Module>().adopt(env.main_state(), "random.soml", text, options(seed));
+    if (native) program->load_native(VSD_SOML_NATIVE_LIB);
+    watch();
+  }
+  // @p n steps of one firing each; a failed firing must leave the database as it was (all or nothing).
+  void steps(int n) {
+    for (int i = 0; i < n; ++i) {
+      const std::string before = dump(env.main_state());
+      try {
+        if (program->step(1) == 0) {
+          log += "quiet\n";
+          break;
+        }
+      } catch (const vsd::Error& e) {
+        log += std::string("error: ") + e.what() + "\n";
+        ++errors;
+        EXPECT_EQ(dump(env.main_state()), before) << "a failed firing changed the database: " << e.what();
+      }
+      log += out.str();
+      out.str("");
+    }
+    log += "failed conditions:\n";
+    for (const std::string& c : program->condition_errors()) log += c + "\n";
+  }
+};
+
+// The random nets (native_random_gen.cpp: VSD_SOML_NATIVE_RANDOM_NETS of them in the corpus) under
+// several seeds: conditions, actions and the methods they call run natively and give the VM's run.
+TEST(SomlNative, RandomNetsFireAsUnderTheVm) {
+  const std::string text = read_file(VSD_SOML_NATIVE_RANDOM);
+  std::size_t firings = 0, errors = 0;
+  for (const std::uint64_t seed : {1u, 2u}) {
+    SCOPED_TRACE(seed);
+    NetRun vm(text, false, seed), native(text, true, seed);
+    // Conditions, actions, methods and initialisers of the nets are native too.
+    EXPECT_GE(native.program->native_functions(),
+              std::size_t{VSD_SOML_NATIVE_RANDOM_COUNT + 10 * VSD_SOML_NATIVE_RANDOM_NETS});
+    vm.steps(300);
+    native.steps(300);
+    ASSERT_EQ(vm.log, native.log);
+    EXPECT_EQ(dump(vm.env.main_state()), dump(native.env.main_state()));
+    firings += native.firings;
+    errors += native.errors;
+  }
+  // The corpus exercises firings and failed firings (overflow, division by zero, null peers).
+  EXPECT_GT(firings, 150u);
+  EXPECT_GT(errors, 50u);
+  // A budget of a few units per test and firing: conditions and actions (loops in the functions they
+  // call, calls of methods) exhaust it at the same instruction as the VM's.
+  for (const std::uint64_t budget : {2u, 3u}) {  // (the objects' constructors need 2 to load)
+    NetRun vm(text, false, 1, budget), native(text, true, 1, budget);
+    vm.steps(40);
+    native.steps(40);
+    EXPECT_EQ(vm.log, native.log);
+    EXPECT_NE(native.log.find("instruction budget exhausted (" + std::to_string(budget) + " jumps and calls)"),
+              std::string::npos)
+        << native.log.substr(0, 2000);
+  }
+}
+
+TEST(SomlNative, ALibraryOfAnotherClassLayoutIsRefused) {
+  const std::string text = read_file(VSD_SOML_NATIVE_RANDOM);
+  std::string changed = text;
+  const std::size_t at = changed.find("double w = 1.0;", changed.find("class Tok0 "));
+  ASSERT_NE(at, std::string::npos);
+  changed.replace(at, 15, "float  w = 1.0;");
+  NetRun a(text, false, 1), b(changed, false, 1);
+  EXPECT_EQ(a.program->disassemble(), b.program->disassemble());  // the same code
+  EXPECT_NE(a.program->image_hash(), b.program->image_hash());
+  const std::string e = error_of([&] { b.program->load_native(VSD_SOML_NATIVE_LIB); });
+  EXPECT_NE(e.find("holds no native code of this version of random.soml"), std::string::npos) << e;
+  EXPECT_EQ(b.program->native_functions(), 0u);
+  b.steps(20);
+  EXPECT_GT(b.firings, 0u);
+}
+
+#if VSD_SOML_TEST_IO
+
+// docs/soml.md 8.8: saving, attaching and migrating do not depend on native code. A run saved by vsd::io
+// while native code ran continues under the VM exactly as the run that was never saved, and a run saved
+// under the VM continues natively.
+TEST(SomlNative, ASavedRunContinuesUnderTheOtherEngine) {
+  const std::string text = read_file(VSD_SOML_NATIVE_RANDOM);
+  constexpr int total = 120;
+  for (const bool first_native : {true, false}) {
+    NetRun ref(text, false, 5);
+    ref.steps(total);
+    ASSERT_GT(ref.firings, 20u);
+    for (const int n : {0, 7, 60}) {
+      SCOPED_TRACE(std::string(first_native ? "native, then the VM" : "the VM, then native") + ", split after " +
+                   std::to_string(n));
+      NetRun a(text, first_native, 5);
+      a.steps(n);
+      const auto bytes = vsd::io::save_bytes(a.env.main_state(), n % 2 == 0 ? vsd::io::Format::Text
+                                                                             : vsd::io::Format::Binary);
+      NetRun b;
+      vsd::io::load_bytes(b.env.main_state(), bytes);
+      b.adopt(text, !first_native, 5);
+      EXPECT_EQ(b.program->native_functions() > 0, !first_native);
+      b.steps(total - n);
+      // The failed conditions are listed per program (an attach tests every transition again): compare
+      // the firings, prints and errors.
+      auto firing_lines = [](const std::string& log) { return log.substr(0, log.find("failed conditions:\n")); };
+      EXPECT_EQ(firing_lines(a.log) + firing_lines(b.log), firing_lines(ref.log));
+      EXPECT_EQ(dump(b.env.main_state()), dump(ref.env.main_state()));
+      if (::testing::Test::HasFailure()) return;
+    }
+  }
+}
+
+#endif
 
 }  // namespace

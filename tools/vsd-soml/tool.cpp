@@ -3,6 +3,7 @@
 #include "tool.hpp"
 
 #include <iostream>
+#include <memory>
 #include <set>
 #include <string>
 #include <vector>
@@ -292,15 +293,15 @@ int compile(std::span<const std::string_view> args, std::ostream& out, std::ostr
   a.expect_positional(1, 1000, "one or more FILEs");
   const auto dir = a.value("-o");
   if (!dir) throw UsageError("compile needs -o DIR");
-  Workspace ws;
-  auto& soml = ws.env().use<vsd::soml::Module>();
+  std::vector<std::unique_ptr<Workspace>> spaces;
   std::vector<const vsd::soml::Program*> programs;
   for (const std::string_view path : a.positional()) {
     const std::string file = path == "-" ? "<stdin>" : std::string(path);
     try {
-      // Each script in a state of its own (their objects and classes do not meet).
-      vsd::SimState& state = programs.empty() ? ws.state() : ws.env().create_state(file);
-      const vsd::soml::Program& p = soml.load(state, file, as_text(read_input(path)));
+      // Each script in a Registry of its own: their objects and classes do not meet (two scripts may
+      // declare classes of the same name, as when each is loaded alone).
+      Workspace& ws = *spaces.emplace_back(std::make_unique<Workspace>());
+      const vsd::soml::Program& p = ws.env().use<vsd::soml::Module>().load(ws.state(), file, as_text(read_input(path)));
       programs.push_back(&p);
     } catch (const vsd::Error& e) {
       const std::string m = printable_lines(e.what());

@@ -10,7 +10,7 @@
 namespace vsd::soml::native {
 
 /// The ABI version a module was generated for (Program::load_native refuses any other).
-inline constexpr std::uint32_t kNativeAbi = 1;
+inline constexpr std::uint32_t kNativeAbi = 2;
 
 /// A register as the VM holds it: ints, bools and enums in i, doubles in d, references as ids.
 union Reg {
@@ -36,8 +36,9 @@ enum class Fault : std::uint32_t {
   Fail,           ///< OP_FAIL: run-time error strings[b]
 };
 
-/// The runtime's side: the budget and depth limit the VM keeps, and the calls back for what native code
-/// does not do itself (errors, print). Filled by the runtime before every entry into native code.
+/// The runtime's side: the budget and depth limit the VM keeps, the run-time tables native code reads,
+/// and the calls back for what native code does not do itself (errors, print, properties). Filled by the
+/// runtime before every entry into native code.
 struct Context {
   std::uint64_t budget;     ///< jumps and calls left (the VM's count: backward jumps and calls)
   std::uint32_t max_depth;  ///< RunOptions::max_depth: frames (VM and native) at most
@@ -50,11 +51,28 @@ struct Context {
   void (*unwind)(Context* ctx, std::uint32_t fn, std::uint32_t at);
   /// OP_PRINT number @p index of the image (its print_kinds) over @p regs.
   void (*print)(Context* ctx, std::uint32_t index, const Reg* regs);
+  /// The program's constants as linked (OP_OBJ: the ids of the static objects) and the ids of the outer
+  /// plans' fixed instances (OP_SELF of a static object).
+  const std::int64_t* consts;
+  const std::uint64_t* outer_ids;
+  /// OP_GETP: property props[@p prop] of instance @p id, as the VM reads it (a null or deleted instance,
+  /// a property of another class fail at instruction @p at of function @p fn; a condition's read is
+  /// recorded as its dependency).
+  Reg (*getp)(Context* ctx, std::uint32_t fn, std::uint32_t at, std::uint64_t id, std::uint32_t prop);
+  /// OP_SETP: property props[@p prop] of instance @p id = @p v, through the VM's path (recorded in the
+  /// state's transaction, signalled, re-testing the conditions that read it). The budget goes through
+  /// ctx->budget (listeners of the change may run SOML++ code).
+  void (*setp)(Context* ctx, std::uint32_t fn, std::uint32_t at, std::uint64_t id, std::uint32_t prop, Reg v);
+  /// OP_SELF of an instance @p parents levels up from @p id (the enclosing instance gone: an error).
+  std::uint64_t (*outer)(Context* ctx, std::uint32_t fn, std::uint32_t at, std::uint64_t id,
+                         std::uint32_t parents);
 };
 
 /// A function of the module as the runtime calls it: arguments in @p args (as the VM's registers), the
-/// result (0 for none) returned; @p depth frames are active (the new one counted).
-using Entry = Reg (*)(Context* ctx, std::uint32_t depth, std::uint64_t self, const Reg* args);
+/// result (0 for none) returned; @p depth frames are active (the new one counted); @p mark is the object
+/// token of the firing under way (OP_MARK; 0 outside a firing).
+using Entry = Reg (*)(Context* ctx, std::uint32_t depth, std::uint64_t self, std::uint64_t mark,
+                      const Reg* args);
 
 /// One compiled function: its index in the program image and its entry.
 struct FunctionEntry {
