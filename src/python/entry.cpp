@@ -106,6 +106,9 @@ EnvBox::~EnvBox() {
   for (auto& [s, w] : states)
     if (auto b = w.lock()) b->alive = false;
   py::gil_scoped_release release;  // modules may join threads that call back into Python
+  // A plugin's objects first: the Environment's tasks and listeners refer to them, and their own
+  // destructors may still use the Environment.
+  while (!plugin_objects.empty()) plugin_objects.pop_back();
   env.reset();
 }
 
@@ -340,4 +343,5 @@ PYBIND11_MODULE(_core, m) {
   vsdpy::bind_entry_points(m);
   vsdpy::bind_instances(m);
   vsdpy::bind_modules(m);
+  vsdpy::bind_plugins(m);
 }
