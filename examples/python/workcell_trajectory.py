@@ -32,7 +32,7 @@ print(f"cell loaded: robots {info['robots']}, base step {info['step']} s")
 # Each robot is an 8-axis arm (a linear axis and the iiwa14's 7 joints): the scene arm_a / arm_b with a
 # robotics::KinematicTree extension; its σ/γ interface to the nets is the node robot_a / robot_b.
 arms = {n.name: n for n in state.index("scene::Scene") if n.name in ("arm_a", "arm_b")}
-trees = {name: next(e for e in arm.extensions if e._vsd_class == "robotics::KinematicTree")
+trees = {name: next(e for e in arm.extensions if e.vsd_class == "robotics::KinematicTree")
          for name, arm in sorted(arms.items())}
 names = vsd.robotics.joint_names(trees["arm_a"])
 times, q = [], {name: [] for name in trees}

@@ -136,7 +136,10 @@ void bind_modules([[maybe_unused]] py::module_& m) {
       "contacts",
       [](const PyState& s) {
         auto& w = collision_world(s);
-        w.sync();
+        {
+          py::gil_scoped_release release;
+          w.update();  // now, not at the module's last update: the world may have been made just now
+        }
         py::list out;
         for (const vsd::collision::Contact& c : w.contacts()) {
           py::dict d;
@@ -149,7 +152,7 @@ void bind_modules([[maybe_unused]] py::module_& m) {
         }
         return out;
       },
-      "The contacts of the state's collision hulls at the last update: [{a, b, position, normal, depth}]");
+      "The contacts of the state's collision hulls now (updates its world): [{a, b, position, normal, depth}]");
   collision.def(
       "distance",
       [](const PyState& s, const Handle& a, const Handle& b) {

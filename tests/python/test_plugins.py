@@ -19,8 +19,9 @@ def test_plugin_builds_into_the_environment_and_its_task_runs(env):
     info = vsd.load_plugin(PLUGIN, env, ["counter"])
     assert info == {"node": "counter"}
     s = env.main_state
-    (node,) = [n for n in s.database.children]
-    assert node.name == "counter"
+    node, gauge = s.database.children
+    assert node.name == "counter" and gauge.name == "gauge"
+    assert isinstance(gauge, vsd.Node) and type(gauge).__name__ == "PluginGauge"  # the plugin's own class
     env.step()
     env.step()
     assert node.name == "steps 2"  # the plugin's task, through the object the environment keeps
@@ -28,8 +29,28 @@ def test_plugin_builds_into_the_environment_and_its_task_runs(env):
     other = vsd.Environment()
     vsd.load_plugin(PLUGIN, other, ["second"])
     other.step()
-    assert [n.name for n in other.main_state.database.children] == ["steps 1"]
+    assert [n.name for n in other.main_state.database.children] == ["steps 1", "gauge"]
     assert node.name == "steps 2"
+
+
+@needs_plugins
+def test_a_read_only_property_refuses_assignment_and_keeps_its_value(env):
+    vsd.load_plugin(PLUGIN, env, ["counter"])
+    s = env.main_state
+    (gauge,) = s.index("PluginGauge")
+    s.start_recording()
+    changes = []
+    with s.on_property_changed(lambda inst, prop: changes.append(prop)):
+        with pytest.raises(AttributeError, match="property 'PluginGauge.serial' is read-only"):
+            gauge.serial = 8
+        with pytest.raises(AttributeError, match="property 'PluginGauge.serial' is read-only"):
+            setattr(gauge, "serial", 9)
+        with pytest.raises(AttributeError, match="property 'PluginGauge.serial' is read-only"):
+            s.set_column("PluginGauge", "serial", [10])
+        gauge.reading = 1.5  # its writable neighbour is writable
+    assert gauge.serial == 7 and list(s.column("PluginGauge", "serial")) == [7]
+    assert changes == ["reading"]  # no change of serial signalled ...
+    assert len(s.stop_recording()) == 1  # ... nor recorded
 
 
 @needs_plugins
