@@ -98,5 +98,6 @@ void bind_instances(py::module_& m);   // instances.cpp: handles, classes, prope
 void bind_entry_points(py::module_& m);  // entry.cpp: Environment, SimState, Transaction, io, SOML++
 void bind_modules(py::module_& m);       // modules.cpp: scene (URDF), robotics (FK, IK), physics, collision
 void bind_plugins(py::module_& m);       // plugins.cpp: load_plugin
+void bind_soml(py::module_& m);          // soml.cpp: load, Program, Debugger (when vsd::soml is built)
 
 }  // namespace vsdpy
