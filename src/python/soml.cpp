@@ -71,6 +71,18 @@ const char* reason_name(vsd::soml::StopReason r) {
   return "step";
 }
 
+// One dict per item, filled by @p fill.
+template <class T, class F>
+py::list dicts(const std::vector<T>& items, F fill) {
+  py::list l;
+  for (const T& item : items) {
+    py::dict d;
+    fill(d, item);
+    l.append(d);
+  }
+  return l;
+}
+
 void set_stop_handler(const std::shared_ptr<PyDebugger>& d, py::object fn) {
   if (fn.is_none()) {
     d->get().on_stop(nullptr);
@@ -166,16 +178,12 @@ void bind_soml(py::module_& m) {
            "Stops before transition 'owner.name' (or every transition of that name) fires; returns the id")
       .def("remove", [](const PyDebugger& d, int id) { return d.get().remove(id); })
       .def_property_readonly("breakpoints", [](const PyDebugger& d) {
-        py::list l;
-        for (const auto& b : d.get().breakpoints()) {
-          py::dict x;
+        return dicts(d.get().breakpoints(), [](py::dict& x, const vsd::soml::Breakpoint& b) {
           x["id"] = b.id;
           x["line"] = b.line;
           x["transition"] = b.transition;
           x["hits"] = b.hits;
-          l.append(x);
-        }
-        return l;
+        });
       })
       .def("on_stop", &set_stop_handler, py::arg("fn"),
            "Sets the stop handler fn(debugger, stop) (None: every stop continues); stop is a dict "
@@ -184,16 +192,12 @@ void bind_soml(py::module_& m) {
       .def_property_readonly("stopped", [](const PyDebugger& d) { return d.get().stopped(); })
       .def_property_readonly("attached", [](const PyDebugger& d) { return d.debugger && d.debugger->attached(); })
       .def("call_stack", [](const PyDebugger& d) {
-        py::list l;
-        for (const auto& f : d.get().call_stack()) {
-          py::dict x;
+        return dicts(d.get().call_stack(), [](py::dict& x, const vsd::soml::StackFrame& f) {
           x["function"] = f.function;
           x["file"] = f.file;
           x["line"] = f.line;
-          l.append(x);
-        }
-        return l;
-      })
+        });
+      }, "The SOML++ call stack at a stop, innermost first: [{function, file, line}]")
       .def("locals", [](const PyDebugger& d, std::size_t frame) {
         py::dict x;
         for (const auto& v : d.get().locals(frame)) x[py::str(v.name)] = v.value;
