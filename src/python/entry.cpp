@@ -1,5 +1,5 @@
 // The hand-written entry points: the module itself, errors, Environment, SimState, Transaction, signals,
-// classes defined from Python, and the modules' own entry points (io, SOML++) when they are built.
+// classes defined from Python, and vsd::io's entry points when it is built (SOML++: soml.cpp).
 #include <pybind11/stl.h>
 
 #include <string>
@@ -10,9 +10,6 @@
 #include "vsdpy.hpp"
 #ifdef VSDPY_WITH_IO
 #include "vsd/io/snapshot.hpp"
-#endif
-#ifdef VSDPY_WITH_SOML
-#include "vsd/soml/module.hpp"
 #endif
 
 namespace vsdpy {
@@ -106,6 +103,9 @@ EnvBox::~EnvBox() {
   for (auto& [s, w] : states)
     if (auto b = w.lock()) b->alive = false;
   py::gil_scoped_release release;  // modules may join threads that call back into Python
+  // A plugin's objects first: the Environment's tasks and listeners refer to them, and their own
+  // destructors may still use the Environment.
+  while (!plugin_objects.empty()) plugin_objects.pop_back();
   env.reset();
 }
 
@@ -320,17 +320,6 @@ void bind_entry_points(py::module_& m) {
     return vsd::io::load(st, path).instances;
   }, "Loads a state file into an empty state; returns the number of instances");
 #endif
-
-#ifdef VSDPY_WITH_SOML
-  py::module_ soml = m.def_submodule("soml", "vsd::soml: SOML++ scripts");
-  soml.def("load", [](const PyEnvironment& e, const PyState& s, const std::string& name, const std::string& text) {
-    auto& mod = e.box->env->use<vsd::soml::Module>();
-    SimState& st = s.get();
-    py::gil_scoped_release release;
-    mod.load(st, name, text);
-  }, py::arg("env"), py::arg("state"), py::arg("name"), py::arg("text"),
-     "Loads a SOML++ script into a state of env; its nets fire in every step");
-#endif
 }
 
 }  // namespace vsdpy
@@ -340,4 +329,8 @@ PYBIND11_MODULE(_core, m) {
   vsdpy::bind_entry_points(m);
   vsdpy::bind_instances(m);
   vsdpy::bind_modules(m);
+  vsdpy::bind_plugins(m);
+#ifdef VSDPY_WITH_SOML
+  vsdpy::bind_soml(m);
+#endif
 }

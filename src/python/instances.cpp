@@ -336,6 +336,19 @@ void bind_instances(py::module_& m) {
     if (p == nullptr || c == nullptr) throw py::type_error("remove_child: both must be Nodes");
     p->remove_child(*c);
   });
+  m.def("_add_extension", [](const Handle& owner, const Handle& ext) {
+    auto* o = owner.get().as<vsd::NamedModelInstance>();
+    auto* e = ext.get().as<vsd::Extension>();
+    if (o == nullptr) throw py::type_error("add_extension: the owner must be a NamedModelInstance");
+    if (e == nullptr) throw py::type_error("add_extension: expected an Extension, got a " + ext.get().meta().name());
+    o->add_extension(*e);
+  });
+  m.def("_remove_extension", [](const Handle& owner, const Handle& ext) {
+    auto* o = owner.get().as<vsd::NamedModelInstance>();
+    auto* e = ext.get().as<vsd::Extension>();
+    if (o == nullptr || e == nullptr) throw py::type_error("remove_extension: expects an owner and an Extension");
+    o->remove_extension(*e);
+  });
   m.def("_node_parent", [](const Handle& n) {
     auto* p = n.get().as<vsd::Node>();
     if (p == nullptr) throw py::type_error("parent: not a Node");

@@ -1,6 +1,7 @@
-// The entry points of vsd::scene (URDF loading) and vsd::robotics (kinematics, FK, IK), each only when
-// the module is built. Everything else of theirs (Node3D frames, joint positions, ...) is reached
-// through the meta-information like any class.
+// The entry points of vsd::scene (URDF loading), vsd::robotics (kinematics, FK, IK), vsd::physics and
+// vsd::collision (use, contacts, distances), each only when the module is built. Everything else of
+// theirs (Node3D frames, joint positions, worlds, rigid bodies, geometries ...) is reached through the
+// meta-information like any class.
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
@@ -9,6 +10,14 @@
 #include "vsd/scene/module.hpp"
 #include "vsd/scene/scene.hpp"
 #include "vsd/scene/urdf_loader.hpp"
+#endif
+#ifdef VSDPY_WITH_PHYSICS
+#include "vsd/physics/module.hpp"
+#endif
+#ifdef VSDPY_WITH_COLLISION
+#include "vsd/collision/collision_world.hpp"
+#include "vsd/collision/module.hpp"
+#include "vsd/scene/hull.hpp"
 #endif
 #ifdef VSDPY_WITH_ROBOTICS
 #include "vsd/robotics/ik.hpp"
@@ -55,6 +64,30 @@ py::array matrix_of(const Eigen::Isometry3d& f) {
 }
 #endif
 
+#if defined(VSDPY_WITH_ROBOTICS) || defined(VSDPY_WITH_COLLISION)
+py::array vector_of(const Eigen::Vector3d& v) {
+  py::array_t<double> a(3);
+  for (int i = 0; i < 3; ++i) a.mutable_at(i) = v[i];
+  return a;
+}
+#endif
+
+#ifdef VSDPY_WITH_COLLISION
+vsd::scene::Hull& hull_of(const Handle& h, const char* what) {
+  auto* x = h.get().as<vsd::scene::Hull>();
+  if (x == nullptr) throw py::type_error(std::string(what) + ": expected a scene::Hull, got a " + h.get().meta().name());
+  return *x;
+}
+
+// The collision world of a state (the module used in its environment first).
+vsd::collision::CollisionWorld& collision_world(const PyState& s) {
+  vsd::SimState& st = s.get();
+  auto* m = s.box->env->env->module<vsd::collision::Module>();
+  if (m == nullptr) throw py::value_error("collision: the environment does not use the collision module (vsd.collision.use(env))");
+  return m->world(st);
+}
+#endif
+
 }  // namespace
 
 void bind_modules([[maybe_unused]] py::module_& m) {
@@ -83,6 +116,52 @@ void bind_modules([[maybe_unused]] py::module_& m) {
       },
       py::arg("parent"), py::arg("path"), py::arg("load_meshes") = true,
       "Loads a URDF file under parent; returns {scene, links, joints, warnings}");
+#endif
+#ifdef VSDPY_WITH_PHYSICS
+  py::module_ physics = m.def_submodule("physics", "vsd::physics: rigid bodies (ODE) in physics::World scenes");
+  physics.def("use", [](const PyEnvironment& e) { e.box->env->use<vsd::physics::Module>(); },
+              "Uses the physics module in env: every step moves the rigid bodies of each physics::World");
+#endif
+#ifdef VSDPY_WITH_COLLISION
+  py::module_ collision = m.def_submodule("collision", "vsd::collision: contacts and distances between hulls");
+  collision.def(
+      "use",
+      [](const PyEnvironment& e, double period) {
+        if (!(period >= 0)) throw py::value_error("collision.use: period must be >= 0 (0: every step)");
+        e.box->env->use<vsd::collision::Module>(period);
+      },
+      py::arg("env"), py::arg("period") = 0.0,
+      "Uses the collision module in env: its worlds update every `period` seconds (0: every step)");
+  collision.def(
+      "contacts",
+      [](const PyState& s) {
+        auto& w = collision_world(s);
+        {
+          py::gil_scoped_release release;
+          w.update();  // now, not at the module's last update: the world may have been made just now
+        }
+        py::list out;
+        for (const vsd::collision::Contact& c : w.contacts()) {
+          py::dict d;
+          d["a"] = wrap(s.box, c.a);
+          d["b"] = wrap(s.box, c.b);
+          d["position"] = vector_of(c.position);
+          d["normal"] = vector_of(c.normal);
+          d["depth"] = c.depth;
+          out.append(d);
+        }
+        return out;
+      },
+      "The contacts of the state's collision hulls now (updates its world): [{a, b, position, normal, depth}]");
+  collision.def(
+      "distance",
+      [](const PyState& s, const Handle& a, const Handle& b) {
+        auto& ha = hull_of(a, "collision.distance");
+        auto& hb = hull_of(b, "collision.distance");
+        const auto r = collision_world(s).distance(ha, hb);
+        return py::make_tuple(r.distance, vector_of(r.point_a), vector_of(r.point_b));
+      },
+      "(distance, point_a, point_b) between two hulls of the state, now");
 #endif
 #ifdef VSDPY_WITH_ROBOTICS
   py::module_ rob = m.def_submodule("robotics", "vsd::robotics: kinematic trees, FK and IK");

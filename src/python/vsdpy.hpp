@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <unordered_map>
+#include <vector>
 
 #include "vsd/core/environment.hpp"
 
@@ -30,6 +31,8 @@ struct StateBox {
 /// (the environment, a state, an instance handle, a connection) is gone.
 struct EnvBox {
   std::unique_ptr<vsd::Environment> env;
+  /// What plugins built (vsd.load_plugin): destroyed before the Environment, newest first.
+  std::vector<std::shared_ptr<void>> plugin_objects;
   std::unordered_map<const vsd::SimState*, std::weak_ptr<StateBox>> states;
   ~EnvBox();
 };
@@ -93,6 +96,8 @@ vsd::Registry& registry();
 // Parts of the module, each in its own file.
 void bind_instances(py::module_& m);   // instances.cpp: handles, classes, properties, methods, columns
 void bind_entry_points(py::module_& m);  // entry.cpp: Environment, SimState, Transaction, io, SOML++
-void bind_modules(py::module_& m);       // modules.cpp: scene (URDF) and robotics (FK, IK), when built
+void bind_modules(py::module_& m);       // modules.cpp: scene (URDF), robotics (FK, IK), physics, collision
+void bind_plugins(py::module_& m);       // plugins.cpp: load_plugin
+void bind_soml(py::module_& m);          // soml.cpp: load, Program, Debugger (when vsd::soml is built)
 
 }  // namespace vsdpy

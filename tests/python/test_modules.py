@@ -78,3 +78,52 @@ def test_urdf_bad_files(env, tmp_path):
     with pytest.raises(vsd.Error):
         vsd.scene.load_urdf(env.main_state.database, str(tmp_path / "missing.urdf"))
     assert env.main_state.database.children == []  # nothing was left behind
+
+
+def test_physics_box_falls_onto_the_ground_and_collision_sees_it(env):
+    vsd.scene.use(env)
+    vsd.physics.use(env)
+    vsd.collision.use(env)
+    s = env.main_state
+    room = s.create("scene::Scene", name="room")
+    s.database.add_child(room)
+    room.add_extension(s.create("physics::World"))
+    ground = s.create("scene::Hull", name="ground", role="Collision",
+                      geometry=s.create("scene::Geometry", kind="Plane"))
+    frame = np.eye(4)
+    frame[2, 3] = 0.5
+    box = s.create("scene::Hull", name="box", role="Collision", frame=frame,
+                   geometry=s.create("scene::Geometry", kind="Box", size=np.array([0.1, 0.1, 0.1])))
+    room.add_child(ground)
+    room.add_child(box)
+    body = s.create("physics::RigidBody", mass=1.0)
+    box.add_extension(body)
+    assert list(box.extensions) == [body]
+    env.run_for(1.0)
+    z = box.frame[2, 3]
+    assert abs(z - 0.05) < 0.01  # fell 0.45 m and lies on the ground
+    contacts = vsd.collision.contacts(s)
+    assert {frozenset((c["a"].name, c["b"].name)) for c in contacts} == {frozenset(("ground", "box"))}
+    assert all(c["depth"] >= 0 and c["position"].shape == (3,) for c in contacts)
+    d, pa, pb = vsd.collision.distance(s, box, ground)
+    assert d < 0.01 and pa.shape == (3,)
+
+
+def test_physics_and_collision_bad_input(env):
+    s = env.main_state
+    node = s.create("Node")
+    with pytest.raises(ValueError, match=r"does not use the collision module \(vsd.collision.use\(env\)\)"):
+        vsd.collision.contacts(s)
+    vsd.collision.use(env)
+    with pytest.raises(TypeError, match="collision.distance: expected a scene::Hull, got a Node"):
+        vsd.collision.distance(s, node, node)
+    with pytest.raises(ValueError, match="collision.use: period must be >= 0"):
+        vsd.collision.use(env, -1.0)
+    with pytest.raises(TypeError):
+        vsd.physics.use("not an environment")
+    with pytest.raises(TypeError, match="add_extension: expected an Extension, got a Node"):
+        node.add_extension(s.create("Node"))
+    body = s.create("physics::RigidBody")
+    s.destroy(body)
+    with pytest.raises(vsd.DeadInstanceError):
+        node.add_extension(body)

@@ -383,26 +383,50 @@ void add_cell_modules(vsd::Environment& env, double collision_period) {
   env.use<vsd::soml::Module>();
 }
 
-CellReport run_cell(const CellOptions& o) {
-  using vsd::scene::GeometryKind;
+struct Cell::promise_type {
+  CellReport report;
+  std::exception_ptr error;
+  Cell get_return_object() { return Cell(std::coroutine_handle<promise_type>::from_promise(*this)); }
+  std::suspend_never initial_suspend() noexcept { return {}; }  // building runs in build_cell's call
+  std::suspend_always final_suspend() noexcept { return {}; }   // the Cell destroys the frame
+  void return_value(CellReport r) { report = std::move(r); }
+  void unhandled_exception() { error = std::current_exception(); }  // rethrown by Cell::rethrow
+};
+
+Cell::Cell(Cell&& other) noexcept : h_(std::exchange(other.h_, {})) {}
+
+Cell::~Cell() {
+  if (h_) h_.destroy();  // the frame's locals (the cell) go in reverse order, as a function's would
+}
+
+void Cell::rethrow() {
+  if (h_ && h_.promise().error) std::rethrow_exception(std::exchange(h_.promise().error, nullptr));
+}
+
+CellReport Cell::run() {
+  if (!h_ || h_.done()) throw vsd::Error("Cell::run: the cell has run already");
+  h_.resume();
+  rethrow();
+  return std::move(h_.promise().report);
+}
+
+namespace {
+
+void check_options(const CellOptions& o) {
   if (o.parts < 1) throw vsd::Error("parts must be at least 1");
   if (!(o.step > 0) || !(o.physics_step > 0) || o.physics_step > o.step)
     throw vsd::Error("the physics step must be positive and at most the step");
-  std::ostream* tl = o.timeline;
   if (!o.png.empty()) check_writable(o.png);  // before the run, not after it
+}
+
+// The whole run as one coroutine: it builds the cell, suspends (build_cell returns), and the loop runs
+// when Cell::run resumes it. Its locals — the cell's state, which the scheduler task, the collision
+// listeners and the nets' callbacks refer to — live in the coroutine's frame as long as the Cell.
+Cell cell_coroutine(vsd::Environment& env, const CellOptions& o) {
+  using vsd::scene::GeometryKind;
+  std::ostream* tl = o.timeline;
   const double time_limit = o.time_limit > 0 ? o.time_limit : 60.0 * o.parts;
 
-  vsd::Environment env;
-  // on_finished runs before the Environment goes, however the run ends.
-  bool completed = false;
-  struct Finish {
-    const CellOptions& o;
-    vsd::Environment& env;
-    const bool& completed;
-    ~Finish() {
-      if (o.on_finished) o.on_finished(env, completed);
-    }
-  } finish{o, env, completed};
   env.scheduler().set_base_step(o.step);
   add_cell_modules(env, o.step);
   auto& collision = env.use<vsd::collision::Module>(o.step);
@@ -918,6 +942,8 @@ CellReport run_cell(const CellOptions& o) {
     });
   }
 
+  co_await std::suspend_always{};  // built: build_cell returns; Cell::run resumes here
+
   // --- The run, with the geometric checks every step.
   std::ofstream csv;
   if (!o.csv.empty()) {
@@ -1050,6 +1076,34 @@ CellReport run_cell(const CellOptions& o) {
   report.faults = faults.records();
   report.fault_lines = faults.lines();
   for (int i = 0; hardware && i < 2; ++i) report.hardware.push_back(robots[i]->name() + ": " + hardware->summary(i));
+  co_return report;
+}
+
+}  // namespace
+
+Cell build_cell(vsd::Environment& env, const CellOptions& o) {
+  check_options(o);
+  Cell cell = cell_coroutine(env, o);
+  cell.rethrow();
+  return cell;
+}
+
+CellReport run_cell(const CellOptions& o) {
+  check_options(o);
+  vsd::Environment env;
+  // on_finished runs before the Environment goes, however the run ends.
+  bool completed = false;
+  struct Finish {
+    const CellOptions& o;
+    vsd::Environment& env;
+    const bool& completed;
+    ~Finish() {
+      if (o.on_finished) o.on_finished(env, completed);
+    }
+  } finish{o, env, completed};
+  Cell cell = cell_coroutine(env, o);
+  cell.rethrow();
+  CellReport report = cell.run();
   completed = true;
   return report;
 }

@@ -6,10 +6,14 @@
 //
 // run_cell() builds the cell, runs it until the requested number of parts is handled and returns what
 // the summary prints. main.cpp is the command line; tests/examples/workcell/two_robot_cell_test.cpp runs
-// it on several seeds.
+// it on several seeds. build_cell() does the first half alone: the cell in an Environment the caller
+// owns, its behaviour in the Environment's scheduler tasks and SOML++ nets, so that whoever steps the
+// Environment runs the cell (the Python plugin, python_plugin.cpp, does so).
 #pragma once
 
+#include <coroutine>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <iosfwd>
 #include <string>
@@ -95,7 +99,41 @@ void add_cell_modules(vsd::Environment& env, double collision_period = 0.01);
 /// before the first snapshot arrives: run-time class definitions do not travel (docs/dist.md).
 void define_net_classes(vsd::Environment& env, const CellOptions& options);
 
-/// Builds the cell and runs it. @throws vsd::Error on bad options, unreadable files or a plant fault.
+/// A cell built into an Environment (build_cell). Its plant — the sensors, the parts' arrivals, the
+/// operator's commands, the robots' σ/γ interface — is a scheduler task and its controls are two SOML++
+/// programs, all referring to what this object holds: every step of the Environment runs the cell for as
+/// long as the object lives. Destroy it before the Environment. Move-only.
+///
+/// It is the suspended coroutine of the whole run (build, then the demo's loop): its frame holds what the
+/// tasks refer to, and run() resumes it for the loop that run_cell() drives.
+class Cell {
+ public:
+  struct promise_type;
+  Cell(Cell&& other) noexcept;
+  Cell& operator=(Cell&&) = delete;
+  ~Cell();
+  /// The demo's loop (CellOptions::on_built first): steps the Environment until every part is handled
+  /// and the robots rest, the time limit or a deadlock, then makes the report. Once only.
+  /// @throws vsd::Error from the run (a plant fault), or when the cell has run already.
+  CellReport run();
+
+ private:
+  explicit Cell(std::coroutine_handle<promise_type> h) : h_(h) {}
+  void rethrow();
+  std::coroutine_handle<promise_type> h_;
+  friend Cell build_cell(vsd::Environment& env, const CellOptions& options);
+  friend CellReport run_cell(const CellOptions& options);
+};
+
+/// Builds the cell into @p env (its base step becomes CellOptions::step): the modules of
+/// add_cell_modules, the nodes under the main state's database, the tasks and the nets. @p options must
+/// outlive the Cell; `csv`, `png`, `time_limit`, `on_built`, `before_step` and `on_finished` are the
+/// loop's (Cell::run), unused by whoever steps the Environment alone.
+/// @throws vsd::Error on bad options, unreadable files or an unreachable layout.
+Cell build_cell(vsd::Environment& env, const CellOptions& options);
+
+/// Builds the cell in an Environment of its own and runs it (Cell::run).
+/// @throws vsd::Error on bad options, unreadable files or a plant fault.
 CellReport run_cell(const CellOptions& options);
 
 /// Writes the summary lines (`parts handled: N`, `parts/hour: X`, `zone violations: N`, ...).

@@ -23,11 +23,13 @@ from ._core import (  # noqa: F401  (the package's API)
     class_info,
     class_names,
     define_class,
+    load_plugin,
     type_names,
 )
 
-# The modules' entry points (vsd.io, vsd.soml, vsd.scene, vsd.robotics): only those of the modules built.
-for _name in ("io", "soml", "scene", "robotics"):
+# The modules' entry points (vsd.io, vsd.soml, vsd.scene, vsd.robotics, vsd.physics, vsd.collision): only
+# those of the modules built.
+for _name in ("io", "soml", "scene", "robotics", "physics", "collision"):
     if hasattr(_core, _name):
         globals()[_name] = getattr(_core, _name)
 
@@ -64,7 +66,22 @@ def _remove_child(self, child):
     _core._node_remove_child(self, child)
 
 
+def _add_extension(self, ext):
+    """Attaches the extension ext (moving it from a former owner); returns self."""
+    _core._add_extension(self, ext)
+    return self
+
+
+def _remove_extension(self, ext):
+    """Detaches ext; it is deleted when nothing else holds it."""
+    _core._remove_extension(self, ext)
+
+
 _extras = {
+    "NamedModelInstance": {
+        "add_extension": _add_extension,
+        "remove_extension": _remove_extension,
+    },
     "Node": {
         "add_child": _add_child,
         "remove_child": _remove_child,

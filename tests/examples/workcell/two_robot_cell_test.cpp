@@ -10,7 +10,9 @@
 
 #include "cell.hpp"
 #include "trace_plot.hpp"
+#include "vsd/core/environment.hpp"
 #include "vsd/core/error.hpp"
+#include "vsd/robotics.hpp"
 
 namespace {
 
@@ -240,6 +242,49 @@ TEST(TwoRobotCell, BadOptionsAreClearErrors) {
   CellOptions missing = options(1, 1);
   missing.robot_script = "/nonexistent/mrc.soml";
   EXPECT_THROW(vsd_workcell::run_cell(missing), vsd::Error);
+}
+
+// build_cell: the cell in the caller's Environment, run by whoever steps it (the Python plugin does so) —
+// the same cell as run_cell's, part by part. (Its tasks and nets refer to the Cell: it goes before the
+// Environment, which is not stepped after that.)
+TEST(TwoRobotCell, BuiltIntoAnEnvironmentRunsWhenItIsStepped) {
+  const CellOptions o = options(1, 2);
+  const CellReport whole = vsd_workcell::run_cell(o);
+  vsd::Environment env;
+  {
+    vsd_workcell::Cell cell = vsd_workcell::build_cell(env, o);
+    EXPECT_DOUBLE_EQ(env.scheduler().base_step(), o.step);
+    vsd::Node* outfeed = nullptr;
+    for (vsd::Node* n : env.main_state().database().children())
+      if (n->name() == "outfeed") outfeed = n;
+    ASSERT_NE(outfeed, nullptr);
+    std::vector<double> first;
+    bool moved = false;
+    for (vsd::SimStateInstance* i : env.main_state().instances())
+      if (auto* tree = i->as<vsd::robotics::KinematicTree>(); tree != nullptr && first.empty())
+        first = tree->positions();
+    while (outfeed->children().size() < 2 && env.time() < whole.time + 1) {
+      env.step();
+      for (vsd::SimStateInstance* i : env.main_state().instances())
+        if (auto* tree = i->as<vsd::robotics::KinematicTree>(); tree != nullptr && tree->positions() != first)
+          moved = true;
+    }
+    EXPECT_EQ(outfeed->children().size(), 2u);  // both parts handled, in no more time than run_cell took
+    EXPECT_TRUE(moved);
+  }
+  // Bad options fail before anything is built; a Cell runs once.
+  CellOptions bad = o;
+  bad.parts = 0;
+  vsd::Environment other;
+  EXPECT_THROW(vsd_workcell::build_cell(other, bad), vsd::Error);
+  vsd_workcell::Cell cell = vsd_workcell::build_cell(other, o);
+  EXPECT_EQ(cell.run().parts_handled, 2);
+  try {
+    cell.run();
+    FAIL() << "a second run";
+  } catch (const vsd::Error& e) {
+    EXPECT_STREQ(e.what(), "Cell::run: the cell has run already");
+  }
 }
 
 }  // namespace
