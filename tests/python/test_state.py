@@ -35,6 +35,31 @@ def test_transactions_record_apply_invert_bytes(env):
     assert replica.database.children == []
 
 
+def test_python_classes_replicate_through_bundles(env):
+    # A class defined in Python is a run-time vsd class like any other: its instances and their changes
+    # travel in recorded bundles (what vsd::dist sends) to a state of another environment.
+    class Feeder(vsd.Node):
+        rate: float = 1.5
+        lane: int = 2
+
+    s = env.main_state
+    with s.record() as rec:
+        f = s.create(Feeder, name="f1")
+        s.database.add_child(f)
+        f.rate = 3.25
+    other = vsd.Environment()
+    replica = other.main_state
+    replica.apply(vsd.Transaction.from_bytes(rec.transaction.bytes()))
+    (copy,) = replica.index(Feeder)
+    assert type(copy) is Feeder and copy.name == "f1" and copy.rate == 3.25 and copy.lane == 2
+    with s.record() as rec:
+        f.lane = 5
+    replica.apply(vsd.Transaction.from_bytes(rec.transaction.bytes()))
+    assert copy.lane == 5
+    replica.apply(rec.transaction.inverted())
+    assert copy.lane == 2
+
+
 def test_io_save_and_load(env, tmp_path):
     s = env.main_state
     build(s)
