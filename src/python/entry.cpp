@@ -333,4 +333,7 @@ PYBIND11_MODULE(_core, m) {
 #ifdef VSDPY_WITH_SOML
   vsdpy::bind_soml(m);
 #endif
+#ifdef VSDPY_WITH_WEB
+  vsdpy::bind_web(m);
+#endif
 }

@@ -99,5 +99,6 @@ void bind_entry_points(py::module_& m);  // entry.cpp: Environment, SimState, Tr
 void bind_modules(py::module_& m);       // modules.cpp: scene (URDF), robotics (FK, IK), physics, collision
 void bind_plugins(py::module_& m);       // plugins.cpp: load_plugin
 void bind_soml(py::module_& m);          // soml.cpp: load, Program, Debugger (when vsd::soml is built)
+void bind_web(py::module_& m);           // web.cpp: the inspector's Server (when vsd::web is built)
 
 }  // namespace vsdpy
