@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <new>
 #include <span>
 #include <string>
 #include <vector>
@@ -11,43 +10,7 @@
 #include "vsd/core/error.hpp"
 #include "vsd/core/sim_state.hpp"
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 namespace vsd::web::detail {
-
-namespace {
-constexpr std::size_t line = 64;  // an entry starts on a cache line of its own
-
-std::size_t round_up(std::size_t n) noexcept { return (n + line - 1) / line * line; }
-// The room an entry of @p n bytes takes in a block: the copy writes whole 16-byte pieces.
-std::size_t room(std::size_t n) noexcept { return (n + 15) / 16 * 16; }
-
-// Copies an entry into its block without reading the block's cache lines first and without keeping them
-// in the caches: the timeline is written once and read only when the page scrubs, so ordinary stores
-// would fetch every line of the block from memory (the block was last used a whole timeline ago) and push
-// the simulation's own data out of the caches. Non-temporal stores write whole lines straight to memory.
-void stream_copy(std::uint8_t* to, const std::uint8_t* from, std::size_t n) noexcept {
-#if defined(__SSE2__)
-  std::size_t i = 0;
-  for (; i + 16 <= n; i += 16)
-    _mm_stream_si128(reinterpret_cast<__m128i*>(to + i), _mm_loadu_si128(reinterpret_cast<const __m128i*>(from + i)));
-  if (i < n) {  // the last piece, padded (room() keeps space for it): an ordinary store would fetch its line
-    alignas(16) std::uint8_t last[16] = {};
-    std::memcpy(last, from + i, n - i);
-    _mm_stream_si128(reinterpret_cast<__m128i*>(to + i), _mm_load_si128(reinterpret_cast<const __m128i*>(last)));
-  }
-  _mm_sfence();  // the streamed stores are ordered before anything this thread writes next
-#else
-  std::memcpy(to, from, n);
-#endif
-}
-}  // namespace
-
-void Timeline::BlockDelete::operator()(std::uint8_t* p) const noexcept {
-  ::operator delete[](p, std::align_val_t{line});
-}
 
 Timeline::Timeline(SimState& state, std::size_t max_bytes)
     : state_(state),
@@ -91,26 +54,26 @@ void Timeline::add(const Transaction& bundle) {
   // A change made while scrubbed back forks the history: the undone entries are gone for good.
   while (position_ < end()) drop_back();
   const std::span<const std::uint8_t> bytes(bundle.bytes());
-  if (blocks_.empty() || round_up(blocks_.back().used) + room(bytes.size()) > blocks_.back().capacity) {
+  if (blocks_.empty() || blocks_.back().capacity - blocks_.back().used < bytes.size()) {
     Block b;
-    if (spare_.data && spare_.capacity >= room(bytes.size())) {
+    if (spare_.data && spare_.capacity >= bytes.size()) {
       b = std::move(spare_);
       spare_ = Block{};
     } else {
       // A bundle larger than a block gets one of its own size.
-      b.capacity = std::max(block_bytes_, room(bytes.size()));
-      b.data.reset(static_cast<std::uint8_t*>(::operator new[](b.capacity, std::align_val_t{line})));
+      b.capacity = std::max(block_bytes_, bytes.size());
+      b.data = std::make_unique_for_overwrite<std::uint8_t[]>(b.capacity);
     }
     b.used = 0;
     b.entries = 0;
     blocks_.push_back(std::move(b));
   }
   Block& b = blocks_.back();
-  std::uint8_t* at = b.data.get() + round_up(b.used);
-  stream_copy(at, bytes.data(), bytes.size());
-  b.used = static_cast<std::size_t>(at - b.data.get()) + bytes.size();
+  std::uint8_t* at = b.data.get() + b.used;
+  std::memcpy(at, bytes.data(), bytes.size());
+  b.used += bytes.size();
   ++b.entries;
-  bytes_ += round_up(bytes.size());
+  bytes_ += bytes.size();
   entries_.push_back(Entry{step_, time_, bundle.size(), at, bytes.size(), &b});
   while (bytes_ > max_bytes_ && entries_.size() > 1) drop_front();
   position_ = end();
@@ -119,7 +82,7 @@ void Timeline::add(const Transaction& bundle) {
 void Timeline::drop_back() {
   const Entry e = entries_.back();
   entries_.pop_back();
-  bytes_ -= round_up(e.size);
+  bytes_ -= e.size;
   // Entries are added at the end of the last block, so the newest one's bytes are the last used there.
   e.block->used = static_cast<std::size_t>(e.bytes - e.block->data.get());
   if (--e.block->entries == 0) {
@@ -132,7 +95,7 @@ void Timeline::drop_front() {
   const Entry e = entries_.front();
   entries_.pop_front();
   ++first_;
-  bytes_ -= round_up(e.size);
+  bytes_ -= e.size;
   if (--e.block->entries == 0) {
     retire(std::move(blocks_.front()));
     blocks_.pop_front();

@@ -25,7 +25,7 @@ class Timeline {
  public:
   /// @brief Listens to @p state's bundles (SimState::on_bundle) and makes the state record; keeps at most
   /// @p max_bytes of bundles (oldest dropped first; the newest entry is kept even when it alone is
-  /// larger). Memory: bytes() plus at most two blocks of max_bytes / 16 (64 KiB to 1 MiB).
+  /// larger). Memory: the bundles kept plus at most two blocks of max_bytes / 16 (64 KiB to 1 MiB).
   Timeline(SimState& state, std::size_t max_bytes);
   ~Timeline();
   Timeline(const Timeline&) = delete;
@@ -41,8 +41,7 @@ class Timeline {
   [[nodiscard]] std::uint64_t position() const noexcept { return position_; }
   [[nodiscard]] bool live() const noexcept { return position_ == end(); }
   [[nodiscard]] std::size_t size() const noexcept { return entries_.size(); }
-  /// @brief Memory the bundles kept take: each one's bytes rounded up to a whole 64-byte cache line (an
-  /// entry starts on a line of its own), so that many small bundles (edits) stay within the budget too.
+  /// @brief Bytes of the bundles kept.
   [[nodiscard]] std::size_t bytes() const noexcept { return bytes_; }
   /// @brief The bundle of entry @p index (absolute, in [first(), end())), for tests and tools.
   /// @throws vsd::Error when @p index is not kept.
@@ -60,11 +59,8 @@ class Timeline {
   // and was used before, not an allocation: a malloc of a few KiB a step makes glibc consolidate its
   // fast bins every step, and a bundle kept in the recording's own buffer (the buffer moved, not copied)
   // made every step record into fresh memory (benchmarks/README.md, "On the two-robot work cell").
-  struct BlockDelete {
-    void operator()(std::uint8_t* p) const noexcept;
-  };
   struct Block {
-    std::unique_ptr<std::uint8_t[], BlockDelete> data;  // aligned to a cache line
+    std::unique_ptr<std::uint8_t[]> data;
     std::size_t capacity = 0;
     std::size_t used = 0;
     std::size_t entries = 0;  // entries whose bytes are here
