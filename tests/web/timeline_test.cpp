@@ -134,6 +134,22 @@ TEST_F(TimelineTest, ABundleLargerThanABlockIsKeptWholeAndTheNewestAlwaysStays) 
   EXPECT_EQ(tiny.first(), 1U);
 }
 
+TEST_F(TimelineTest, SmallBundlesOfEveryLengthStayExactAndWithinTheBudget) {
+  // Entries of every length follow each other in a block: each must come back byte for byte, and many
+  // tiny bundles (edits) stay within the budget.
+  const std::size_t budget = std::size_t{64} << 10;
+  Timeline timeline(state, budget);
+  listen();
+  for (int step = 0; step < 4000; ++step) {
+    nodes[static_cast<std::size_t>(step) % nodes.size()]->set_name(std::string(static_cast<std::size_t>(step % 37), 'n'));
+    timeline.cut(static_cast<std::uint64_t>(step), 0.0);
+    ASSERT_LE(timeline.bytes(), budget);
+  }
+  ASSERT_GT(timeline.first(), 0U);  // the budget dropped the oldest
+  for (std::uint64_t i = timeline.first(); i < timeline.end(); ++i)
+    ASSERT_EQ(timeline.entry(i).bytes(), heard[i]) << "entry " << i;
+}
+
 TEST_F(TimelineTest, AChangeWhileScrubbedBackForksAndLaterEntriesFitAfterIt) {
   Timeline timeline(state, std::size_t{1} << 20);
   listen();
