@@ -336,4 +336,7 @@ PYBIND11_MODULE(_core, m) {
 #ifdef VSDPY_WITH_WEB
   vsdpy::bind_web(m);
 #endif
+#ifdef VSDPY_WITH_DIST
+  vsdpy::bind_dist(m);
+#endif
 }
