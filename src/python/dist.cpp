@@ -31,12 +31,6 @@ struct PyParticipant {
   }
 };
 
-std::chrono::milliseconds to_ms(double seconds, const char* what) {
-  if (!(seconds >= 0) || !std::isfinite(seconds))
-    throw py::value_error(std::string(what) + ": seconds must be a finite number >= 0");
-  return std::chrono::milliseconds(static_cast<long long>(std::ceil(seconds * 1000.0)));
-}
-
 const char* kind_name(vsd::dist::ConflictKind k) {
   switch (k) {
     case vsd::dist::ConflictKind::Owned: return "owned";
@@ -73,9 +67,9 @@ void bind_dist(py::module_& m) {
         o.topic = std::move(topic);
         o.seed = seed;
         o.config = std::move(config);
-        o.request_interval = to_ms(request_interval, "dist.join request_interval");
+        o.request_interval = milliseconds_of(request_interval, "dist.join request_interval");
         if (lease_duration > 0) {
-          o.lease_duration = to_ms(lease_duration, "dist.join lease_duration");
+          o.lease_duration = milliseconds_of(lease_duration, "dist.join lease_duration");
           o.write_timeout = std::max(o.write_timeout, o.lease_duration * 2);
         }
         auto p = std::make_shared<PyParticipant>();
@@ -117,7 +111,7 @@ void bind_dist(py::module_& m) {
           "wait_synced",
           [](const PyParticipant& p, double seconds) {
             vsd::dist::Participant& d = p.get();
-            const auto ms = to_ms(seconds, "wait_synced");
+            const auto ms = milliseconds_of(seconds, "wait_synced");
             py::gil_scoped_release release;
             return d.wait_synced(ms);
           },
@@ -126,7 +120,7 @@ void bind_dist(py::module_& m) {
           "wait_peers",
           [](const PyParticipant& p, std::size_t n, double seconds) {
             vsd::dist::Participant& d = p.get();
-            const auto ms = to_ms(seconds, "wait_peers");
+            const auto ms = milliseconds_of(seconds, "wait_peers");
             py::gil_scoped_release release;
             return d.wait_peers(n, ms);
           },

@@ -2,6 +2,8 @@
 // classes defined from Python, and vsd::io's entry points when it is built (SOML++: soml.cpp).
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -107,6 +109,13 @@ EnvBox::~EnvBox() {
   // destructors may still use the Environment.
   while (!plugin_objects.empty()) plugin_objects.pop_back();
   env.reset();
+}
+
+std::chrono::milliseconds milliseconds_of(double seconds, const char* what) {
+  if (!(seconds >= 0) || !std::isfinite(seconds))
+    throw py::value_error(std::string(what) + ": seconds must be a finite number >= 0");
+  // Clamped far below the range of the count (a wait of a billion seconds is "forever" here).
+  return std::chrono::milliseconds(static_cast<long long>(std::ceil(std::min(seconds, 1e9) * 1000.0)));
 }
 
 std::shared_ptr<StateBox> box_of(const std::shared_ptr<EnvBox>& env, vsd::SimState& s) {

@@ -4,6 +4,7 @@
 
 #include <pybind11/pybind11.h>
 
+#include <chrono>
 #include <memory>
 #include <unordered_map>
 #include <vector>
@@ -89,6 +90,10 @@ py::list instance_list(const std::shared_ptr<StateBox>& box, py::handle cls);
 py::object column(const std::shared_ptr<StateBox>& box, py::handle cls, const std::string& name);
 /// Sets property @p name of every instance of @p cls from @p values, through the setters.
 void set_column(const std::shared_ptr<StateBox>& box, py::handle cls, const std::string& name, py::handle values);
+
+/// @p seconds from Python as milliseconds (rounded up, so that a short wait is not none); raises
+/// ValueError naming @p what for a negative, NaN or infinite number.
+std::chrono::milliseconds milliseconds_of(double seconds, const char* what);
 
 /// The registry the module uses (the global one).
 vsd::Registry& registry();

@@ -35,12 +35,6 @@ struct PyServer {
   }
 };
 
-std::chrono::milliseconds to_ms(double seconds, const char* what) {
-  if (!(seconds >= 0) || !std::isfinite(seconds))
-    throw py::value_error(std::string(what) + ": seconds must be a finite number >= 0");
-  return std::chrono::milliseconds(static_cast<long long>(seconds * 1000.0));
-}
-
 }  // namespace
 
 void bind_web(py::module_& m) {
@@ -92,7 +86,7 @@ void bind_web(py::module_& m) {
           "serve_for",
           [](const PyServer& s, double seconds) {
             vsd::web::Server& server = s.get();
-            const auto ms = to_ms(seconds, "serve_for");
+            const auto ms = milliseconds_of(seconds, "serve_for");
             py::gil_scoped_release release;
             server.serve_for(ms);
           },
