@@ -348,4 +348,7 @@ PYBIND11_MODULE(_core, m) {
 #ifdef VSDPY_WITH_DIST
   vsdpy::bind_dist(m);
 #endif
+#ifdef VSDPY_WITH_ANALYSIS
+  vsdpy::bind_analysis(m);
+#endif
 }

@@ -106,5 +106,6 @@ void bind_plugins(py::module_& m);       // plugins.cpp: load_plugin
 void bind_soml(py::module_& m);          // soml.cpp: load, Program, Debugger (when vsd::soml is built)
 void bind_web(py::module_& m);           // web.cpp: the inspector's Server (when vsd::web is built)
 void bind_dist(py::module_& m);          // dist.cpp: join a DDS domain (when vsd::dist is built)
+void bind_analysis(py::module_& m);      // analysis.cpp: P/T nets, PNML, state spaces (when vsd::analysis is built)
 
 }  // namespace vsdpy

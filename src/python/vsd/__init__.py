@@ -27,9 +27,9 @@ from ._core import (  # noqa: F401  (the package's API)
     type_names,
 )
 
-# The modules' entry points (vsd.io, vsd.soml, vsd.scene, vsd.robotics, vsd.physics, vsd.collision, vsd.web, vsd.dist): only
+# The modules' entry points (vsd.io, vsd.soml, vsd.scene, vsd.robotics, vsd.physics, vsd.collision, vsd.web, vsd.dist, vsd.analysis): only
 # those of the modules built.
-for _name in ("io", "soml", "scene", "robotics", "physics", "collision", "web", "dist"):
+for _name in ("io", "soml", "scene", "robotics", "physics", "collision", "web", "dist", "analysis"):
     if hasattr(_core, _name):
         globals()[_name] = getattr(_core, _name)
 
