@@ -1,10 +1,18 @@
 // What the executor's tests read, by (instance id, property): the transitions to re-test when that
 // property of that instance changes (a null property: any property — the test called a C++ method of the
 // instance). Looked up on every change a SOML++ program hears, so it is an open-addressing table (linear
-// probing, power-of-two size, load at most 1/2, backward-shift erase) rather than std::unordered_map,
-// whose prime-modulo bucket and node hop cost as much as the rest of the setter.
+// probing, power-of-two size, at most half full) rather than std::unordered_map, whose prime-modulo
+// bucket and node hop cost as much as the rest of the setter.
+//
+// A key whose last watcher leaves stays in the table, dormant (no watchers, its list's capacity kept):
+// an object token that moves on changes the first token its transitions read, so the same few keys lose
+// and regain their watcher on almost every firing, and erasing them cost a free, then a malloc and a
+// vector growth when the key came back. Dormant keys are dropped when the table rehashes (it is
+// rebuilt at its size, not doubled, when they make most of it), so keys of deleted instances do not
+// pile up.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <utility>
@@ -24,66 +32,54 @@ class DepTable {
  public:
   using Watchers = std::vector<std::uint32_t>;  // transition entries, in transition order
 
-  [[nodiscard]] bool empty() const noexcept { return size_ == 0; }
-  [[nodiscard]] std::size_t size() const noexcept { return size_; }
+  /// True when no key has a watcher.
+  [[nodiscard]] bool empty() const noexcept { return live_ == 0; }
+  /// The keys with at least one watcher (dormant keys do not count).
+  [[nodiscard]] std::size_t size() const noexcept { return live_; }
+  /// The slots in use, dormant keys included (for tests of the reuse).
+  [[nodiscard]] std::size_t used_slots() const noexcept { return used_; }
+  [[nodiscard]] std::size_t capacity() const noexcept { return slots_.size(); }
 
-  /// The watchers of @p key, or nullptr.
-  [[nodiscard]] Watchers* find(const DepKey& key) noexcept {
-    if (size_ == 0) return nullptr;
+  /// The watchers of @p key (possibly none: a dormant key), or nullptr.
+  [[nodiscard]] const Watchers* find(const DepKey& key) const noexcept {
+    if (used_ == 0) return nullptr;
     for (std::size_t i = slot(key);; i = (i + 1) & mask_) {
-      Entry& e = slots_[i];
+      const Entry& e = slots_[i];
       if (e.key.id == 0) return nullptr;
       if (e.key == key) return &e.watchers;
     }
   }
-  /// The watchers of @p key, made empty when absent (valid until the next insert or erase).
-  Watchers& operator[](const DepKey& key) {
-    if ((size_ + 1) * 2 > slots_.size()) rehash(slots_.empty() ? 16 : slots_.size() * 2);
-    for (std::size_t i = slot(key);; i = (i + 1) & mask_) {
-      Entry& e = slots_[i];
-      if (e.key == key) return e.watchers;
-      if (e.key.id == 0) {
-        e.key = key;
-        ++size_;
-        return e.watchers;
-      }
-    }
+  /// Adds transition entry @p ti to the watchers of @p key, keeping them in ascending (transition)
+  /// order; returns true when the key had none before (it was absent or dormant).
+  bool add(const DepKey& key, std::uint32_t ti) {
+    Watchers& w = slot_for(key);
+    const bool first = w.empty();
+    if (first) ++live_;
+    w.insert(std::upper_bound(w.begin(), w.end(), ti), ti);
+    return first;
   }
-  /// Removes @p key (nothing when absent).
-  void erase(const DepKey& key) noexcept {
-    if (size_ == 0) return;
-    std::size_t i = slot(key);
-    while (!(slots_[i].key == key)) {
-      if (slots_[i].key.id == 0) return;
-      i = (i + 1) & mask_;
-    }
-    // Backward shift: pull later entries of the run into the hole unless they would leave their home.
-    for (std::size_t j = (i + 1) & mask_; slots_[j].key.id != 0; j = (j + 1) & mask_) {
-      const std::size_t home = slot(slots_[j].key);
-      if (((j - home) & mask_) >= ((j - i) & mask_)) {
-        slots_[i] = std::move(slots_[j]);
-        i = j;
-      }
-    }
-    slots_[i] = Entry{};
-    --size_;
+  /// Removes transition entry @p ti from the watchers of @p key (nothing when absent); the key stays,
+  /// dormant, when that was its last watcher.
+  void remove(const DepKey& key, std::uint32_t ti) noexcept {
+    Watchers* w = find_mutable(key);
+    if (w == nullptr || w->empty()) return;
+    w->erase(std::remove(w->begin(), w->end(), ti), w->end());
+    if (w->empty()) --live_;
   }
-  /// Calls @p fn(key, watchers) for every entry (it may change the watchers), then drops the entries
-  /// left without watchers.
+  /// Calls @p fn(key, watchers) for every key with watchers (it may change them, keeping them sorted),
+  /// then drops the keys left without watchers.
   template <class F>
   void update_all(F&& fn) {
-    bool emptied = false;
+    if (slots_.empty()) return;
     for (Entry& e : slots_)
-      if (e.key.id != 0) {
-        fn(e.key, e.watchers);
-        emptied = emptied || e.watchers.empty();
-      }
-    if (emptied) rehash(slots_.size());
+      if (e.key.id != 0 && !e.watchers.empty()) fn(e.key, e.watchers);
+    rehash(slots_.size());  // recounts live_ and drops the dormant keys
   }
+  /// Calls @p fn(key, watchers) for every key with watchers.
   template <class F>
   void for_each(F&& fn) const {
     for (const Entry& e : slots_)
-      if (e.key.id != 0) fn(e.key, e.watchers);
+      if (e.key.id != 0 && !e.watchers.empty()) fn(e.key, e.watchers);
   }
 
  private:
@@ -98,23 +94,44 @@ class DepTable {
                             0x9E3779B97F4A7C15ULL;
     return static_cast<std::size_t>(h >> 32) & mask_;
   }
-  // Rebuilds with @p capacity slots (a power of two), leaving out entries without watchers.
+  Watchers* find_mutable(const DepKey& key) noexcept {
+    return const_cast<Watchers*>(std::as_const(*this).find(key));
+  }
+  // The watchers of @p key, an empty (new) entry when absent.
+  Watchers& slot_for(const DepKey& key) {
+    if (Watchers* w = find_mutable(key)) return *w;
+    if ((used_ + 1) * 2 > slots_.size()) {
+      // Full: rebuilt without the dormant keys, at a size that leaves the live ones at most a quarter
+      // of it (so a table of mostly dormant keys is rebuilt at its size, not doubled).
+      std::size_t capacity = slots_.empty() ? 16 : slots_.size();
+      while ((live_ + 1) * 4 > capacity) capacity *= 2;
+      rehash(capacity);
+    }
+    std::size_t i = slot(key);
+    while (slots_[i].key.id != 0) i = (i + 1) & mask_;
+    slots_[i].key = key;
+    ++used_;
+    return slots_[i].watchers;
+  }
+  // Rebuilds with @p capacity slots (a power of two), leaving out keys without watchers.
   void rehash(std::size_t capacity) {
     std::vector<Entry> old(capacity);
     old.swap(slots_);
     mask_ = slots_.size() - 1;
-    size_ = 0;
+    used_ = 0;
     for (Entry& e : old)
       if (e.key.id != 0 && !e.watchers.empty()) {
         std::size_t i = slot(e.key);
         while (slots_[i].key.id != 0) i = (i + 1) & mask_;
         slots_[i] = std::move(e);
-        ++size_;
+        ++used_;
       }
+    live_ = used_;
   }
   std::vector<Entry> slots_;
   std::size_t mask_ = 0;
-  std::size_t size_ = 0;
+  std::size_t used_ = 0;  // keys in the table, dormant ones included
+  std::size_t live_ = 0;  // keys with watchers
 };
 
 }  // namespace vsd::soml

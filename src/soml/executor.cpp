@@ -230,23 +230,33 @@ bool ProgramImpl::test(TI& ti) {
     same = ti.deps[k].id == dep_scratch_[k].first && ti.deps[k].prop == dep_scratch_[k].second;
   if (!same) {
     const auto index = static_cast<std::uint32_t>(&ti - tis_.data());
-    for (const DepKey& k : ti.deps) {
-      auto* v = deps_map_.find(k);
-      if (v == nullptr) continue;
-      v->erase(std::remove(v->begin(), v->end(), index), v->end());
-      if (v->empty()) deps_map_.erase(k);
+    // Both lists are sorted: walk them together and touch only the keys that differ (an object token
+    // that moved on changes one key of a test's reads, not all of them). Each watcher list is kept in
+    // transition order, not in the order of the tests that happened to run: a change then marks its
+    // watchers dirty in the same order in a run that was saved and attached again (8.7), whose tests
+    // ran at other times, as in the run that was never saved. The order of these adds and removes does
+    // not matter: a watcher list is a sorted set.
+    auto before = [](const DepKey& k, const std::pair<std::uint64_t, const MetaProperty*>& d) {
+      return std::pair(k.id, k.prop) < d;
+    };
+    std::size_t o = 0;
+    std::size_t n = 0;
+    while (o < ti.deps.size() || n < dep_scratch_.size()) {
+      if (n == dep_scratch_.size() || (o < ti.deps.size() && before(ti.deps[o], dep_scratch_[n]))) {
+        deps_map_.remove(ti.deps[o++], index);  // no longer read (a token that left, a deleted instance)
+      } else if (o < ti.deps.size() && ti.deps[o].id == dep_scratch_[n].first &&
+                 ti.deps[o].prop == dep_scratch_[n].second) {
+        ++o;  // read before and now
+        ++n;
+      } else {
+        const auto& [id, prop] = dep_scratch_[n++];
+        whole_instance_deps_ = whole_instance_deps_ || prop == nullptr;
+        if (deps_map_.add(DepKey{id, prop}, index)) cover(id, prop);
+      }
     }
-    ti.deps.clear();
-    // Each watcher list is kept in transition order, not in the order of the tests that happened to
-    // run: a change then marks its watchers dirty in the same order in a run that was saved and attached
-    // again (8.7), whose tests ran at other times, as in the run that was never saved.
-    for (const auto& [id, prop] : dep_scratch_) {
-      whole_instance_deps_ = whole_instance_deps_ || prop == nullptr;
-      ti.deps.push_back(DepKey{id, prop});
-      auto& v = deps_map_[DepKey{id, prop}];
-      if (v.empty()) cover(id, prop);
-      v.insert(std::upper_bound(v.begin(), v.end(), index), index);
-    }
+    ti.deps.resize(dep_scratch_.size());
+    for (std::size_t k = 0; k < dep_scratch_.size(); ++k)
+      ti.deps[k] = DepKey{dep_scratch_[k].first, dep_scratch_[k].second};
   }
   ti.mark = mark;
   return enabled;
