@@ -870,7 +870,7 @@ void ProgramImpl::connect_listeners() {
   deps_map_.for_each([&](const DepKey& key, const DepTable::Watchers&) { cover(key.id, key.prop); });
 }
 
-void ProgramImpl::cover(std::uint64_t id, const MetaProperty* prop) {
+void ProgramImpl::cover_new(std::uint64_t id, const MetaProperty* prop) {
   if (!watch_) return;
   if (prop != nullptr) {
     const std::size_t cls = prop->owner().index();

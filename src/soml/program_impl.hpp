@@ -174,6 +174,10 @@ class ProgramImpl {
   Val run(int f, std::uint64_t self, std::uint64_t mark, const Val* args, const std::string* sargs,
           std::string* sresult = nullptr, const VecReg* vargs = nullptr, VecReg* vresult = nullptr,
           const Value* xargs = nullptr, Value* xresult = nullptr);
+  // run()'s VM part (run() calls native code itself), with @p f = the function of index @p fi.
+  Val run_vm(const Function& f, int fi, std::uint64_t self, std::uint64_t mark, const Val* args,
+             const std::string* sargs, std::string* sresult, const VecReg* vargs, VecReg* vresult,
+             const Value* xargs, Value* xresult);
   Value call_from_cpp(int f, SimStateInstance& self, std::span<const Value> args);
   // The body of the MetaMethod of function @p f of @p weak: runs it in the program that runs the state
   // of @p self (the method's own program, or another attached to a replica or a loaded copy that uses
@@ -373,7 +377,19 @@ class ProgramImpl {
   // test's reads change with every token, so this is asked often and answered without hashing).
   std::vector<std::vector<std::uint64_t>> covered_properties_;
   std::unordered_set<const MetaInstance*> covered_classes_;  // all properties watched (C++ methods)
-  void cover(std::uint64_t id, const MetaProperty* prop);
+  void cover(std::uint64_t id, const MetaProperty* prop) {
+    // A test's reads change with every token, so this is asked often: a property covered already is
+    // answered here, without the call.
+    if (prop != nullptr && watch_) {
+      const std::size_t cls = prop->owner().index();
+      const std::size_t i = prop->index();
+      if (cls < covered_properties_.size() && i / 64 < covered_properties_[cls].size() &&
+          (covered_properties_[cls][i / 64] & (std::uint64_t{1} << (i % 64))) != 0)
+        return;
+    }
+    cover_new(id, prop);
+  }
+  void cover_new(std::uint64_t id, const MetaProperty* prop);  // cover()'s body (program.cpp)
   static void heard(void* self, SimStateInstance& inst, const MetaProperty* p, Changes what);
   void stop_listening() noexcept { watch_.reset(); }
   std::unordered_map<std::uint64_t, NetInst*> node_net_;  // owner, place and transition ids -> net

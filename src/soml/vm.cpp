@@ -280,6 +280,16 @@ Val ProgramImpl::run(int fi, std::uint64_t self, std::uint64_t mark, const Val* 
     // Native code (Program::load_native) takes scalar arguments and returns a scalar: nothing to move.
     return call_native(e, self, mark, args, entry + 1);
   }
+  return run_vm(f, fi, self, mark, args, sargs, sresult, vargs, vresult, xargs, xresult);
+}
+
+// run() in the VM: out of line, so that a call of native code (a condition tested on every firing) does
+// not pay for this part's frame (its registers and exception handling).
+[[gnu::noinline]] Val ProgramImpl::run_vm(const Function& f, int fi, std::uint64_t self, std::uint64_t mark,
+                                          const Val* args, const std::string* sargs, std::string* sresult,
+                                          const VecReg* vargs, VecReg* vresult, const Value* xargs,
+                                          Value* xresult) {
+  const std::size_t entry = frames_.size();
   const std::uint32_t saved_top = top_;
   const std::uint32_t base = top_;
   if (regs_.size() < base + static_cast<std::size_t>(f.nregs) + 1) {
