@@ -1097,6 +1097,10 @@ void ProgramImpl::register_net(std::unique_ptr<NetInst> net, const ClassInfo& ci
     tis_.push_back(TI{{}, n, static_cast<int>(t)});
     tis_.back().dirty = false;
     const TransitionInfo& info = ci.net->transitions[t];
+    bool counts_only = info.mark_in < 0 && info.cond < 0;
+    for (const ArrowInfo& a : info.in) counts_only = counts_only && !a.remote && a.cond < 0;
+    for (const ArrowInfo& a : info.out) counts_only = counts_only && !a.remote;
+    tis_.back().counts_only = counts_only;
     if (!info.inert) mark_dirty(ti);  // a substitution transition never fires: its sub-net does
     for (const ArrowInfo& a : info.in)
       if (!a.remote) place_watch_[n->places[static_cast<std::size_t>(a.place)]->id()].push_back(ti);

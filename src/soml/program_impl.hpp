@@ -359,6 +359,9 @@ class ProgramImpl {
     bool enabled = false;
     std::uint64_t mark = 0;
     std::int32_t enabled_pos = -1;
+    // No condition, no arrow condition, no communication arrow: its test only compares the counts of
+    // its input places, and reads no property (test() takes a short way; register_net sets it).
+    bool counts_only = false;
   };
   std::vector<TI> tis_;
   std::vector<std::uint32_t> dirty_;
