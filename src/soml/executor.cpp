@@ -239,9 +239,17 @@ bool ProgramImpl::test(TI& ti) {
     std::sort(dep_scratch_.begin(), dep_scratch_.end());
     dep_scratch_.erase(std::unique(dep_scratch_.begin(), dep_scratch_.end()), dep_scratch_.end());
   }
-  bool same = dep_scratch_.size() == ti.deps.size();
-  for (std::size_t k = 0; same && k < dep_scratch_.size(); ++k)
-    same = ti.deps[k].id == dep_scratch_[k].first && ti.deps[k].prop == dep_scratch_[k].second;
+  // (Sizes and elements are read through locals: the calls below could change any vector as far as
+  // the compiler knows, and this runs for every test.)
+  const std::size_t nn = dep_scratch_.size();
+  const std::size_t no = ti.deps.size();
+  const std::pair<std::uint64_t, const MetaProperty*>* now = dep_scratch_.data();
+  const DepKey* old = ti.deps.data();
+  auto equal = [](const DepKey& k, const std::pair<std::uint64_t, const MetaProperty*>& d) {
+    return k.id == d.first && k.prop == d.second;
+  };
+  bool same = nn == no;
+  for (std::size_t k = 0; same && k < nn; ++k) same = equal(old[k], now[k]);
   if (!same) {
     const auto index = static_cast<std::uint32_t>(&ti - tis_.data());
     // Both lists are sorted: walk them together and touch only the keys that differ (an object token
@@ -250,27 +258,22 @@ bool ProgramImpl::test(TI& ti) {
     // watchers dirty in the same order in a run that was saved and attached again (8.7), whose tests
     // ran at other times, as in the run that was never saved. The order of these adds and removes does
     // not matter: a watcher list is a sorted set.
-    auto before = [](const DepKey& k, const std::pair<std::uint64_t, const MetaProperty*>& d) {
-      return std::pair(k.id, k.prop) < d;
-    };
     std::size_t o = 0;
     std::size_t n = 0;
-    while (o < ti.deps.size() || n < dep_scratch_.size()) {
-      if (n == dep_scratch_.size() || (o < ti.deps.size() && before(ti.deps[o], dep_scratch_[n]))) {
-        deps_map_.remove(ti.deps[o++], index);  // no longer read (a token that left, a deleted instance)
-      } else if (o < ti.deps.size() && ti.deps[o].id == dep_scratch_[n].first &&
-                 ti.deps[o].prop == dep_scratch_[n].second) {
+    while (o < no || n < nn) {
+      if (n == nn || (o < no && std::pair(old[o].id, old[o].prop) < now[n])) {
+        deps_map_.remove(old[o++], index);  // no longer read (a token that left, a deleted instance)
+      } else if (o < no && equal(old[o], now[n])) {
         ++o;  // read before and now
         ++n;
       } else {
-        const auto& [id, prop] = dep_scratch_[n++];
+        const auto& [id, prop] = now[n++];
         whole_instance_deps_ = whole_instance_deps_ || prop == nullptr;
         if (deps_map_.add(DepKey{id, prop}, index)) cover(id, prop);
       }
     }
-    ti.deps.resize(dep_scratch_.size());
-    for (std::size_t k = 0; k < dep_scratch_.size(); ++k)
-      ti.deps[k] = DepKey{dep_scratch_[k].first, dep_scratch_[k].second};
+    ti.deps.resize(nn);  // (old is not used after this)
+    for (std::size_t k = 0; k < nn; ++k) ti.deps[k] = DepKey{now[k].first, now[k].second};
   }
   ti.mark = mark;
   return enabled;
