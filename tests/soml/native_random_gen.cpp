@@ -2,7 +2,8 @@
 // counting loops, calls of earlier functions, min/max/abs, int <-> double) and, when NETS is given, that
 // many random nets of object tokens whose conditions and actions read and write properties, for the
 // VM-versus-native differential test (native_test.cpp): `vsd_soml_native_random_gen SEED COUNT OUT.soml
-// [NETS]`. Run at build time; the same arguments always write the same file.
+// [NETS]`. Run at build time; the same arguments always write the same file, whichever compiler built the
+// generator: every draw is sequenced (the operands of `+` are not, and GCC and clang order them apart).
 #include <algorithm>
 #include <cstdint>
 #include <fstream>
@@ -38,7 +39,7 @@ struct Gen {
   }
   std::string expr(int depth) {
     if (depth <= 0) return pick(3) == 0 ? constant() : var();
-    switch (pick(12)) {
+    switch (const int k = pick(12)) {
       case 0:
         return var();
       case 1:
@@ -46,26 +47,34 @@ struct Gen {
       case 2:
         return "-(" + expr(depth - 1) + ")";
       case 3:
-        return "min(" + expr(depth - 1) + ", " + expr(depth - 1) + ")";
-      case 4:
-        return "max(" + expr(depth - 1) + ", " + expr(depth - 1) + ")";
+      case 4: {
+        const std::string l = expr(depth - 1);
+        return std::string(k == 3 ? "min(" : "max(") + l + ", " + expr(depth - 1) + ")";
+      }
       case 5:
         return "abs(" + expr(depth - 1) + ")";
       case 6:
         return "int(double(" + expr(depth - 1) + ") * 1.5)";
       case 7:
-        if (fn > 0)
-          return "g" + std::to_string(pick(fn)) + "(" + expr(depth - 1) + ", " + expr(depth - 1) + ")";
+        if (fn > 0) {
+          const std::string g = "g" + std::to_string(pick(fn));
+          const std::string l = expr(depth - 1);
+          return g + "(" + l + ", " + expr(depth - 1) + ")";
+        }
         return var();
       default: {
         static const char* ops[] = {"+", "-", "*", "/", "%"};
-        return "(" + expr(depth - 1) + " " + ops[pick(5)] + " " + expr(depth - 1) + ")";
+        const std::string l = expr(depth - 1);
+        const char* op = ops[pick(5)];
+        return "(" + l + " " + op + " " + expr(depth - 1) + ")";
       }
     }
   }
   std::string cond(int depth) {
     static const char* cmps[] = {"<", "<=", "==", "!=", ">", ">="};
-    std::string c = expr(depth) + " " + cmps[pick(6)] + " " + expr(depth);
+    std::string c = expr(depth);
+    c = c + " " + cmps[pick(6)];
+    c = c + " " + expr(depth);
     if (pick(4) == 0) c = "(" + c + ") && (" + cond(depth - 1) + ")";
     if (pick(6) == 0) c = "!(" + c + ")";
     return c;
@@ -75,7 +84,8 @@ struct Gen {
       const int kind = depth > 0 ? pick(6) : 0;
       if (kind <= 2) {
         static const char* targets[] = {"x", "y", "s"};
-        out += indent + targets[pick(3)] + " = " + expr(2) + ";\n";
+        const char* target = targets[pick(3)];
+        out += indent + target + " = " + expr(2) + ";\n";
       } else if (kind == 3) {
         out += indent + "if (" + cond(1) + ") {\n";
         stmts(out, depth - 1, 1 + pick(2), indent + "  ");
@@ -90,7 +100,8 @@ struct Gen {
         stmts(out, depth - 1, 1 + pick(2), indent + "  ");
         out += indent + "}\n";
       } else {
-        out += indent + "while (" + var() + " > " + std::to_string(pick(50)) +
+        const std::string v = var();
+        out += indent + "while (" + v + " > " + std::to_string(pick(50)) +
                ") { x = x / 2 - 1; y = y - 3; s = s / 2; }\n";
       }
     }
@@ -104,7 +115,8 @@ struct Gen {
       switch (depth > 0 ? pick(9) : pick(7)) {
         case 0:
         case 1:
-          out += indent + (pick(2) == 0 ? "mark.a" : "mark.b") + " = " + expr(2) + ";\n";
+          out += indent + (pick(2) == 0 ? "mark.a" : "mark.b");
+          out += " = " + expr(2) + ";\n";
           break;
         case 2:
           out += indent + "c = " + expr(1) + ";\n";
@@ -152,7 +164,10 @@ struct Gen {
     for (int t = 0; t < 4; ++t) {
       const std::string name = "t" + std::to_string(t);
       out += "  transition " + name + " {\n";
-      if (pick(4) != 0) out += "    when " + std::string(pick(3) == 0 ? "mark.f || " : "") + cond(1) + ";\n";
+      if (pick(4) != 0) {
+        out += "    when " + std::string(pick(3) == 0 ? "mark.f || " : "");
+        out += cond(1) + ";\n";
+      }
       out += "    do {\n";
       action(out, k, 2, 1 + pick(3), "      ");
       out += "    }\n  }\n";
@@ -165,8 +180,11 @@ struct Gen {
     small = false;
     out += "}\n";
     for (int j = 0; j < 3; ++j)
-      out += "object k" + K + "_" + std::to_string(j) + " : " + T + "(" + std::to_string(pick(11) - 5) + ", " +
+    {
+      const int x = pick(11) - 5;
+      out += "object k" + K + "_" + std::to_string(j) + " : " + T + "(" + std::to_string(x) + ", " +
              std::to_string(pick(11) - 5) + ");\n";
+    }
   }
 };
 
