@@ -12,6 +12,7 @@
 #include "nets.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/analysis/pnml.hpp"
+#include "../sanitized.hpp"
 
 namespace an = vsd::analysis;
 using an::ExploreOptions;
@@ -565,7 +566,7 @@ TEST(Explore, ReportsOfUnboundedAndIncompleteRuns) {
 // reset_peak_rss(). Empty where there is no such file, and in sanitizer builds (their shadow memory and
 // quarantine of freed blocks count as resident too).
 std::optional<std::size_t> resident(const std::string& key) {
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#ifdef VSD_TEST_SANITIZED
   (void)key;
   return std::nullopt;
 #else

@@ -16,6 +16,7 @@
 
 #include "vsd/collision.hpp"
 #include "vsd/core.hpp"
+#include "../sanitized.hpp"
 
 namespace vsd::collision {
 namespace {
@@ -583,7 +584,7 @@ TEST_F(CollisionTest, RayCastOnAMeshDescendsItsTreeAndAgreesWithEveryTriangle) {
   const Eigen::Vector3d centre = pose.translation();
   // Each ray is checked against all 6,240 triangles: 1,500 rays take 0.3 s optimised but over a minute
   // unoptimised under AddressSanitizer, where 300 rays still check every path of the descent.
-#ifdef __SANITIZE_ADDRESS__
+#ifdef VSD_TEST_SANITIZED
   constexpr int rays = 300;
 #else
   constexpr int rays = 1500;

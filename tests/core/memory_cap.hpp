@@ -14,13 +14,8 @@
 #include <fstream>
 #include <string>
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define VSD_TEST_SANITIZED 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-#define VSD_TEST_SANITIZED 1
-#endif
-#endif
+#include "../sanitized.hpp"
+
 
 namespace vsd_test {
 

@@ -13,6 +13,7 @@
 #include "vsd/core/environment.hpp"
 #include "vsd/core/error.hpp"
 #include "vsd/robotics.hpp"
+#include "../../sanitized.hpp"
 
 namespace {
 
@@ -56,7 +57,7 @@ void expect_clean(const CellReport& r, int parts) {
 // Four seeds of 250 parts: 1,000 parts in all (two suites, so that ctest runs them in parallel). The
 // sanitizer build (Debug, ASan: some twenty times slower) runs the same nets and checks on 10 parts per
 // seed, so that CI stays in its time budget; the Release suite carries the 1,000.
-#if defined(__SANITIZE_ADDRESS__)
+#ifdef VSD_TEST_SANITIZED
 constexpr int parts_per_seed = 10;
 #else
 constexpr int parts_per_seed = 250;
