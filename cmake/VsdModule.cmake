@@ -96,6 +96,7 @@ function(vsd_add_module name)
       $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   endif()
   vsd_target_options(${target})
+  vsd_fuzz_coverage(${target})
 
   # For the package (VsdInstall.cmake): the module in dependency order, what it needs.
   set_property(GLOBAL APPEND PROPERTY VSD_MODULES ${name})
