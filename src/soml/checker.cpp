@@ -1800,6 +1800,7 @@ bool CheckerImpl::always_returns(const Stmt& s) {
     case StmtKind::Finish:
       return true;
     case StmtKind::Block:
+      if (s.as<BlockStmt>().lost) return true;  // its parse error said enough
       for (const StmtPtr& c : s.as<BlockStmt>().body)
         if (always_returns(*c)) return true;
       return false;
@@ -2238,6 +2239,11 @@ void check(Script& script, Diagnostics& diagnostics, const Registry& registry) {
 
 std::unique_ptr<CheckResult> check_source(std::string name, std::string text, const Registry& registry) {
   auto result = std::make_unique<CheckResult>(std::make_unique<Source>(std::move(name), std::move(text)));
+  if (const std::size_t bytes = result->source->too_long(); bytes != 0) {
+    result->diagnostics.error({}, "the script is " + std::to_string(bytes) + " bytes, larger than the limit of " +
+                                      std::to_string(max_source_bytes) + " bytes of a SOML++ source");
+    return result;
+  }
   result->script = parse(*result->source, result->diagnostics);
   check(result->script, result->diagnostics, registry);
   result->diagnostics.sort();

@@ -6,6 +6,11 @@
 namespace vsd::soml {
 
 Source::Source(std::string name, std::string text) : name_(std::move(name)), text_(std::move(text)) {
+  if (text_.size() > max_source_bytes) {  // positions are 32-bit: keep what they can name, for the message
+    too_long_ = text_.size();
+    text_.resize(max_source_bytes);
+    text_.shrink_to_fit();
+  }
   line_starts_.push_back(0);
   for (std::size_t i = 0; i < text_.size(); ++i)
     if (text_[i] == '\n') line_starts_.push_back(static_cast<std::uint32_t>(i + 1));

@@ -1,5 +1,6 @@
 // Tests of include/vsd/soml/lexer.hpp and source.hpp: tokens, positions, and bad input.
 #include "vsd/soml/lexer.hpp"
+#include "vsd/soml/checker.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -123,6 +124,20 @@ TEST(Diagnostics, KeepsAtMostAFixedNumberAndCountsAll) {
   EXPECT_EQ(d.all().size(), Diagnostics::max_diagnostics);
   EXPECT_EQ(d.error_count(), 1000u);
   EXPECT_THAT(d.all().back().message, HasSubstr("too many errors"));
+}
+
+// Positions are 32-bit: a longer text would be located wrongly, so the front end refuses it whole.
+TEST(Source, AScriptLongerThanTheLimitIsOneErrorAtItsStart) {
+  constexpr std::size_t max_source_bytes = vsd::soml::max_source_bytes;
+  std::string text(max_source_bytes + 1, ' ');
+  text.replace(0, 9, "int x = ;");  // would be a syntax error: not reached
+  const auto checked = vsd::soml::check_source("huge.soml", std::move(text));
+  ASSERT_EQ(checked->diagnostics.all().size(), 1u);
+  EXPECT_EQ(checked->source->text().size(), max_source_bytes);
+  EXPECT_THAT(checked->diagnostics.format(),
+              HasSubstr("huge.soml:1:1: error: the script is " + std::to_string(max_source_bytes + 1) +
+                        " bytes, larger than the limit of " + std::to_string(max_source_bytes) +
+                        " bytes of a SOML++ source"));
 }
 
 }  // namespace

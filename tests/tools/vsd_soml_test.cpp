@@ -5,11 +5,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "tool_run.hpp"
+#include "vsd/soml/source.hpp"
 
 namespace vsd_soml_tool_test {
 namespace {
@@ -117,6 +119,20 @@ TEST(VsdSoml, CompileWritesTheNativeLibrarySource) {
   const ToolRun n = run({"run", a, "--native", a});
   EXPECT_EQ(n.code, 1);
   EXPECT_THAT(n.err, HasSubstr("cannot load the SOML++ native library"));
+  const ToolRun nodir = run({"compile", a, "-o", tmp.path("missing")});
+  EXPECT_EQ(nodir.code, 1);
+  EXPECT_THAT(nodir.err, HasSubstr("missing: no such directory"));
+  EXPECT_FALSE(std::filesystem::exists(tmp.path("missing")));
+}
+
+// A stream without end (/dev/zero) is read up to the limit of a script, not up to the tools' 4 GiB.
+TEST(VsdSoml, AScriptIsReadUpToTheSourceLimit) {
+  const TempDir tmp("vsd_soml_source_limit");
+  for (const ToolRun& r : {run({"disasm", "/dev/zero"}), run({"compile", "/dev/zero", "-o", tmp.dir().string()})}) {
+    EXPECT_EQ(r.code, 1);
+    EXPECT_THAT(r.err, HasSubstr("/dev/zero: is larger than " + std::to_string(vsd::soml::max_source_bytes) +
+                                     " bytes"));
+  }
 }
 
 }  // namespace

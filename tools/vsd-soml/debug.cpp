@@ -311,7 +311,7 @@ int debug_command(std::span<const std::string_view> args, std::istream& in, std:
   options.seed = a.unsigned_integer("--seed", options.seed, UINT64_MAX);
   const std::uint64_t limit = a.unsigned_integer("--steps", 1'000'000, UINT64_MAX);
   const std::string file(path);
-  const std::string text = read_text_input(path);
+  const std::string text = read_text_input(path, soml::max_source_bytes);
   Workspace ws;
   auto& module = ws.env().use<soml::Module>();
   soml::Program* p = nullptr;

@@ -2,6 +2,7 @@
 // converts between the two.
 #include "tool.hpp"
 
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <set>
@@ -273,7 +274,7 @@ int disasm(std::span<const std::string_view> args, std::ostream& out, std::ostre
   a.expect_positional(1, 1, "one FILE");
   const std::string_view path = a.positional()[0];
   const std::string file = path == "-" ? "<stdin>" : std::string(path);
-  const std::string text = as_text(read_input(path));
+  const std::string text = as_text(read_input(path, vsd::soml::max_source_bytes));
   Workspace ws;
   auto& soml = ws.env().use<vsd::soml::Module>();
   try {
@@ -293,6 +294,14 @@ int compile(std::span<const std::string_view> args, std::ostream& out, std::ostr
   a.expect_positional(1, 1000, "one or more FILEs");
   const auto dir = a.value("-o");
   if (!dir) throw UsageError("compile needs -o DIR");
+  // Said before any script is compiled, and in the user's words (the atomic write would only say that
+  // it cannot make its temporary file there).
+  std::error_code ec;
+  if (!std::filesystem::is_directory(std::filesystem::path(std::string(*dir)), ec)) {
+    err << "vsd-soml: " << printable(*dir) << ": no such directory (compile writes DIR/soml_native.cpp into an "
+        << "existing DIR)\n";
+    return exit_failure;
+  }
   std::vector<std::unique_ptr<Workspace>> spaces;
   std::vector<const vsd::soml::Program*> programs;
   for (const std::string_view path : a.positional()) {
@@ -301,7 +310,7 @@ int compile(std::span<const std::string_view> args, std::ostream& out, std::ostr
       // Each script in a Registry of its own: their objects and classes do not meet (two scripts may
       // declare classes of the same name, as when each is loaded alone).
       Workspace& ws = *spaces.emplace_back(std::make_unique<Workspace>());
-      const vsd::soml::Program& p = ws.env().use<vsd::soml::Module>().load(ws.state(), file, as_text(read_input(path)));
+      const vsd::soml::Program& p = ws.env().use<vsd::soml::Module>().load(ws.state(), file, as_text(read_input(path, vsd::soml::max_source_bytes)));
       programs.push_back(&p);
     } catch (const vsd::Error& e) {
       const std::string m = printable_lines(e.what());

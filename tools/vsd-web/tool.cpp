@@ -15,6 +15,7 @@
 #include "vsd/robotics/module.hpp"
 #include "vsd/scene/module.hpp"
 #include "vsd/soml/module.hpp"
+#include "vsd/soml/source.hpp"
 #include "vsd/web/server.hpp"
 #include "vsd_tool/arguments.hpp"
 #include "vsd_tool/input.hpp"
@@ -115,7 +116,7 @@ int body(std::span<const std::string_view> args, std::ostream& out, std::ostream
   SimState& state = ws.state();
   if (ends_with(path, ".soml")) {
     const std::string file(path);
-    soml.load(state, file, read_text_input(path));
+    soml.load(state, file, read_text_input(path, vsd::soml::max_source_bytes));
     out << "loaded SOML++ script " << printable(file) << "\n";
   } else {
     const SceneInput in = load_scene_input(state, path, scene::UrdfOptions{});

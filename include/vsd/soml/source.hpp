@@ -14,6 +14,7 @@
  */
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -28,10 +29,16 @@ struct SourceLoc {
   std::uint32_t column = 1;
 };
 
+/// @brief The largest SOML++ script, in bytes: 256 MiB (the 10,000-line benchmark script is 0.3 MB).
+/// A longer text is refused with one error at 1:1 (positions are 32-bit); the vsd-* tools read a file
+/// they know to be a script up to this size and no further.
+inline constexpr std::size_t max_source_bytes = std::size_t{1} << 28;
+
 /// @brief A named source text with a line table.
 class Source {
  public:
   /// @brief Takes the script text @p text, shown in diagnostics as @p name (usually the file path).
+  /// A text longer than max_source_bytes is cut there (too_long() says so; check_source reports it).
   Source(std::string name, std::string text);
 
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
@@ -41,10 +48,13 @@ class Source {
   /// @brief The text of 1-based line @p line without its line break (empty when out of range).
   [[nodiscard]] std::string_view line_text(std::uint32_t line) const noexcept;
   [[nodiscard]] std::size_t line_count() const noexcept { return line_starts_.size(); }
+  /// @brief The size of the text given, when it was longer than max_source_bytes; else 0.
+  [[nodiscard]] std::size_t too_long() const noexcept { return too_long_; }
 
  private:
   std::string name_;
   std::string text_;
+  std::size_t too_long_ = 0;
   std::vector<std::uint32_t> line_starts_;
 };
 
