@@ -741,12 +741,14 @@ std::unique_ptr<BlockStmt> Parser::parse_block() {
         diag_.error(peek().loc, "expected '}' to close the block opened at line " +
                                     std::to_string(open.loc.line) + ", found end of file");
       eof_reported_ = true;
+      block->lost = true;
       return block;
     }
     const std::size_t before = pos_;
     try {
       block->body.push_back(parse_statement());
     } catch (const Abort&) {
+      block->lost = true;
       if (pos_ == before && !check(TokenKind::RBrace)) advance();
       sync_statement();
     }

@@ -216,6 +216,18 @@ TEST(Checker, ReportsAllErrorsOfAFileSortedWithCarets) {
             "            ^\n");
 }
 
+// A statement that did not parse is not also reported as a missing return: its error is the one.
+TEST(Checker, AStatementLostToAParseErrorAddsNoMissingReturn) {
+  for (const std::string& body : {std::string("return 1 +;"), "return " + std::string(1000, '(') + "1" +
+                                                                   std::string(1000, ')') + ";",
+                                  std::string("while (1 +) {}")}) {
+    auto r = check("int f() { " + body + " }\nint g() { }\n");
+    EXPECT_EQ(r->diagnostics.error_count(), 2u) << r->diagnostics.format();
+    EXPECT_THAT(r->diagnostics.format(), testing::Not(HasSubstr("function 'f' must return")));
+    EXPECT_THAT(r->diagnostics.format(), HasSubstr("function 'g' must return"));  // still checked
+  }
+}
+
 TEST(Checker, BaseClassCyclesAreReportedNotLooped) {
   auto r = check("class A : B { int x; } class B : A { void f() { x = 1; y = 2; } }");
   EXPECT_THAT(r->diagnostics.format(), HasSubstr("derives from itself"));

@@ -177,6 +177,9 @@ using StmtPtr = std::unique_ptr<Stmt>;
 struct BlockStmt : Stmt {
   using Stmt::Stmt;
   std::vector<StmtPtr> body;
+  /// A statement of it did not parse (its error is reported) or the file ended inside it: the checker
+  /// takes the block as returning, so that the lost statement adds no "must return" error of its own.
+  bool lost = false;
 };
 
 struct LocalStmt : Stmt {  // `T name = init;`; also the variable of a ForEach
