@@ -282,13 +282,13 @@ void emit_function(std::ostream& out, const ProgramImage& img, std::size_t fi) {
         // The fast copy, entered with counter < bound (<= for LOOPLE), which nothing in the body changes:
         // counter + 1 overflows only for LOOPLE at INT64_MAX; the budget was found to cover every
         // backward jump, so it only counts them.
+        // At the exit the counter is one past the last jump's: the budget is vb - counter + 1.
         if (le)
           o << "  { std::int64_t t; if (__builtin_add_overflow(" << I(in.a)
-            << ", std::int64_t{1}, &t)) [[unlikely]] " << ovf;
+            << ", std::int64_t{1}, &t)) [[unlikely]] " << ovf << I(in.a) << " = t; }";
         else
-          o << "  { const std::int64_t t = " << I(in.a) << " + 1; ";
-        o << "if (t " << cmp << " " << bound << ") { " << I(in.a) << " = t; goto " << T
-          << "; } budget = budget; " << I(in.a) << " = t; }\n";
+          o << "  " << I(in.a) << " = " << I(in.a) << " + 1;";
+        o << " if (" << I(in.a) << " " << cmp << " " << bound << ") goto " << T << "; budget = budget + 1;\n";
         return;
       }
       o << "  { std::int64_t t; if (__builtin_add_overflow(" << I(in.a) << ", std::int64_t{1}, &t)) [[unlikely]] "
@@ -620,7 +620,7 @@ void emit_function(std::ostream& out, const ProgramImage& img, std::size_t fi) {
     // Every `budget` of the copy read as vb - counter ("budget = budget" assigns it at the exits).
     std::string text = o.str(), copy = text.substr(start);
     const std::string bud = "(vb" + V + " - static_cast<std::uint64_t>(" + I(f.code[at].a) + "))";
-    for (const char* w : {"c, budget,", ", budget}", "= budget;"}) {
+    for (const char* w : {"c, budget,", ", budget}", "= budget;", "= budget + 1;"}) {
       const std::string from = w;
       std::string to = from;
       to.replace(to.find("budget"), 6, bud);
