@@ -7,7 +7,8 @@
 // a move copies both (the optimiser drops the dead one). Jumps become gotos to the instruction's label;
 // the checks the VM makes (overflow, division by zero, budget on backward jumps and calls, call depth)
 // are made at the same instructions and report through the Context (native_abi.hpp), so a native run
-// fails where and as the VM's does.
+// fails where and as the VM's does. Counted loops also get a copy without the budget test, run while the
+// budget covers them (counted_loop, emit_function); calls pass the frames still allowed (`left`).
 #include <cstring>
 #include <sstream>
 
