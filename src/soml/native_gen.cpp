@@ -7,7 +7,8 @@
 // a move copies both (the optimiser drops the dead one). Jumps become gotos to the instruction's label;
 // the checks the VM makes (overflow, division by zero, budget on backward jumps and calls, call depth)
 // are made at the same instructions and report through the Context (native_abi.hpp), so a native run
-// fails where and as the VM's does.
+// fails where and as the VM's does. Counted loops also get a copy without the budget test, run while the
+// budget covers them (counted_loop, emit_function); calls pass the frames still allowed (`left`).
 #include <cstring>
 #include <sstream>
 
@@ -139,8 +140,74 @@ std::string imm(std::uint16_t v) {
   return "std::int64_t{" + std::to_string(static_cast<std::int16_t>(v)) + "}";
 }
 
+// Whether instruction @p in may write its register a (everything but jumps that only test, returns,
+// fail, stores and print; a loop instruction writes its counter).
+bool writes_a(const Ins& in) {
+  switch (in.op) {
+    case OP_NOP:
+    case OP_JMP:
+    case OP_JMPF:
+    case OP_JMPT:
+    case OP_JGEI:
+    case OP_JGTI:
+    case OP_JLTI:
+    case OP_JLEI:
+    case OP_JEQI:
+    case OP_JNEI:
+    case OP_JGEIK:
+    case OP_JGTIK:
+    case OP_JLTIK:
+    case OP_JLEIK:
+    case OP_JEQIK:
+    case OP_JNEIK:
+    case OP_RET:
+    case OP_RET0:
+    case OP_FAIL:
+    case OP_SETP:
+    case OP_PRINT:
+      return false;
+    default:
+      return true;
+  }
+}
+
+bool is_loop(std::uint8_t op) {
+  return op == OP_LOOPLT || op == OP_LOOPLE || op == OP_LOOPLTK || op == OP_LOOPLEK;
+}
+
+// Whether the loop closed by the LOOP* instruction at @p at is counted: between its target and itself
+// nothing writes the counter (register a) or the bound (register b of LOOPLT/LOOPLE), nothing jumps
+// backward (no inner loop), and nothing spends budget or calls back into the runtime (no call, no
+// property, no print, no enclosing instance). Then each pass through the loop instruction adds one to
+// the counter and the backward jumps left are known from the counter and the bound: when the budget
+// covers them all, a copy of the loop without the budget test runs (emit_function).
+bool counted_loop(const Function& f, std::size_t at) {
+  const Ins& lp = f.code[at];
+  const std::uint32_t top = target_of(lp);
+  if (!is_loop(lp.op) || top > at) return false;
+  const bool reg_bound = lp.op == OP_LOOPLT || lp.op == OP_LOOPLE;
+  for (std::size_t k = top; k < at; ++k) {
+    const Ins& in = f.code[k];
+    switch (in.op) {
+      case OP_CALL:
+      case OP_CALLS:
+      case OP_SETP:
+      case OP_GETP:
+      case OP_SELF:
+      case OP_PRINT:
+        return false;
+      default:
+        break;
+    }
+    if (op_jumps(in.op) && target_of(in) <= k) return false;
+    if (writes_a(in) && (in.a == lp.a || (reg_bound && in.a == lp.b))) return false;
+  }
+  return true;
+}
+
 // The body of function @p fi (translatable) as C++.
-void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
+void emit_function(std::ostream& out, const ProgramImage& img, std::size_t fi) {
+  std::ostringstream o;  // the fast copies of counted loops are rewritten in place (below)
   const Function& f = *img.functions[fi];
   const std::string F = std::to_string(fi) + "u";
   std::vector<char> label(f.code.size() + 1, 0);
@@ -148,7 +215,7 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
     if (op_jumps(in.op)) label[target_of(in)] = 1;
   o << "// " << one_line(f.name) << "\n";
   o << rtype(f.result) << " f" << fi
-    << "([[maybe_unused]] Context* c, [[maybe_unused]] std::uint32_t depth, std::uint64_t budget, "
+    << "([[maybe_unused]] Context* c, [[maybe_unused]] std::uint32_t left, std::uint64_t budget, "
        "[[maybe_unused]] std::uint64_t self, [[maybe_unused]] std::uint64_t mark";
   for (int p = 0; p < f.nparams; ++p)
     o << ", " << ctype(f.param_kinds[static_cast<std::size_t>(p)]) << " p" << p;
@@ -159,30 +226,83 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
   }
   for (int p = 0; p < f.nparams; ++p)
     o << "  " << view(f.param_kinds[static_cast<std::size_t>(p)]) << p << " = p" << p << ";\n";
+  std::vector<char> counted(f.code.size(), 0);  // the counted loops (counted_loop), by their LOOP*
+  for (std::size_t at = 0; at < f.code.size(); ++at)
+    if (counted_loop(f, at)) {
+      counted[at] = 1;
+      label[at + 1] = 1;
+      o << "  [[maybe_unused]] std::uint64_t vb" << at << " = 0;  // the fast copy's budget + counter\n";
+    }
   // The budget travels in a register: a parameter, returned with the result (no memory traffic per call
   // or iteration); it goes to the Context only when failing (fail() takes it) and at the entry (e<n>).
   auto I = [](int r) { return "i" + std::to_string(r); };
   auto D = [](int r) { return "d" + std::to_string(r); };
-  for (std::size_t at = 0; at < f.code.size(); ++at) {
+  // Counted loops (counted_loop) get a second copy of their body, emitted after the function's code, with
+  // labels V<loop>_<instruction>: the checked copy's loop instruction jumps into it when the budget left
+  // covers every backward jump the loop can still make, and its exit falls to the instruction after.
+  std::size_t fast = f.code.size();  // the loop whose fast copy is being emitted (size(): none)
+  auto lab = [&](std::uint32_t t) {
+    if (fast < f.code.size())  // in the fast copy: its own labels, or the exits that set the budget
+      return (t >= target_of(f.code[fast]) && t <= fast ? "V" : "X") + std::to_string(fast) + "_" +
+             std::to_string(t);
+    return "L" + std::to_string(t);
+  };
+  auto emit = [&](std::size_t at) {
     const Ins in = f.code[at];
     const std::string AT = std::to_string(at) + "u";
-    const std::string T = "L" + std::to_string(in.op < kOpCount && op_jumps(in.op) ? target_of(in) : 0);
-    if (label[at]) o << "L" << at << ":\n";
-    auto checked = [&](const char* builtin, const std::string& x, const std::string& y, const char* fault) {
+    const std::string T = lab(in.op < kOpCount && op_jumps(in.op) ? target_of(in) : 0);
+    // Checked int arithmetic into register a. The message needs the operands; when a is one of them (s +=
+    // i), passing the old value would make GCC keep a copy of it in the loop: for + and - the failing
+    // path recomputes it from the wrapped result t instead (t - y, t + y, x - t: exact modulo 2^64).
+    // @p xr, @p yr: the operands' registers (-1: an immediate).
+    auto checked = [&](const char* builtin, const std::string& x, const std::string& y, const char* fault,
+                       int xr, int yr) {
+      auto u = [](const std::string& v) { return "static_cast<std::uint64_t>(" + v + ")"; };
+      std::string fx = x, fy = y;
+      const bool add = fault[0] == 'A', sub = fault[0] == 'S';
+      if ((add || sub) && xr == in.a && yr != in.a)
+        fx = "static_cast<std::int64_t>(" + u("t") + (add ? " - " : " + ") + u(y) + ")";
+      else if ((add || sub) && yr == in.a && xr != in.a)
+        fy = "static_cast<std::int64_t>(" + (add ? u("t") + " - " + u(x) : u(x) + " - " + u("t")) + ")";
       o << "  { std::int64_t t; if (" << builtin << "(" << x << ", " << y
-        << ", &t)) [[unlikely]] fail(c, budget, Fault::" << fault << ", " << F << ", " << AT << ", " << x
-        << ", " << y << "); " << I(in.a) << " = t; }\n";
+        << ", &t)) [[unlikely]] fail(c, budget, Fault::" << fault << ", " << F << ", " << AT << ", " << fx
+        << ", " << fy << "); " << I(in.a) << " = t; }\n";
     };
     auto budget = [&](const char* fault) {
       o << "{ if (--budget == 0) [[unlikely]] fail(c, budget, Fault::" << fault << ", " << F << ", " << AT
         << "); } ";
     };
+    // LOOPLT/LOOPLE: counter + 1 (an overflow means the counter was INT64_MAX: the message's operand is
+    // that constant, so that no copy of the old counter is kept for it), then the backward jump while
+    // the counter is below (at most) the bound.
     auto loop = [&](const char* cmp, const std::string& bound) {
-      o << "  { std::int64_t t; if (__builtin_add_overflow(" << I(in.a)
-        << ", std::int64_t{1}, &t)) [[unlikely]] "
-        << "fail(c, budget, Fault::Add, " << F << ", " << AT << ", " << I(in.a) << ", 1); " << I(in.a)
-        << " = t; if (t " << cmp << " " << bound << ") { ";
+      const bool le = cmp[1] == '=';
+      const std::string top = std::to_string(target_of(in));
+      const std::string ovf = "fail(c, budget, Fault::Add, " + F + ", " + AT + ", 9223372036854775807ll, 1); ";
+      if (fast == at) {
+        // The fast copy, entered with counter < bound (<= for LOOPLE), which nothing in the body changes:
+        // counter + 1 overflows only for LOOPLE at INT64_MAX; the budget was found to cover every
+        // backward jump, so it only counts them.
+        // At the exit the counter is one past the last jump's: the budget is vb - counter + 1.
+        if (le)
+          o << "  { std::int64_t t; if (__builtin_add_overflow(" << I(in.a)
+            << ", std::int64_t{1}, &t)) [[unlikely]] " << ovf << I(in.a) << " = t; }";
+        else
+          o << "  " << I(in.a) << " = " << I(in.a) << " + 1;";
+        o << " if (" << I(in.a) << " " << cmp << " " << bound << ") goto " << T << "; budget = budget + 1;\n";
+        return;
+      }
+      o << "  { std::int64_t t; if (__builtin_add_overflow(" << I(in.a) << ", std::int64_t{1}, &t)) [[unlikely]] "
+        << ovf << I(in.a) << " = t; if (t " << cmp << " " << bound << ") { ";
       budget("LoopBudget");
+      if (counted[at]) {
+        // Backward jumps left after this one: bound - t - 1 (LOOPLT) or bound - t (LOOPLE), each needing
+        // the budget above 0 after it: the fast copy when the budget covers them (unsigned: bound - t is
+        // exact, it is positive and below 2^64).
+        o << "if (static_cast<std::uint64_t>(" << bound << ") - static_cast<std::uint64_t>(t) "
+          << (le ? "<" : "<=") << " budget) { vb" << at << " = budget + static_cast<std::uint64_t>(t); goto V"
+          << at << "_" << top << "; } ";
+      }
       o << "goto " << T << "; } }\n";
     };
     auto cmp = [&](const char* op, char v) {
@@ -207,19 +327,19 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
         o << "  " << I(in.a) << " = " << I(in.b) << "; " << D(in.a) << " = " << D(in.b) << ";\n";
         break;
       case OP_ADDI:
-        checked("__builtin_add_overflow", I(in.b), I(in.c), "Add");
+        checked("__builtin_add_overflow", I(in.b), I(in.c), "Add", in.b, in.c);
         break;
       case OP_SUBI:
-        checked("__builtin_sub_overflow", I(in.b), I(in.c), "Sub");
+        checked("__builtin_sub_overflow", I(in.b), I(in.c), "Sub", in.b, in.c);
         break;
       case OP_MULI:
-        checked("__builtin_mul_overflow", I(in.b), I(in.c), "Mul");
+        checked("__builtin_mul_overflow", I(in.b), I(in.c), "Mul", in.b, in.c);
         break;
       case OP_ADDIK:
-        checked("__builtin_add_overflow", I(in.b), imm(in.c), "Add");
+        checked("__builtin_add_overflow", I(in.b), imm(in.c), "Add", in.b, -1);
         break;
       case OP_MULIK:
-        checked("__builtin_mul_overflow", I(in.b), imm(in.c), "Mul");
+        checked("__builtin_mul_overflow", I(in.b), imm(in.c), "Mul", in.b, -1);
         break;
       case OP_DIVI:
       case OP_MODI: {
@@ -366,10 +486,12 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
         if (in.op == OP_CALL)
           o << "{ if (" << I(in.c) << " == 0) [[unlikely]] fail(c, budget, Fault::NullReference, " << F
             << ", " << AT << "); } ";
-        o << "{ if (depth >= c->max_depth) [[unlikely]] fail(c, budget, Fault::Depth, " << F << ", " << AT
-          << ", 0, " << in.b << "); } ";
+        // `left`: the frames that may still be added (the entry computed it from the depth and
+        // max_depth), so that the test reads no memory.
+        o << "{ if (left == 0) [[unlikely]] fail(c, budget, Fault::Depth, " << F << ", " << AT << ", 0, " << in.b
+          << "); } ";
         budget("CallBudget");
-        o << "\n  try { const auto r = f" << in.b << "(c, depth + 1, budget, " << self << ", mark";
+        o << "\n  try { const auto r = f" << in.b << "(c, left - 1, budget, " << self << ", mark";
         for (int p = 0; p < callee.nparams; ++p)
           o << ", " << view(callee.param_kinds[static_cast<std::size_t>(p)]) << in.a + p;
         o << "); " << (callee.result == RK::D ? D(in.a) : I(in.a))
@@ -467,9 +589,51 @@ void emit_function(std::ostream& o, const ProgramImage& img, std::size_t fi) {
       default:
         o << "  fail(c, budget, Fault::Fail, " << F << ", " << AT << ", 0, 0);  // not translated\n";
     }
+  };
+  for (std::size_t at = 0; at < f.code.size(); ++at) {
+    if (label[at]) o << "L" << at << ":\n";
+    emit(at);
   }
   if (label[f.code.size()]) o << "L" << f.code.size() << ":\n";
-  o << "  return {0, budget};\n}\n\n";
+  o << "  return {0, budget};\n";
+  // The fast copy does not count the budget down: every backward jump also adds one to the counter, so
+  // the budget is vb<loop> - counter throughout (vb set on entry); it is computed where it is needed —
+  // at a failure, a return, the exits — and the loop carries nothing for it.
+  for (std::size_t at = 0; at < f.code.size(); ++at) {
+    if (!counted[at]) continue;
+    fast = at;
+    const std::uint32_t top = target_of(f.code[at]);
+    const std::string V = std::to_string(at);
+    std::vector<char> vlabel(at + 1, 0);        // only the labels jumped to (no unused label)
+    std::vector<char> exit(f.code.size() + 1, 0);  // targets outside the loop
+    vlabel[top] = 1;
+    for (std::size_t k = top; k < at; ++k)
+      if (op_jumps(f.code[k].op)) (target_of(f.code[k]) <= at ? vlabel : exit)[target_of(f.code[k])] = 1;
+    const auto start = o.str().size();
+    o << "  // the loop of instruction " << at << " while the budget covers it\n";
+    for (std::size_t k = top; k <= at; ++k) {
+      if (vlabel[k]) o << "V" << V << "_" << k << ":\n";
+      emit(k);
+    }
+    o << "  goto L" << at + 1 << ";\n";
+    for (std::size_t t = 0; t < exit.size(); ++t)
+      if (exit[t]) o << "X" << V << "_" << t << ":\n  budget = budget;\n  goto L" << t << ";\n";
+    // Every `budget` of the copy read as vb - counter ("budget = budget" assigns it at the exits).
+    std::string text = o.str(), copy = text.substr(start);
+    const std::string bud = "(vb" + V + " - static_cast<std::uint64_t>(" + I(f.code[at].a) + "))";
+    for (const char* w : {"c, budget,", ", budget}", "= budget;", "= budget + 1;"}) {
+      const std::string from = w;
+      std::string to = from;
+      to.replace(to.find("budget"), 6, bud);
+      for (std::size_t pos = 0; (pos = copy.find(from, pos)) != std::string::npos; pos += to.size())
+        copy.replace(pos, from.size(), to);
+    }
+    o.str(text.substr(0, start) + copy);
+    o.seekp(0, std::ios_base::end);
+  }
+  fast = f.code.size();
+  o << "}\n\n";
+  out << o.str();
 }
 
 }  // namespace
@@ -576,7 +740,8 @@ void native_module_source(std::ostream& o, const ProgramImage& img, const std::s
     o << "Reg e" << i
       << "(Context* c, std::uint32_t depth, std::uint64_t self, std::uint64_t mark, "
          "[[maybe_unused]] const Reg* a) {\n"
-      << "  const auto x = f" << i << "(c, depth, c->budget, self, mark";
+      << "  const std::uint32_t left = depth >= c->max_depth ? 0 : c->max_depth - depth;\n"
+      << "  const auto x = f" << i << "(c, left, c->budget, self, mark";
     for (int p = 0; p < f.nparams; ++p)
       o << ", a[" << p << "]." << view(f.param_kinds[static_cast<std::size_t>(p)]);
     o << ");\n  c->budget = x.budget;\n  Reg r;\n  r." << view(f.result) << " = x.v;\n  return r;\n}\n";

@@ -159,6 +159,49 @@ TEST(SomlNative, BudgetAndDepthFailAtTheSamePointAsTheVm) {
   EXPECT_NE(endless.find("\n  at outer (arith.soml:27:"), std::string::npos) << endless;
 }
 
+// Counted loops run natively without the per-iteration budget test while the budget covers every
+// backward jump left (docs/soml.md 8.8): the budget still runs out at the same jump as in the VM, whether
+// it runs out in the middle of the loop, in a second loop or a call after it, or just suffices.
+TEST(SomlNative, CountedLoopsSpendTheBudgetAsTheVm) {
+  const std::string text = read_file(kArith);
+  struct Case {
+    const char* fn;
+    std::vector<vsd::Value> args;
+  };
+  const std::vector<Case> cases = {
+      {"count_loop", one(1000)},         // 999 backward jumps: a budget of 1000 just suffices
+      {"two_loops", one(500)},           // 499 + 500 jumps (the second loop <=)
+      {"loop_exit", ints(1000, 600)},    // a break, then 299 jumps
+      {"loop_exit", ints(5000, 4000)},   // a return from inside the loop
+      {"loop_then_call", one(1000)},     // 999 jumps, then calls
+      {"up_to", ints(INT64_MAX - 700, INT64_MAX)},  // the counter overflows at the end (<= INT64_MAX)
+      {"grow", ints(1000, INT64_MAX / 500)},        // the sum overflows in the loop
+  };
+  for (const std::uint64_t budget : {1ull, 2ull, 3ull, 298ull, 299ull, 300ull, 301ull, 498ull, 499ull, 500ull,
+                                     501ull, 502ull, 599ull, 600ull, 601ull, 700ull, 701ull, 702ull, 897ull,
+                                     898ull, 899ull, 900ull, 901ull, 997ull, 998ull, 999ull, 1000ull, 1001ull,
+                                     1002ull, 1010ull, 1020ull, 1021ull, 1022ull, 1023ull, 1024ull, 1025ull,
+                                     4300ull, 4301ull, 4302ull, 100000ull}) {
+    Script vm("arith.soml", text, false, budget), native("arith.soml", text, true, budget);
+    SCOPED_TRACE(budget);
+    for (const Case& c : cases) {
+      SCOPED_TRACE(c.fn);
+      EXPECT_EQ(vm.call(c.fn, c.args), native.call(c.fn, c.args));
+    }
+  }
+  // The exact edge: 999 backward jumps need a budget of 1000.
+  Script just("arith.soml", text, true, 1000), short_of("arith.soml", text, true, 999);
+  EXPECT_EQ(just.call("count_loop", one(1000)), "499500\nprinted: ");
+  const std::string e = short_of.call("count_loop", one(1000));
+  EXPECT_NE(e.find("instruction budget exhausted (999 jumps and calls): an endless loop?\n  at count_loop "
+                   "(arith.soml:6:"),
+            std::string::npos)
+      << e;
+  const std::string o = just.call("up_to", ints(INT64_MAX - 5, INT64_MAX));
+  EXPECT_NE(o.find("integer overflow: 9223372036854775807 + 1 does not fit an int (64 bits)"), std::string::npos)
+      << o;
+}
+
 // A seeded corpus of random well-typed functions (native_random_gen.cpp, built with the library):
 // every function on inputs small, large and at the edges gives the VM's result or error.
 TEST(SomlNative, RandomProgramsMatchTheVm) {

@@ -94,14 +94,22 @@ struct Module {
 inline constexpr const char* kModulesSymbol = "vsd_soml_native_modules";
 using Modules = const Module* const* (*)(std::uint32_t* count);
 
+/// What fail() calls, with the function and the instruction in one argument (@p site: fn << 32 | at): six
+/// arguments, all in registers (a seventh would go on the stack, and the pushes on the failing paths made
+/// GCC keep a frame pointer in the functions that call it).
+[[noreturn, gnu::cold, gnu::noinline]] inline void fail_site(Context* c, std::uint64_t budget, Fault f,
+                                                             std::uint64_t site, std::int64_t a,
+                                                             std::int64_t b) {
+  c->budget = budget;
+  c->fail(c, f, static_cast<std::uint32_t>(site >> 32), static_cast<std::uint32_t>(site), a, b);
+  __builtin_unreachable();
+}
+
 /// Generated code fails through this: @p budget (what is left, kept in a local) goes back to the Context
 /// first, then the runtime throws.
-[[noreturn, gnu::cold, gnu::noinline]] inline void fail(Context* c, std::uint64_t budget, Fault f,
-                                                        std::uint32_t fn, std::uint32_t at,
-                                                        std::int64_t a = 0, std::int64_t b = 0) {
-  c->budget = budget;
-  c->fail(c, f, fn, at, a, b);
-  __builtin_unreachable();
+[[noreturn, gnu::always_inline]] inline void fail(Context* c, std::uint64_t budget, Fault f, std::uint32_t fn,
+                                                  std::uint32_t at, std::int64_t a = 0, std::int64_t b = 0) {
+  fail_site(c, budget, f, (std::uint64_t{fn} << 32) | at, a, b);
 }
 
 }  // namespace vsd::soml::native
