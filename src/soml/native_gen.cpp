@@ -21,6 +21,27 @@ namespace {
 
 bool scalar(RK k) { return k == RK::I || k == RK::D || k == RK::R; }
 
+// The int compare-and-jumps (JGEI ... JNEIK): they test registers and write none.
+bool is_compare_jump(std::uint8_t op) {
+  switch (op) {
+    case OP_JGEI:
+    case OP_JGTI:
+    case OP_JLTI:
+    case OP_JLEI:
+    case OP_JEQI:
+    case OP_JNEI:
+    case OP_JGEIK:
+    case OP_JGTIK:
+    case OP_JLTIK:
+    case OP_JLEIK:
+    case OP_JEQIK:
+    case OP_JNEIK:
+      return true;
+    default:
+      return false;
+  }
+}
+
 // Whether every instruction of @p f has a translation (calls checked against @p ok, the functions known
 // to be translatable so far).
 bool translatable(const ProgramImage& img, const Function& f, const std::vector<char>& ok) {
@@ -29,6 +50,7 @@ bool translatable(const ProgramImage& img, const Function& f, const std::vector<
     if (!scalar(k)) return false;
   if (!scalar(f.result) && f.result != RK::None) return false;
   for (const Ins& in : f.code) {
+    if (is_compare_jump(in.op)) continue;
     switch (in.op) {
       case OP_NOP:
       case OP_LOADI:
@@ -63,18 +85,6 @@ bool translatable(const ProgramImage& img, const Function& f, const std::vector<
       case OP_JMP:
       case OP_JMPF:
       case OP_JMPT:
-      case OP_JGEI:
-      case OP_JGTI:
-      case OP_JLTI:
-      case OP_JLEI:
-      case OP_JEQI:
-      case OP_JNEI:
-      case OP_JGEIK:
-      case OP_JGTIK:
-      case OP_JLTIK:
-      case OP_JLEIK:
-      case OP_JEQIK:
-      case OP_JNEIK:
       case OP_LOOPLT:
       case OP_LOOPLE:
       case OP_LOOPLTK:
@@ -143,23 +153,12 @@ std::string imm(std::uint16_t v) {
 // Whether instruction @p in may write its register a (everything but jumps that only test, returns,
 // fail, stores and print; a loop instruction writes its counter).
 bool writes_a(const Ins& in) {
+  if (is_compare_jump(in.op)) return false;
   switch (in.op) {
     case OP_NOP:
     case OP_JMP:
     case OP_JMPF:
     case OP_JMPT:
-    case OP_JGEI:
-    case OP_JGTI:
-    case OP_JLTI:
-    case OP_JLEI:
-    case OP_JEQI:
-    case OP_JNEI:
-    case OP_JGEIK:
-    case OP_JGTIK:
-    case OP_JLTIK:
-    case OP_JLEIK:
-    case OP_JEQIK:
-    case OP_JNEIK:
     case OP_RET:
     case OP_RET0:
     case OP_FAIL:
