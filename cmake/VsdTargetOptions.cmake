@@ -1,7 +1,9 @@
 # Compile options for vsd's own targets. Everything here is PRIVATE so that
 # consumers never inherit our warnings, -Werror or sanitizer flags.
-function(vsd_target_options target)
-  target_compile_features(${target} PUBLIC cxx_std_20)
+# The warnings of vsd's own code (and -Werror with VSD_WERROR); vsd_target_options() adds them. Also for
+# the native SOML++ modules the tests and benchmarks generate, so that generated code stays warning-clean
+# where a user's build warns.
+function(vsd_target_warnings target)
   if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
     target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic)
     # GCC 12 and 13 report -Wrestrict false positives inside libstdc++'s operator+ on strings at -O2/-O3
@@ -13,6 +15,13 @@ function(vsd_target_options target)
     if(VSD_WERROR)
       target_compile_options(${target} PRIVATE -Werror)
     endif()
+  endif()
+endfunction()
+
+function(vsd_target_options target)
+  target_compile_features(${target} PUBLIC cxx_std_20)
+  vsd_target_warnings(${target})
+  if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
     if(VSD_SANITIZE OR VSD_BUILD_FUZZERS)
       target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
                                                -fno-sanitize-recover=all)
